@@ -1,0 +1,57 @@
+#include "app/cli/cli.h"
+
+#include <ostream>
+
+namespace flexarm::cli {
+
+const std::vector<Verb>& verbs() {
+  static const std::vector<Verb> kVerbs = {
+      {"info", "channels, units, sample rate, length, metadata and ranges of a log", runInfo},
+      {"preprocess", "differentiate, decimate with anti-alias filter, detrend, cut; write CSV",
+       runPreprocess},
+  };
+  return kVerbs;
+}
+
+bool isVerb(const std::string& word) {
+  for (const auto& v : verbs())
+    if (word == v.name) return true;
+  return false;
+}
+
+namespace {
+
+void printHelp(std::ostream& out) {
+  out << "FlexArm " << FLEXARM_VERSION
+      << " - identification, diagnosis and control of flexible robot arms\n\n"
+         "Usage:\n"
+         "  flexarm [LOG]               open the window (optionally on a log)\n"
+         "  flexarm VERB [options]      run one step without a window\n"
+         "  flexarm VERB --help         explain a verb's options\n\nVerbs:\n";
+  for (const auto& v : verbs()) {
+    std::string name = v.name;
+    name.resize(14, ' ');
+    out << "  " << name << v.summary << "\n";
+  }
+  out << "\nExit status: 0 success, 2 usage error, 3 bad input (the message names file, line\n"
+         "and problem), 4 numerical failure.\n";
+}
+
+}  // namespace
+
+int runCommandLine(const std::vector<std::string>& args, std::ostream& out, std::ostream& err) {
+  if (args.empty() || args[0] == "--help" || args[0] == "-h" || args[0] == "help") {
+    printHelp(out);
+    return kExitOk;
+  }
+  if (args[0] == "--version") {
+    out << "flexarm " << FLEXARM_VERSION << "\n";
+    return kExitOk;
+  }
+  for (const auto& v : verbs())
+    if (args[0] == v.name) return v.run({args.begin() + 1, args.end()}, out, err);
+  err << "flexarm: unknown verb '" << args[0] << "' (flexarm --help lists the verbs)\n";
+  return kExitUsage;
+}
+
+}  // namespace flexarm::cli

@@ -1,0 +1,68 @@
+#pragma once
+// The headless command line: `flexarm VERB [options]`. Each verb is a function that parses
+// its own arguments, prints JSON with --json, and returns one of the exit codes below.
+// Nothing here uses Qt, so the same verbs run in a build without the GUI.
+#include <iosfwd>
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace flexarm::cli {
+
+enum ExitCode : int {
+  kExitOk = 0,
+  kExitUsage = 2,      // unknown verb or option, missing or malformed argument
+  kExitBadInput = 3,   // unreadable or malformed input file
+  kExitNumerical = 4,  // the computation failed (diverged, singular, ...)
+};
+
+using VerbFunction = int (*)(const std::vector<std::string>& args, std::ostream& out,
+                             std::ostream& err);
+
+struct Verb {
+  const char* name;
+  const char* summary;  // one line for `flexarm --help`
+  VerbFunction run;
+};
+
+// All verbs, in the order `flexarm --help` lists them.
+const std::vector<Verb>& verbs();
+
+// Runs `flexarm ARGS...` (args excludes the program name). Returns the exit code.
+int runCommandLine(const std::vector<std::string>& args, std::ostream& out, std::ostream& err);
+
+// True when args name a verb (the executable then runs without a window).
+bool isVerb(const std::string& word);
+
+// A small option parser shared by the verbs. Options are --name VALUE, --name=VALUE or
+// flags (--json); repeated options keep every value; the rest are positional arguments.
+class ArgParser {
+ public:
+  // flags: options that take no value; valued: options that take one value.
+  ArgParser(std::vector<std::string> flags, std::vector<std::string> valued);
+  // Parses args; on failure returns false and sets error() to a sentence.
+  bool parse(const std::vector<std::string>& args);
+  const std::string& error() const { return error_; }
+
+  bool flag(const std::string& name) const;
+  std::optional<std::string> value(const std::string& name) const;
+  std::vector<std::string> values(const std::string& name) const;
+  const std::vector<std::string>& positional() const { return positional_; }
+
+  // Typed access; on a malformed value return false and set error().
+  bool number(const std::string& name, double& out);
+  bool integer(const std::string& name, long& out);
+
+ private:
+  std::vector<std::string> flags_, valued_;
+  std::map<std::string, std::vector<std::string>> values_;
+  std::vector<std::string> positional_;
+  std::string error_;
+};
+
+// Verbs. Each lives in its own verb_*.cpp.
+int runInfo(const std::vector<std::string>& args, std::ostream& out, std::ostream& err);
+int runPreprocess(const std::vector<std::string>& args, std::ostream& out, std::ostream& err);
+
+}  // namespace flexarm::cli

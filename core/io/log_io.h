@@ -1,0 +1,68 @@
+#pragma once
+// Reading and writing robot logs: the FlexArm CSV log (shared/notes/log-format.md),
+// headerless numeric tables with a user column mapping, and MATLAB .mat files.
+// Bad input never throws and never yields partial data: the result carries a ReadError
+// naming the file, the line and column (or variable) and the problem.
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "core/signal/id_data.h"
+
+namespace flexarm {
+
+struct ReadError {
+  std::string file;
+  int line = 0;             // 1-based; 0 when the problem is not on one line
+  int column = 0;           // 1-based field number; 0 when not about one field
+  std::string columnName;   // header name or .mat variable, when known
+  std::string problem;      // a sentence, e.g. "'abc' is not a number"
+  // "file:line: column 3 (torque_ref_nm): 'abc' is not a number"
+  std::string toString() const;
+};
+
+struct LogReadResult {
+  bool ok = false;
+  IdData data;
+  ReadError error;
+};
+
+enum class LogFormat { Auto, FlexArmCsv, Table, Mat };
+const char* toString(LogFormat f);
+
+struct LogReadOptions {
+  LogFormat format = LogFormat::Auto;  // Auto: .mat by extension or magic, CSV with header
+                                       // when the first data line is not numeric, else Table
+  std::uint64_t maxFileBytes = 2ull << 30;  // larger files are refused with a clear message
+  double maxSampleJitter = 0.01;            // relative deviation from the mean interval
+
+  // Headerless tables and .mat files without FlexArm names: which column (1-based) or
+  // variable is the input u and the output y, an optional time column, and the sample time
+  // used when there is no time column.
+  int inputColumn = 1;
+  int outputColumn = 2;
+  int timeColumn = 0;  // 0: none, use sampleTime
+  double sampleTime = 1.0;
+  std::string inputName = "u";
+  std::string outputName = "y";
+  std::string inputVariable;   // .mat: variable holding u (default: torque_ref_nm or u)
+  std::string outputVariable;  // .mat: variable holding y (default: motor_angle_rad or y)
+
+  bool isValid(std::string* why) const;
+};
+
+// Reads any supported log; see LogReadOptions::format.
+LogReadResult readLog(const std::string& path, const LogReadOptions& options = {});
+LogReadResult readFlexArmCsv(const std::string& path, const LogReadOptions& options = {});
+LogReadResult readTable(const std::string& path, const LogReadOptions& options = {});
+LogReadResult readMat(const std::string& path, const LogReadOptions& options = {});
+
+// Writes data in the FlexArm CSV format (metadata, header, time column, every channel).
+// The file is written to a temporary sibling and renamed, so a failure leaves any previous
+// file untouched. Returns false and fills error on failure.
+bool writeFlexArmCsv(const IdData& data, const std::string& path, ReadError* error = nullptr);
+
+// Writes text to path atomically (temporary sibling, flush, rename).
+bool writeFileAtomically(const std::string& path, const std::string& text, std::string* why);
+
+}  // namespace flexarm
