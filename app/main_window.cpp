@@ -1,0 +1,339 @@
+#include "app/main_window.h"
+
+#include <QAction>
+#include <QApplication>
+#include <QCloseEvent>
+#include <QDateTime>
+#include <QDialog>
+#include <QDialogButtonBox>
+#include <QDockWidget>
+#include <QDoubleSpinBox>
+#include <QDragEnterEvent>
+#include <QDropEvent>
+#include <QFileDialog>
+#include <QFileInfo>
+#include <QFormLayout>
+#include <QLabel>
+#include <QMenuBar>
+#include <QMessageBox>
+#include <QMimeData>
+#include <QProgressDialog>
+#include <QSettings>
+#include <QSpinBox>
+#include <QStatusBar>
+#include <QtConcurrent>
+#include <fstream>
+#include <sstream>
+
+#include "app/cli/cli.h"
+#include "core/io/ranges.h"
+#include "widgets/arm_panel.h"
+#include "widgets/log_panel.h"
+#include "widgets/preprocess_panel.h"
+#include "widgets/workspace.h"
+
+namespace flexarm {
+namespace {
+
+constexpr int kMaxRecent = 8;
+
+// True when the first non-comment line of the file starts with a number: a headerless table.
+bool looksLikeTable(const QString& path) {
+  if (path.endsWith(".mat", Qt::CaseInsensitive)) return false;
+  std::ifstream in(path.toStdString());
+  std::string line;
+  for (int n = 0; n < 200 && std::getline(in, line); ++n) {
+    const auto p = line.find_first_not_of(" \t\r");
+    if (p == std::string::npos || line[p] == '#' || line[p] == '%') continue;
+    const char c = line[p];
+    return (c >= '0' && c <= '9') || c == '-' || c == '+' || c == '.';
+  }
+  return false;
+}
+
+// Asks for the column mapping and sample time of a headerless table.
+bool askTableMapping(QWidget* parent, const QString& path, LogReadOptions& o) {
+  QDialog dialog(parent);
+  dialog.setWindowTitle(QObject::tr("Import a headerless table"));
+  auto* form = new QFormLayout(&dialog);
+  form->addRow(new QLabel(QObject::tr("%1 has no header. Which columns are the input u and "
+                                      "the output y?").arg(QFileInfo(path).fileName())));
+  auto* in = new QSpinBox;
+  auto* out = new QSpinBox;
+  auto* time = new QSpinBox;
+  in->setRange(1, 1000);
+  out->setRange(1, 1000);
+  time->setRange(0, 1000);
+  in->setValue(o.inputColumn);
+  out->setValue(o.outputColumn);
+  time->setValue(o.timeColumn);
+  time->setSpecialValueText(QObject::tr("none"));
+  auto* ts = new QDoubleSpinBox;
+  ts->setDecimals(6);
+  ts->setRange(1e-6, 1e6);
+  ts->setValue(o.sampleTime);
+  ts->setSuffix(" s");
+  form->addRow(QObject::tr("Input u column"), in);
+  form->addRow(QObject::tr("Output y column"), out);
+  form->addRow(QObject::tr("Time column"), time);
+  form->addRow(QObject::tr("Sample time (without time column)"), ts);
+  auto* buttons = new QDialogButtonBox(QDialogButtonBox::Ok | QDialogButtonBox::Cancel);
+  form->addRow(buttons);
+  QObject::connect(buttons, &QDialogButtonBox::accepted, &dialog, &QDialog::accept);
+  QObject::connect(buttons, &QDialogButtonBox::rejected, &dialog, &QDialog::reject);
+  if (dialog.exec() != QDialog::Accepted) return false;
+  o.format = LogFormat::Table;
+  o.inputColumn = in->value();
+  o.outputColumn = out->value();
+  o.timeColumn = time->value();
+  o.sampleTime = ts->value();
+  return true;
+}
+
+}  // namespace
+
+MainWindow::MainWindow(QWidget* parent)
+    : QMainWindow(parent), workspace_(new Workspace(this)),
+      logPanel_(new LogPanel(workspace_, this)),
+      preprocessPanel_(new PreprocessPanel(workspace_, this)),
+      armPanel_(new ArmPanel(workspace_, this)),
+      preprocessDock_(new QDockWidget(tr("Preprocess"), this)),
+      armDock_(new QDockWidget(tr("Arm"), this)) {
+  setObjectName("mainWindow");
+  setWindowTitle("FlexArm");
+  setAcceptDrops(true);
+  setCentralWidget(logPanel_);
+  preprocessDock_->setObjectName("preprocessDock");
+  preprocessDock_->setWidget(preprocessPanel_);
+  armDock_->setObjectName("armDock");
+  armDock_->setWidget(armPanel_);
+  addDockWidget(Qt::RightDockWidgetArea, preprocessDock_);
+  addDockWidget(Qt::RightDockWidgetArea, armDock_);
+  resize(1280, 860);
+  createMenus();
+
+  QSettings settings;
+  restoreGeometry(settings.value("window/geometry").toByteArray());
+  restoreState(settings.value("window/state").toByteArray());
+  rebuildRecentMenu();
+  statusBar()->showMessage(tr("Open a robot log with Ctrl+O, or drop it on the window"));
+
+  connect(&reader_, &QFutureWatcher<LogReadResult>::finished, this, &MainWindow::onReadFinished);
+  connect(workspace_, &Workspace::rangesChanged, this, [this] {
+    QStringList parts;
+    for (RangeKind k : {RangeKind::Estimation, RangeKind::Validation})
+      if (auto r = workspace_->range(k))
+        parts << tr("%1 %2-%3 s (%4 samples)")
+                     .arg(toString(k))
+                     .arg(r->start, 0, 'f', 3)
+                     .arg(r->end, 0, 'f', 3)
+                     .arg(workspace_->samples(k).size());
+    if (!parts.isEmpty()) statusBar()->showMessage(parts.join("; "), 8000);
+  });
+  connect(workspace_, &Workspace::currentChanged, this, [this] {
+    if (workspace_->isPreprocessed())
+      statusBar()->showMessage(tr("Preprocessed data in use: %1 samples at %2 Hz")
+                                   .arg(workspace_->current()->samples())
+                                   .arg(workspace_->current()->sampleRateHz(), 0, 'g', 6),
+                               8000);
+  });
+}
+
+MainWindow::~MainWindow() { reader_.waitForFinished(); }
+
+void MainWindow::createMenus() {
+  QMenu* file = menuBar()->addMenu(tr("&File"));
+  QAction* open = file->addAction(tr("&Open log..."), this, &MainWindow::openDialog);
+  open->setShortcut(QKeySequence::Open);
+  recentMenu_ = file->addMenu(tr("Open &recent"));
+  QAction* exportAction = file->addAction(tr("&Export data as CSV..."), this, &MainWindow::exportData);
+  exportAction->setShortcut(QKeySequence("Ctrl+E"));
+  file->addSeparator();
+  QAction* quit = file->addAction(tr("&Quit"), this, &QWidget::close);
+  quit->setShortcut(QKeySequence::Quit);
+
+  QMenu* data = menuBar()->addMenu(tr("&Data"));
+  auto mode = [this, data](const QString& text, const QString& keys, LogPanel::Mode m) {
+    QAction* a = data->addAction(text, this, [this, m] { logPanel_->setMode(m); });
+    a->setShortcut(QKeySequence(keys));
+  };
+  mode(tr("&Zoom and pan"), "Ctrl+1", LogPanel::Mode::Navigate);
+  mode(tr("Select &estimation range"), "Ctrl+2", LogPanel::Mode::SelectEstimation);
+  mode(tr("Select &validation range"), "Ctrl+3", LogPanel::Mode::SelectValidation);
+  data->addSeparator();
+  QAction* all = data->addAction(tr("&Show whole log"), logPanel_, &LogPanel::showAll);
+  all->setShortcut(QKeySequence("Ctrl+0"));
+  QAction* apply = data->addAction(tr("&Apply preprocessing"), preprocessPanel_, &PreprocessPanel::apply);
+  apply->setShortcut(QKeySequence("Ctrl+Return"));
+  data->addAction(tr("&Undo preprocessing"), preprocessPanel_, &PreprocessPanel::reset);
+
+  QMenu* view = menuBar()->addMenu(tr("&View"));
+  QAction* pre = preprocessDock_->toggleViewAction();
+  pre->setShortcut(QKeySequence("Ctrl+Shift+P"));
+  view->addAction(pre);
+  QAction* arm = armDock_->toggleViewAction();
+  arm->setShortcut(QKeySequence("Ctrl+Shift+A"));
+  view->addAction(arm);
+
+  QMenu* help = menuBar()->addMenu(tr("&Help"));
+  help->addAction(tr("&Command line..."), this, [this] {
+    std::ostringstream out, err;
+    cli::runCommandLine({"--help"}, out, err);
+    QMessageBox box(QMessageBox::Information, tr("FlexArm command line"),
+                    tr("The same executable runs every step without a window:"), QMessageBox::Ok, this);
+    box.setInformativeText(QString::fromStdString(out.str()));
+    box.exec();
+  });
+  help->addAction(tr("&About FlexArm"), this, [this] {
+    QMessageBox::about(this, tr("About FlexArm"),
+                       tr("<b>FlexArm %1</b><p>Identification, diagnosis and control of "
+                          "flexible robot arms.</p>").arg(FLEXARM_VERSION));
+  });
+}
+
+void MainWindow::openDialog() {
+  QSettings settings;
+  const QString path = QFileDialog::getOpenFileName(
+      this, tr("Open robot log"), settings.value("lastDir").toString(),
+      tr("Robot logs (*.csv *.dat *.txt *.mat);;All files (*)"));
+  if (!path.isEmpty()) openFile(path);
+}
+
+void MainWindow::openFile(const QString& path) {
+  LogReadOptions options;
+  if (looksLikeTable(path) && !askTableMapping(this, path, options)) {
+    statusBar()->showMessage(tr("Opening %1 cancelled").arg(path), 5000);
+    return;
+  }
+  openFile(path, options);
+}
+
+void MainWindow::openFile(const QString& path, const LogReadOptions& options) {
+  if (reader_.isRunning()) {
+    statusBar()->showMessage(tr("Still reading %1").arg(readingPath_), 4000);
+    return;
+  }
+  readingPath_ = path;
+  readCancelled_ = false;
+  readStartMs_ = QDateTime::currentMSecsSinceEpoch();
+  statusBar()->showMessage(tr("Reading %1...").arg(path));
+  if (!progress_) {
+    progress_ = new QProgressDialog(this);
+    progress_->setWindowTitle(tr("Opening log"));
+    progress_->setRange(0, 0);
+    progress_->setMinimumDuration(400);
+    progress_->setAutoClose(false);
+    progress_->setAutoReset(false);
+    connect(progress_, &QProgressDialog::canceled, this, [this] { readCancelled_ = true; });
+  }
+  progress_->setLabelText(tr("Reading %1").arg(QFileInfo(path).fileName()));
+  progress_->reset();
+  progress_->setRange(0, 0);
+  const std::string p = path.toStdString();
+  reader_.setFuture(QtConcurrent::run([p, options] { return readLog(p, options); }));
+}
+
+void MainWindow::onReadFinished() {
+  if (progress_) progress_->hide();
+  if (readCancelled_) {
+    statusBar()->showMessage(tr("Opening %1 cancelled").arg(readingPath_), 5000);
+    return;
+  }
+  LogReadResult r = reader_.result();
+  if (!r.ok) {
+    const QString msg = QString::fromStdString(r.error.toString());
+    statusBar()->showMessage(tr("Could not open %1").arg(readingPath_), 10000);
+    showError(tr("Could not open the log"), msg);
+    emit openFailed(msg);
+    return;
+  }
+  const double seconds = (QDateTime::currentMSecsSinceEpoch() - readStartMs_) / 1000.0;
+  const std::size_t samples = r.data.samples(), channels = r.data.channels.size();
+  const double rate = r.data.sampleRateHz();
+  workspace_->setLog(std::move(r.data), readingPath_);
+  addRecent(readingPath_);
+  QSettings().setValue("lastDir", QFileInfo(readingPath_).absolutePath());
+  setWindowTitle(QString("FlexArm - %1").arg(QFileInfo(readingPath_).fileName()));
+  statusBar()->showMessage(tr("Opened %1: %2 channels, %3 samples at %4 Hz (%5 s)")
+                               .arg(QFileInfo(readingPath_).fileName())
+                               .arg(channels)
+                               .arg(samples)
+                               .arg(rate, 0, 'g', 6)
+                               .arg(seconds, 0, 'f', 2));
+  emit logOpened(readingPath_);
+}
+
+void MainWindow::showError(const QString& title, const QString& message) {
+  // Not modal-blocking: the window stays usable and tests are not held up.
+  auto* box = new QMessageBox(QMessageBox::Warning, title, message, QMessageBox::Ok, this);
+  box->setObjectName("errorBox");
+  box->setAttribute(Qt::WA_DeleteOnClose);
+  box->open();
+}
+
+void MainWindow::exportData() {
+  if (!workspace_->hasLog()) {
+    statusBar()->showMessage(tr("Nothing to export: open a log first"), 5000);
+    return;
+  }
+  QSettings settings;
+  const QString path = QFileDialog::getSaveFileName(this, tr("Export data"),
+                                                    settings.value("lastDir").toString(),
+                                                    tr("FlexArm CSV log (*.csv)"));
+  if (path.isEmpty()) return;
+  IdData d = workspace_->currentWithRanges();
+  storeRanges(d);
+  ReadError err;
+  if (!writeFlexArmCsv(d, path.toStdString(), &err))
+    showError(tr("Export failed"), QString::fromStdString(err.toString()));
+  else
+    statusBar()->showMessage(tr("Wrote %1 (%2 samples)").arg(path).arg(d.samples()), 6000);
+}
+
+QStringList MainWindow::recentFiles() const {
+  return QSettings().value("recentFiles").toStringList();
+}
+
+void MainWindow::addRecent(const QString& path) {
+  QStringList list = recentFiles();
+  const QString abs = QFileInfo(path).absoluteFilePath();
+  list.removeAll(abs);
+  list.prepend(abs);
+  while (list.size() > kMaxRecent) list.removeLast();
+  QSettings().setValue("recentFiles", list);
+  rebuildRecentMenu();
+}
+
+void MainWindow::rebuildRecentMenu() {
+  recentMenu_->clear();
+  const QStringList list = recentFiles();
+  for (int i = 0; i < list.size(); ++i) {
+    QAction* a = recentMenu_->addAction(QString("&%1 %2").arg(i + 1).arg(QFileInfo(list[i]).fileName()),
+                                        this, [this, p = list[i]] { openFile(p); });
+    a->setToolTip(list[i]);
+    if (i < 9) a->setShortcut(QKeySequence(QString("Alt+Shift+%1").arg(i + 1)));
+  }
+  recentMenu_->setEnabled(!list.isEmpty());
+}
+
+void MainWindow::closeEvent(QCloseEvent* e) {
+  QSettings settings;
+  settings.setValue("window/geometry", saveGeometry());
+  settings.setValue("window/state", saveState());
+  QMainWindow::closeEvent(e);
+}
+
+void MainWindow::dragEnterEvent(QDragEnterEvent* e) {
+  if (e->mimeData()->hasUrls() && !e->mimeData()->urls().isEmpty() &&
+      e->mimeData()->urls().first().isLocalFile())
+    e->acceptProposedAction();
+}
+
+void MainWindow::dropEvent(QDropEvent* e) {
+  const auto urls = e->mimeData()->urls();
+  if (urls.isEmpty() || !urls.first().isLocalFile()) return;
+  e->acceptProposedAction();
+  openFile(urls.first().toLocalFile());
+}
+
+}  // namespace flexarm

@@ -1,0 +1,72 @@
+#pragma once
+// The main window: the Log panel in the centre, dockable Preprocess and Arm panels, menus
+// with shortcuts, recent files, drag-and-drop to open, settings kept between runs and
+// status bar messages. Logs are read off the GUI thread.
+#include <QFutureWatcher>
+#include <QMainWindow>
+#include <QStringList>
+
+#include "core/io/log_io.h"
+
+class QDockWidget;
+class QMenu;
+class QProgressDialog;
+
+namespace flexarm {
+
+class ArmPanel;
+class LogPanel;
+class PreprocessPanel;
+class Workspace;
+
+class MainWindow : public QMainWindow {
+  Q_OBJECT
+ public:
+  explicit MainWindow(QWidget* parent = nullptr);
+  ~MainWindow() override;
+
+  // Reads a log in the background; a headerless table first asks for its column mapping
+  // unless options are given. Emits logOpened or openFailed.
+  void openFile(const QString& path);
+  void openFile(const QString& path, const LogReadOptions& options);
+  bool isOpening() const { return reader_.isRunning(); }
+
+  Workspace* workspace() const { return workspace_; }
+  LogPanel* logPanel() const { return logPanel_; }
+  PreprocessPanel* preprocessPanel() const { return preprocessPanel_; }
+  ArmPanel* armPanel() const { return armPanel_; }
+  QStringList recentFiles() const;
+
+ signals:
+  void logOpened(const QString& path);
+  void openFailed(const QString& message);
+
+ protected:
+  void closeEvent(QCloseEvent* e) override;
+  void dragEnterEvent(QDragEnterEvent* e) override;
+  void dropEvent(QDropEvent* e) override;
+
+ private:
+  void createMenus();
+  void openDialog();
+  void exportData();
+  void addRecent(const QString& path);
+  void rebuildRecentMenu();
+  void onReadFinished();
+  void showError(const QString& title, const QString& message);
+
+  Workspace* workspace_;
+  LogPanel* logPanel_;
+  PreprocessPanel* preprocessPanel_;
+  ArmPanel* armPanel_;
+  QDockWidget* preprocessDock_;
+  QDockWidget* armDock_;
+  QMenu* recentMenu_ = nullptr;
+  QFutureWatcher<LogReadResult> reader_;
+  QProgressDialog* progress_ = nullptr;
+  QString readingPath_;
+  bool readCancelled_ = false;
+  qint64 readStartMs_ = 0;
+};
+
+}  // namespace flexarm

@@ -1,0 +1,44 @@
+#pragma once
+// Helpers shared by the widget tests: the VTK surface format, screenshots, pixel checks.
+#include <QDir>
+#include <QImage>
+#include <QString>
+#include <QWidget>
+
+#include "widgets/arm/vtk_view.h"
+
+namespace flexarm::test {
+
+// Saves a screenshot under the build tree's screenshots/ folder and returns its path.
+inline QString saveShot(const QImage& image, const QString& name) {
+  QDir().mkpath(FLEXARM_SCREENSHOT_DIR);
+  const QString path = QString(FLEXARM_SCREENSHOT_DIR) + "/" + name + ".png";
+  image.save(path);
+  return path;
+}
+
+// Fraction of pixels that look like the arm's orange paint (RGB 237,115,26 before lighting).
+inline double orangeFraction(const QImage& image) {
+  const QImage img = image.convertToFormat(QImage::Format_RGB32);
+  qint64 hits = 0;
+  for (int y = 0; y < img.height(); ++y)
+    for (int x = 0; x < img.width(); ++x) {
+      const QColor c = img.pixelColor(x, y);
+      if (c.red() > 90 && c.red() > 1.4 * c.green() && c.green() > c.blue() + 15) ++hits;
+    }
+  return img.isNull() ? 0.0 : static_cast<double>(hits) / (img.width() * img.height());
+}
+
+// Number of pixels whose colour differs between two images of the same size.
+inline qint64 differingPixels(const QImage& a, const QImage& b) {
+  if (a.size() != b.size()) return -1;
+  const QImage x = a.convertToFormat(QImage::Format_RGB32);
+  const QImage y = b.convertToFormat(QImage::Format_RGB32);
+  qint64 n = 0;
+  for (int r = 0; r < x.height(); ++r)
+    for (int c = 0; c < x.width(); ++c)
+      if (x.pixel(c, r) != y.pixel(c, r)) ++n;
+  return n;
+}
+
+}  // namespace flexarm::test

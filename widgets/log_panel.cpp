@@ -1,0 +1,335 @@
+#include "widgets/log_panel.h"
+
+#include <QHBoxLayout>
+#include <QHeaderView>
+#include <QLabel>
+#include <QTableWidget>
+#include <QToolButton>
+#include <QVBoxLayout>
+#include <algorithm>
+#include <cmath>
+#include <qcustomplot.h>
+
+namespace flexarm {
+namespace {
+
+const QColor kEstimationColor(30, 110, 220);
+const QColor kValidationColor(235, 130, 20);
+const QColor kTraceColors[] = {QColor(31, 119, 180), QColor(214, 39, 40), QColor(44, 160, 44),
+                               QColor(148, 103, 189), QColor(140, 86, 75), QColor(227, 119, 194),
+                               QColor(127, 127, 127), QColor(188, 189, 34)};
+
+QString label(const Channel& c) {
+  QString s = QString::fromStdString(c.name);
+  if (!c.unit.empty()) s += QString(" [%1]").arg(QString::fromStdString(c.unit));
+  if (c.role != ChannelRole::None) s += QString("\n(%1)").arg(toString(c.role));
+  return s;
+}
+
+}  // namespace
+
+LogPanel::LogPanel(Workspace* workspace, QWidget* parent)
+    : QWidget(parent), workspace_(workspace), plot_(new QCustomPlot(this)),
+      readout_(new QLabel(this)), rangeTable_(new QTableWidget(2, 4, this)) {
+  setObjectName("logPanel");
+  auto* tools = new QHBoxLayout;
+  auto makeButton = [&](const QString& text, const QString& tip, const QString& shortcut) {
+    auto* b = new QToolButton(this);
+    b->setText(text);
+    b->setToolTip(tip + " (" + shortcut + ")");
+    b->setShortcut(QKeySequence(shortcut));
+    b->setCheckable(true);
+    b->setAutoExclusive(true);
+    b->setToolButtonStyle(Qt::ToolButtonTextOnly);
+    tools->addWidget(b);
+    return b;
+  };
+  navigateButton_ = makeButton(tr("Zoom / pan"), tr("Wheel zooms time, drag pans"), "Z");
+  estimationButton_ =
+      makeButton(tr("Select estimation range"), tr("Drag in the plot to select"), "E");
+  validationButton_ =
+      makeButton(tr("Select validation range"), tr("Drag in the plot to select"), "V");
+  navigateButton_->setObjectName("navigateButton");
+  estimationButton_->setObjectName("estimationButton");
+  validationButton_->setObjectName("validationButton");
+  navigateButton_->setChecked(true);
+  auto* clear = new QToolButton(this);
+  clear->setText(tr("Clear ranges"));
+  clear->setObjectName("clearRangesButton");
+  auto* all = new QToolButton(this);
+  all->setText(tr("Show all"));
+  all->setToolTip(tr("Show the whole log (double click in the plot does the same)"));
+  tools->addSpacing(12);
+  tools->addWidget(all);
+  tools->addWidget(clear);
+  tools->addStretch(1);
+
+  readout_->setObjectName("readout");
+  readout_->setTextInteractionFlags(Qt::TextSelectableByMouse);
+  readout_->setText(tr("Open a log (Ctrl+O or drop a file here)"));
+  QFont mono = readout_->font();
+  mono.setFamily("monospace");
+  mono.setStyleHint(QFont::Monospace);
+  readout_->setFont(mono);
+
+  rangeTable_->setObjectName("rangeTable");
+  rangeTable_->setHorizontalHeaderLabels({tr("Range"), tr("From [s]"), tr("To [s]"), tr("Samples")});
+  rangeTable_->verticalHeader()->hide();
+  rangeTable_->horizontalHeader()->setSectionResizeMode(QHeaderView::Stretch);
+  rangeTable_->setEditTriggers(QAbstractItemView::NoEditTriggers);
+  rangeTable_->setSelectionMode(QAbstractItemView::NoSelection);
+  rangeTable_->setMaximumHeight(rangeTable_->horizontalHeader()->height() +
+                                2 * rangeTable_->verticalHeader()->defaultSectionSize() + 6);
+
+  plot_->setObjectName("logPlot");
+  plot_->setNoAntialiasingOnDrag(true);
+  plot_->setInteractions(QCP::iRangeDrag | QCP::iRangeZoom);
+  plot_->setMinimumHeight(240);
+
+  auto* layout = new QVBoxLayout(this);
+  layout->setContentsMargins(4, 4, 4, 4);
+  layout->addLayout(tools);
+  layout->addWidget(plot_, 1);
+  layout->addWidget(readout_);
+  layout->addWidget(rangeTable_);
+
+  connect(navigateButton_, &QToolButton::toggled, this, [this](bool on) { if (on) setMode(Mode::Navigate); });
+  connect(estimationButton_, &QToolButton::toggled, this, [this](bool on) { if (on) setMode(Mode::SelectEstimation); });
+  connect(validationButton_, &QToolButton::toggled, this, [this](bool on) { if (on) setMode(Mode::SelectValidation); });
+  connect(clear, &QToolButton::clicked, this, [this] {
+    workspace_->clearRange(RangeKind::Estimation);
+    workspace_->clearRange(RangeKind::Validation);
+  });
+  connect(all, &QToolButton::clicked, this, &LogPanel::showAll);
+  connect(plot_, &QCustomPlot::mousePress, this, &LogPanel::onMousePress);
+  connect(plot_, &QCustomPlot::mouseMove, this, &LogPanel::onMouseMove);
+  connect(plot_, &QCustomPlot::mouseRelease, this, &LogPanel::onMouseRelease);
+  connect(plot_, &QCustomPlot::mouseDoubleClick, this, &LogPanel::onMouseDoubleClick);
+  connect(workspace_, &Workspace::currentChanged, this, &LogPanel::rebuild);
+  connect(workspace_, &Workspace::rangesChanged, this, &LogPanel::updateRanges);
+  rebuild();
+}
+
+void LogPanel::setMode(Mode m) {
+  mode_ = m;
+  QToolButton* b = m == Mode::Navigate           ? navigateButton_
+                   : m == Mode::SelectEstimation ? estimationButton_
+                                                 : validationButton_;
+  if (!b->isChecked()) b->setChecked(true);
+  plot_->setInteraction(QCP::iRangeDrag, m == Mode::Navigate);
+  plot_->setCursor(m == Mode::Navigate ? Qt::OpenHandCursor : Qt::IBeamCursor);
+}
+
+QCPAxisRect* LogPanel::channelRect(int i) const {
+  return i >= 0 && i < channelCount() ? rects_[static_cast<std::size_t>(i)] : nullptr;
+}
+
+double LogPanel::pixelForTime(double t) const {
+  return rects_.empty() ? 0.0 : rects_.front()->axis(QCPAxis::atBottom)->coordToPixel(t);
+}
+
+double LogPanel::timeAtPixel(double x) const {
+  return rects_.empty() ? 0.0 : rects_.front()->axis(QCPAxis::atBottom)->pixelToCoord(x);
+}
+
+QString LogPanel::readoutText() const { return readout_->text(); }
+
+void LogPanel::rebuild() {
+  plot_->clearItems();
+  plot_->clearGraphs();
+  plot_->plotLayout()->clear();
+  rects_.clear();
+  cursors_.clear();
+  estimationRects_.clear();
+  validationRects_.clear();
+  const IdData* data = workspace_->current();
+  if (!plot_->layer("ranges")) {
+    plot_->addLayer("ranges", plot_->layer("main"), QCustomPlot::limBelow);
+    plot_->addLayer("cursor", plot_->layer("main"), QCustomPlot::limAbove);
+  }
+  plot_->layer("ranges")->setMode(QCPLayer::lmBuffered);
+  overlay_ = plot_->layer("cursor");
+  overlay_->setMode(QCPLayer::lmBuffered);
+  if (!data || data->channels.empty()) {
+    plot_->replot();
+    updateRanges();
+    return;
+  }
+  auto* margins = new QCPMarginGroup(plot_);
+  const std::size_t n = data->samples();
+  QVector<double> keys(static_cast<int>(n));
+  for (std::size_t i = 0; i < n; ++i) keys[static_cast<int>(i)] = data->timeAt(i);
+  for (std::size_t c = 0; c < data->channels.size(); ++c) {
+    const Channel& ch = data->channels[c];
+    auto* rect = new QCPAxisRect(plot_);
+    plot_->plotLayout()->addElement(static_cast<int>(c), 0, rect);
+    rect->setMarginGroup(QCP::msLeft | QCP::msRight, margins);
+    rect->setRangeDrag(Qt::Horizontal);
+    rect->setRangeZoom(Qt::Horizontal);
+    rect->setupFullAxesBox(false);
+    QCPAxis* x = rect->axis(QCPAxis::atBottom);
+    QCPAxis* y = rect->axis(QCPAxis::atLeft);
+    y->setLabel(label(ch));
+    const bool last = c + 1 == data->channels.size();
+    x->setTickLabels(last);
+    if (last) x->setLabel(tr("time [s]"));
+    for (QCPAxis* a : rect->axes()) a->setLayer("axes");
+    auto* g = plot_->addGraph(x, y);
+    g->setPen(QPen(kTraceColors[c % 8], 1.2));
+    g->setAdaptiveSampling(true);
+    QVector<double> values(static_cast<int>(n));
+    std::copy(ch.values.begin(), ch.values.end(), values.begin());
+    g->setData(keys, values, true);
+    g->rescaleValueAxis(false, false);
+    QCPRange yr = y->range();
+    const double pad = std::max(1e-12, 0.05 * yr.size());
+    y->setRange(yr.lower - pad, yr.upper + pad);
+    rects_.push_back(rect);
+    connect(x, QOverload<const QCPRange&>::of(&QCPAxis::rangeChanged), this,
+            [this, rect](const QCPRange&) { syncTimeAxes(rect); });
+
+    auto* cursor = new QCPItemStraightLine(plot_);
+    cursor->setLayer(overlay_);
+    cursor->setClipAxisRect(rect);
+    for (auto* p : {cursor->point1, cursor->point2}) {
+      p->setAxes(x, y);
+      p->setAxisRect(rect);
+      p->setTypeX(QCPItemPosition::ptPlotCoords);
+      p->setTypeY(QCPItemPosition::ptAxisRectRatio);
+    }
+    cursor->point1->setCoords(data->startTime, 0);
+    cursor->point2->setCoords(data->startTime, 1);
+    cursor->setPen(QPen(QColor(60, 60, 60), 1, Qt::DashLine));
+    cursor->setVisible(false);
+    cursors_.push_back(cursor);
+
+    for (auto [list, color] : {std::pair{&estimationRects_, kEstimationColor},
+                               std::pair{&validationRects_, kValidationColor}}) {
+      auto* r = new QCPItemRect(plot_);
+      r->setLayer("ranges");
+      r->setClipAxisRect(rect);
+      for (auto* p : {r->topLeft, r->bottomRight}) {
+        p->setAxes(x, y);
+        p->setAxisRect(rect);
+        p->setTypeX(QCPItemPosition::ptPlotCoords);
+        p->setTypeY(QCPItemPosition::ptAxisRectRatio);
+      }
+      QColor fill = color;
+      fill.setAlpha(55);
+      r->setBrush(fill);
+      r->setPen(QPen(color, 1));
+      r->setVisible(false);
+      list->push_back(r);
+    }
+  }
+  showAll();
+  updateRanges();
+  readout_->setText(tr("%1 channels, %2 samples at %3 Hz, %4 s")
+                        .arg(data->channels.size())
+                        .arg(n)
+                        .arg(data->sampleRateHz(), 0, 'g', 6)
+                        .arg(data->duration(), 0, 'g', 6));
+}
+
+void LogPanel::showAll() {
+  const IdData* data = workspace_->current();
+  if (!data || rects_.empty()) return;
+  for (auto* r : rects_)
+    r->axis(QCPAxis::atBottom)->setRange(data->startTime, data->timeAt(data->samples() - 1));
+  plot_->replot();
+}
+
+void LogPanel::syncTimeAxes(QCPAxisRect* source) {
+  if (syncing_) return;
+  syncing_ = true;
+  const QCPRange r = source->axis(QCPAxis::atBottom)->range();
+  for (auto* rect : rects_)
+    if (rect != source) rect->axis(QCPAxis::atBottom)->setRange(r);
+  syncing_ = false;
+}
+
+void LogPanel::placeRect(QCPItemRect* item, double t0, double t1, bool visible) {
+  item->topLeft->setCoords(std::min(t0, t1), 0);
+  item->bottomRight->setCoords(std::max(t0, t1), 1);
+  item->setVisible(visible);
+}
+
+void LogPanel::updateRanges() {
+  struct Row {
+    RangeKind kind;
+    std::vector<QCPItemRect*>* rects;
+    QColor color;
+  };
+  const Row rows[] = {{RangeKind::Estimation, &estimationRects_, kEstimationColor},
+                      {RangeKind::Validation, &validationRects_, kValidationColor}};
+  for (int i = 0; i < 2; ++i) {
+    const Row& row = rows[i];
+    const auto r = workspace_->range(row.kind);
+    for (auto* item : *row.rects) placeRect(item, r ? r->start : 0, r ? r->end : 0, r.has_value());
+    const SampleRange s = workspace_->samples(row.kind);
+    QStringList cells = {row.kind == RangeKind::Estimation ? tr("Estimation") : tr("Validation"),
+                         r ? QString::number(r->start, 'f', 4) : QString("-"),
+                         r ? QString::number(r->end, 'f', 4) : QString("-"),
+                         r ? QString::number(s.size()) : tr("drag in the plot")};
+    for (int c = 0; c < 4; ++c) {
+      auto* item = new QTableWidgetItem(cells[c]);
+      if (c == 0) item->setForeground(row.color.darker(120));
+      rangeTable_->setItem(i, c, item);
+    }
+  }
+  if (auto* layer = plot_->layer("ranges")) layer->replot();
+  plot_->replot(QCustomPlot::rpQueuedReplot);
+}
+
+void LogPanel::onMousePress(QMouseEvent* e) {
+  if (mode_ == Mode::Navigate || rects_.empty() || e->button() != Qt::LeftButton) return;
+  selecting_ = true;
+  selectStart_ = timeAtPixel(e->position().x());
+}
+
+void LogPanel::onMouseMove(QMouseEvent* e) {
+  const IdData* data = workspace_->current();
+  if (!data || rects_.empty()) return;
+  const double t = timeAtPixel(e->position().x());
+  for (auto* c : cursors_) {
+    c->point1->setCoords(t, 0);
+    c->point2->setCoords(t, 1);
+    c->setVisible(true);
+  }
+  const double pos = (t - data->startTime) / data->sampleTime;
+  if (pos >= -0.5 && pos <= static_cast<double>(data->samples()) - 0.5) {
+    const std::size_t i = static_cast<std::size_t>(std::llround(std::max(0.0, pos)));
+    QString text = QString("t = %1 s").arg(data->timeAt(i), 0, 'f', 4);
+    for (const auto& ch : data->channels)
+      text += QString("   %1 = %2").arg(QString::fromStdString(ch.name)).arg(ch.values[i], 0, 'g', 6);
+    readout_->setText(text);
+  }
+  if (selecting_) {
+    auto* list = mode_ == Mode::SelectEstimation ? &estimationRects_ : &validationRects_;
+    for (auto* item : *list) placeRect(item, selectStart_, t, true);
+    plot_->layer("ranges")->replot();
+  }
+  overlay_->replot();
+}
+
+void LogPanel::onMouseRelease(QMouseEvent* e) {
+  if (!selecting_) return;
+  selecting_ = false;
+  const IdData* data = workspace_->current();
+  const RangeKind kind = mode_ == Mode::SelectEstimation ? RangeKind::Estimation : RangeKind::Validation;
+  double t0 = selectStart_, t1 = timeAtPixel(e->position().x());
+  if (t1 < t0) std::swap(t0, t1);
+  t0 = std::max(t0, data->startTime);
+  t1 = std::min(t1, data->timeAt(data->samples() - 1));
+  if (t1 - t0 < 2.0 * data->sampleTime) {  // a click, not a drag: keep the old range
+    updateRanges();
+    return;
+  }
+  // Snap to samples so the listed times are sample times.
+  const SampleRange s = data->rangeForTimes(t0, t1);
+  workspace_->setRange(kind, {data->timeAt(s.begin), data->timeAt(s.end - 1)});
+}
+
+void LogPanel::onMouseDoubleClick(QMouseEvent*) { showAll(); }
+
+}  // namespace flexarm

@@ -1,0 +1,71 @@
+#pragma once
+// Log panel: every channel of the current data against time in stacked plots sharing the
+// time axis. Wheel zooms time, drag pans; a crosshair follows the mouse with a readout of
+// time and values; in range mode a drag selects the estimation or validation range, shown
+// as shaded regions and listed with their sample counts.
+#include <QWidget>
+#include <vector>
+
+#include "widgets/workspace.h"
+
+class QCustomPlot;
+class QCPAxisRect;
+class QCPItemRect;
+class QCPItemStraightLine;
+class QCPLayer;
+class QLabel;
+class QTableWidget;
+class QToolButton;
+class QMouseEvent;
+class QWheelEvent;
+
+namespace flexarm {
+
+class LogPanel : public QWidget {
+  Q_OBJECT
+ public:
+  enum class Mode { Navigate, SelectEstimation, SelectValidation };
+
+  explicit LogPanel(Workspace* workspace, QWidget* parent = nullptr);
+
+  void setMode(Mode m);
+  Mode mode() const { return mode_; }
+  QCustomPlot* plot() const { return plot_; }
+  // Axis rectangle of channel i (top to bottom), for tests and screenshots.
+  QCPAxisRect* channelRect(int i) const;
+  int channelCount() const { return static_cast<int>(rects_.size()); }
+  // Pixel x of time t in the plots.
+  double pixelForTime(double t) const;
+  QString readoutText() const;
+  // Shows the whole log.
+  void showAll();
+
+ private:
+  void rebuild();
+  void updateRanges();
+  void onMousePress(QMouseEvent* e);
+  void onMouseMove(QMouseEvent* e);
+  void onMouseRelease(QMouseEvent* e);
+  void onMouseDoubleClick(QMouseEvent* e);
+  void syncTimeAxes(QCPAxisRect* source);
+  double timeAtPixel(double x) const;
+  void placeRect(QCPItemRect* item, double t0, double t1, bool visible);
+
+  Workspace* workspace_;
+  QCustomPlot* plot_;
+  QLabel* readout_;
+  QTableWidget* rangeTable_;
+  QToolButton* navigateButton_;
+  QToolButton* estimationButton_;
+  QToolButton* validationButton_;
+  QCPLayer* overlay_ = nullptr;
+  std::vector<QCPAxisRect*> rects_;
+  std::vector<QCPItemStraightLine*> cursors_;
+  std::vector<QCPItemRect*> estimationRects_, validationRects_;
+  Mode mode_ = Mode::Navigate;
+  bool selecting_ = false;
+  double selectStart_ = 0.0;
+  bool syncing_ = false;
+};
+
+}  // namespace flexarm

@@ -1,0 +1,62 @@
+#pragma once
+// The data every panel shares: the opened log, the result of preprocessing (what later
+// panels use), and the estimation and validation ranges, kept in seconds so they survive
+// decimation. Panels observe it through its signals.
+#include <QObject>
+#include <QString>
+#include <memory>
+#include <optional>
+
+#include "core/signal/id_data.h"
+#include "core/signal/preprocess.h"
+
+namespace flexarm {
+
+enum class RangeKind { Estimation, Validation };
+
+struct TimeRange {
+  double start = 0.0;
+  double end = 0.0;
+};
+
+class Workspace : public QObject {
+  Q_OBJECT
+ public:
+  explicit Workspace(QObject* parent = nullptr);
+
+  // Replaces the log; ranges stored in its metadata become the workspace's ranges.
+  void setLog(IdData data, const QString& path);
+  bool hasLog() const { return raw_ != nullptr; }
+  QString logPath() const { return path_; }
+  const IdData* raw() const { return raw_.get(); }
+
+  // The preprocessed data if preprocessing was applied, otherwise the raw log.
+  const IdData* current() const { return processed_ ? processed_.get() : raw_.get(); }
+  bool isPreprocessed() const { return processed_ != nullptr; }
+  const PreprocessOptions& preprocessOptions() const { return options_; }
+  void setPreprocessed(IdData data, const PreprocessOptions& options);
+  void clearPreprocessed();
+
+  std::optional<TimeRange> range(RangeKind kind) const;
+  void setRange(RangeKind kind, TimeRange r);
+  void clearRange(RangeKind kind);
+  // Samples of current() that the range covers (empty when unset).
+  SampleRange samples(RangeKind kind) const;
+  // current() with its estimationRange and validationRange set from the workspace ranges.
+  IdData currentWithRanges() const;
+
+ signals:
+  void logChanged();
+  void currentChanged();  // the log or its preprocessing changed
+  void rangesChanged();
+
+ private:
+  std::shared_ptr<IdData> raw_, processed_;
+  PreprocessOptions options_;
+  QString path_;
+  std::optional<TimeRange> estimation_, validation_;
+};
+
+const char* toString(RangeKind kind);
+
+}  // namespace flexarm
