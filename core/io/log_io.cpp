@@ -514,7 +514,8 @@ LogReadResult readMat(const std::string& path, const LogReadOptions& options) {
   if (!ec && size > options.maxFileBytes)
     return failure(path, 0, 0, {}, "the file is " + humanBytes(size) + ", larger than the " +
                                        humanBytes(options.maxFileBytes) + " FlexArm reads at once");
-  Mat_LogInit("flexarm");
+  // matio prints its own complaints to stderr; FlexArm reports one sentence instead.
+  Mat_LogInitFunc("flexarm", [](int, char*) {});
   mat_t* mat = Mat_Open(path.c_str(), MAT_ACC_RDONLY);
   if (!mat)
     return failure(path, 0, 0, {},
