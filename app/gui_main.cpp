@@ -1,13 +1,15 @@
 #include "app/gui_main.h"
 
 #include <QApplication>
+#include <QTimer>
+#include <iostream>
 
 #include "app/main_window.h"
 #include "widgets/arm/vtk_view.h"
 
 namespace flexarm {
 
-int runGui(int argc, char** argv) {
+int runGui(int argc, char** argv, const std::string& log, const std::string& screenshot) {
   // VTK's OpenGL2 backend needs a 3.2 core profile before the application object exists.
   VtkView::installDefaultSurfaceFormat();
   QApplication app(argc, argv);
@@ -16,9 +18,28 @@ int runGui(int argc, char** argv) {
   QApplication::setApplicationVersion(FLEXARM_VERSION);
   MainWindow window;
   window.show();
-  const QStringList args = QApplication::arguments();
-  if (args.size() > 1) window.openFile(args.at(1));
-  return app.exec();
+  int code = 0;
+  if (!screenshot.empty()) {
+    auto save = [&] {
+      QTimer::singleShot(700, &window, [&] {
+        if (!window.grab().save(QString::fromStdString(screenshot))) {
+          std::cerr << "flexarm: cannot write " << screenshot << "\n";
+          code = 3;
+        }
+        QApplication::quit();
+      });
+    };
+    QObject::connect(&window, &MainWindow::logOpened, &window, save);
+    QObject::connect(&window, &MainWindow::openFailed, &window, [&](const QString& m) {
+      std::cerr << "flexarm: " << m.toStdString() << "\n";
+      code = 3;
+      save();
+    });
+    if (log.empty()) save();
+  }
+  if (!log.empty()) window.openFile(QString::fromStdString(log));
+  const int rc = app.exec();
+  return code ? code : rc;
 }
 
 }  // namespace flexarm

@@ -1,0 +1,52 @@
+#pragma once
+// Runs the flexarm executable and captures its exit code, standard output and error.
+#include <array>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <string>
+#include <sys/wait.h>
+#include <unistd.h>
+
+namespace flexarm::test {
+
+struct RunResult {
+  int code = -1;
+  std::string out, err;
+};
+
+inline std::string readAll(const std::string& path) {
+  std::string text;
+  if (FILE* f = std::fopen(path.c_str(), "rb")) {
+    std::array<char, 4096> buf;
+    std::size_t n;
+    while ((n = std::fread(buf.data(), 1, buf.size(), f)) > 0) text.append(buf.data(), n);
+    std::fclose(f);
+  }
+  return text;
+}
+
+inline std::filesystem::path scratchDir() {
+  auto p = std::filesystem::temp_directory_path() / ("flexarm_cli_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(p);
+  return p;
+}
+
+// args are passed through the shell, each single-quoted.
+inline RunResult runFlexarm(const std::vector<std::string>& args) {
+  const auto dir = scratchDir();
+  static int counter = 0;
+  const std::string out = (dir / ("out" + std::to_string(counter))).string();
+  const std::string err = (dir / ("err" + std::to_string(counter++))).string();
+  std::string cmd = std::string("'") + FLEXARM_EXE + "'";
+  for (const auto& a : args) cmd += " '" + a + "'";
+  cmd += " >'" + out + "' 2>'" + err + "' </dev/null";
+  const int status = std::system(cmd.c_str());
+  RunResult r;
+  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  r.out = readAll(out);
+  r.err = readAll(err);
+  return r;
+}
+
+}  // namespace flexarm::test
