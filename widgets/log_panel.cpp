@@ -139,6 +139,7 @@ void LogPanel::rebuild() {
   plot_->clearGraphs();
   plot_->plotLayout()->clear();
   rects_.clear();
+  envelopes_.clear();
   cursors_.clear();
   estimationRects_.clear();
   validationRects_.clear();
@@ -157,8 +158,6 @@ void LogPanel::rebuild() {
   }
   auto* margins = new QCPMarginGroup(plot_);
   const std::size_t n = data->samples();
-  QVector<double> keys(static_cast<int>(n));
-  for (std::size_t i = 0; i < n; ++i) keys[static_cast<int>(i)] = data->timeAt(i);
   for (std::size_t c = 0; c < data->channels.size(); ++c) {
     const Channel& ch = data->channels[c];
     auto* rect = new QCPAxisRect(plot_);
@@ -176,17 +175,18 @@ void LogPanel::rebuild() {
     for (QCPAxis* a : rect->axes()) a->setLayer("axes");
     auto* g = plot_->addGraph(x, y);
     g->setPen(QPen(kTraceColors[c % 8], 1.2));
-    g->setAdaptiveSampling(true);
-    QVector<double> values(static_cast<int>(n));
-    std::copy(ch.values.begin(), ch.values.end(), values.begin());
-    g->setData(keys, values, true);
-    g->rescaleValueAxis(false, false);
-    QCPRange yr = y->range();
-    const double pad = std::max(1e-12, 0.05 * yr.size());
-    y->setRange(yr.lower - pad, yr.upper + pad);
+    // Millions of samples are drawn through a min/max envelope of the visible range, so
+    // opening, zooming and panning cost the same for a 10-minute log as for a short one.
+    envelopes_.push_back(std::make_unique<EnvelopePyramid>(ch.values));
+    const auto [lo, hi] = std::minmax_element(ch.values.begin(), ch.values.end());
+    const double pad = std::max(1e-12, 0.05 * (*hi - *lo));
+    y->setRange(*lo - pad, *hi + pad);
     rects_.push_back(rect);
     connect(x, QOverload<const QCPRange&>::of(&QCPAxis::rangeChanged), this,
-            [this, rect](const QCPRange&) { syncTimeAxes(rect); });
+            [this, rect, c](const QCPRange&) {
+              syncTimeAxes(rect);
+              refreshChannel(c);
+            });
 
     auto* cursor = new QCPItemStraightLine(plot_);
     cursor->setLayer(overlay_);
@@ -246,6 +246,23 @@ void LogPanel::syncTimeAxes(QCPAxisRect* source) {
   for (auto* rect : rects_)
     if (rect != source) rect->axis(QCPAxis::atBottom)->setRange(r);
   syncing_ = false;
+}
+
+void LogPanel::refreshChannel(std::size_t c) {
+  const IdData* data = workspace_->current();
+  if (!data || c >= rects_.size() || c >= envelopes_.size()) return;
+  const QCPRange r = rects_[c]->axis(QCPAxis::atBottom)->range();
+  const double n = static_cast<double>(data->samples());
+  const double first = std::clamp(std::floor((r.lower - data->startTime) / data->sampleTime) - 1.0, 0.0, n);
+  const double last = std::clamp(std::ceil((r.upper - data->startTime) / data->sampleTime) + 2.0, 0.0, n);
+  static thread_local std::vector<double> position, value;
+  envelopes_[c]->visiblePoints(static_cast<std::size_t>(first), static_cast<std::size_t>(last),
+                               static_cast<std::size_t>(2 * std::max(rects_[c]->width(), 800)),
+                               position, value);
+  QVector<QCPGraphData> points(static_cast<int>(position.size()));
+  for (std::size_t i = 0; i < position.size(); ++i)
+    points[static_cast<int>(i)] = QCPGraphData(data->startTime + position[i] * data->sampleTime, value[i]);
+  plot_->graph(static_cast<int>(c))->data()->set(points, true);
 }
 
 void LogPanel::placeRect(QCPItemRect* item, double t0, double t1, bool visible) {

@@ -4,7 +4,10 @@
 // time and values; in range mode a drag selects the estimation or validation range, shown
 // as shaded regions and listed with their sample counts.
 #include <QWidget>
+#include <memory>
 #include <vector>
+
+#include "core/signal/envelope.h"
 
 #include "widgets/workspace.h"
 
@@ -48,6 +51,8 @@ class LogPanel : public QWidget {
   void onMouseRelease(QMouseEvent* e);
   void onMouseDoubleClick(QMouseEvent* e);
   void syncTimeAxes(QCPAxisRect* source);
+  // Gives channel c's graph the points to draw for its visible time range.
+  void refreshChannel(std::size_t c);
   double timeAtPixel(double x) const;
   void placeRect(QCPItemRect* item, double t0, double t1, bool visible);
 
@@ -62,6 +67,7 @@ class LogPanel : public QWidget {
   std::vector<QCPAxisRect*> rects_;
   std::vector<QCPItemStraightLine*> cursors_;
   std::vector<QCPItemRect*> estimationRects_, validationRects_;
+  std::vector<std::unique_ptr<EnvelopePyramid>> envelopes_;
   Mode mode_ = Mode::Navigate;
   bool selecting_ = false;
   double selectStart_ = 0.0;

@@ -91,6 +91,31 @@ class MainWindowTest : public QObject {
     window_->logPanel()->setMode(LogPanel::Mode::Navigate);
   }
 
+  void wheelZoomsAllChannelsTogether() {
+    LogPanel* panel = window_->logPanel();
+    QCustomPlot* plot = panel->plot();
+    const QCPRange before = panel->channelRect(0)->axis(QCPAxis::atBottom)->range();
+    const QPoint at(static_cast<int>(panel->channelRect(1)->center().x()),
+                    static_cast<int>(panel->channelRect(1)->center().y()));
+    QWheelEvent wheel(at, plot->mapToGlobal(at), QPoint(), QPoint(0, 960), Qt::NoButton,
+                      Qt::NoModifier, Qt::NoScrollPhase, false);
+    QApplication::sendEvent(plot, &wheel);
+    const QCPRange after = panel->channelRect(0)->axis(QCPAxis::atBottom)->range();
+    QVERIFY2(after.size() < 0.5 * before.size(), qPrintable(QString::number(after.size())));
+    for (int c = 1; c < panel->channelCount(); ++c)
+      QCOMPARE(panel->channelRect(c)->axis(QCPAxis::atBottom)->range(), after);
+    // The zoomed view is drawn from the samples in view: the first graph holds no more points
+    // than about two per pixel, and they cover the visible range.
+    QCPGraph* g = plot->graph(0);
+    QVERIFY(g->dataCount() > 10);
+    QVERIFY(g->dataCount() <= 2 * std::max(panel->channelRect(0)->width(), 800) + 16);
+    QVERIFY(g->data()->constBegin()->key <= after.lower + 0.01);
+    QVERIFY((g->data()->constEnd() - 1)->key >= after.upper - 0.01);
+    panel->showAll();
+    QCOMPARE(panel->channelRect(0)->axis(QCPAxis::atBottom)->range().size(),
+             window_->workspace()->current()->duration());
+  }
+
   void crosshairReadsValues() {
     QCustomPlot* plot = window_->logPanel()->plot();
     const int y = static_cast<int>(window_->logPanel()->channelRect(1)->center().y());
