@@ -1,0 +1,278 @@
+#include "widgets/plots/bode_plot.h"
+
+#include <QFileInfo>
+#include <QLabel>
+#include <QPainter>
+#include <QSvgGenerator>
+#include <QVBoxLayout>
+#include <cmath>
+#include <qcustomplot.h>
+
+namespace flexarm {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+double toDb(double magnitude) { return 20.0 * std::log10(std::max(magnitude, 1e-300)); }
+
+void setupLogFrequencyAxis(QCPAxis* axis) {
+  axis->setScaleType(QCPAxis::stLogarithmic);
+  QSharedPointer<QCPAxisTickerLog> ticker(new QCPAxisTickerLog);
+  axis->setTicker(ticker);
+  axis->setNumberFormat("eb");
+  axis->setNumberPrecision(0);
+}
+
+}  // namespace
+
+std::vector<double> unwrappedPhaseDeg(const std::vector<std::complex<double>>& response) {
+  std::vector<double> out(response.size());
+  double offset = 0.0, previous = 0.0;
+  for (std::size_t i = 0; i < response.size(); ++i) {
+    const double p = std::arg(response[i]);
+    if (i > 0) {
+      const double jump = p - previous;
+      if (jump > kPi) offset -= 2 * kPi;
+      if (jump < -kPi) offset += 2 * kPi;
+    }
+    previous = p;
+    out[i] = (p + offset) * 180.0 / kPi;
+  }
+  return out;
+}
+
+BodePlot::BodePlot(QWidget* parent)
+    : QWidget(parent), plot_(new QCustomPlot(this)), readout_(new QLabel(this)) {
+  setObjectName("bodePlot");
+  plot_->plotLayout()->clear();
+  magRect_ = new QCPAxisRect(plot_);
+  phaseRect_ = new QCPAxisRect(plot_);
+  plot_->plotLayout()->addElement(0, 0, magRect_);
+  plot_->plotLayout()->addElement(1, 0, phaseRect_);
+  auto* margins = new QCPMarginGroup(plot_);
+  for (QCPAxisRect* r : {magRect_, phaseRect_}) {
+    r->setMarginGroup(QCP::msLeft | QCP::msRight, margins);
+    setupLogFrequencyAxis(r->axis(QCPAxis::atBottom));
+    r->setRangeDrag(Qt::Horizontal | Qt::Vertical);
+    r->setRangeZoom(Qt::Horizontal | Qt::Vertical);
+  }
+  magRect_->axis(QCPAxis::atLeft)->setLabel(tr("magnitude [dB]"));
+  phaseRect_->axis(QCPAxis::atLeft)->setLabel(tr("phase [deg]"));
+  phaseRect_->axis(QCPAxis::atBottom)->setLabel(tr("frequency [rad/s]"));
+  connect(magRect_->axis(QCPAxis::atBottom), QOverload<const QCPRange&>::of(&QCPAxis::rangeChanged),
+          phaseRect_->axis(QCPAxis::atBottom), QOverload<const QCPRange&>::of(&QCPAxis::setRange));
+  connect(phaseRect_->axis(QCPAxis::atBottom), QOverload<const QCPRange&>::of(&QCPAxis::rangeChanged),
+          magRect_->axis(QCPAxis::atBottom), QOverload<const QCPRange&>::of(&QCPAxis::setRange));
+  auto* legendRect = magRect_;
+  plot_->legend = new QCPLegend;
+  legendRect->insetLayout()->addElement(plot_->legend, Qt::AlignRight | Qt::AlignTop);
+  plot_->legend->setLayer("legend");
+  plot_->legend->setVisible(true);
+  plot_->legend->setSelectableParts(QCPLegend::spItems);
+  plot_->setInteractions(QCP::iRangeDrag | QCP::iRangeZoom | QCP::iSelectLegend);
+  connect(plot_, &QCustomPlot::legendClick, this,
+          [this](QCPLegend*, QCPAbstractLegendItem* item, QMouseEvent*) {
+            auto* pli = qobject_cast<QCPPlottableLegendItem*>(item);
+            if (!pli) return;
+            for (std::size_t i = 0; i < curves_.size(); ++i)
+              if (curves_[i].mag == pli->plottable()) setCurveVisible(static_cast<int>(i), !isCurveVisible(static_cast<int>(i)));
+          });
+  connect(plot_, &QCustomPlot::mousePress, this, &BodePlot::onClick);
+  readout_->setObjectName("bodeReadout");
+  readout_->setText(tr("Click near a peak or notch to read it; click a legend entry to hide it"));
+  auto* layout = new QVBoxLayout(this);
+  layout->setContentsMargins(0, 0, 0, 0);
+  layout->addWidget(plot_, 1);
+  layout->addWidget(readout_);
+  setMinimumSize(320, 260);
+}
+
+void BodePlot::clear() {
+  plot_->clearGraphs();
+  curves_.clear();
+  plot_->replot();
+}
+
+int BodePlot::addCurve(const BodeCurve& curve) {
+  Entry e;
+  e.curve = curve;
+  for (const auto& h : curve.response) e.magnitudeDb.push_back(toDb(std::abs(h)));
+  e.phaseDeg = unwrappedPhaseDeg(curve.response);
+  auto qv = [](const std::vector<double>& v) { return QVector<double>(v.begin(), v.end()); };
+  const QVector<double> w = qv(curve.frequency);
+  QCPAxis* mx = magRect_->axis(QCPAxis::atBottom);
+  QCPAxis* my = magRect_->axis(QCPAxis::atLeft);
+  QCPAxis* px = phaseRect_->axis(QCPAxis::atBottom);
+  QCPAxis* py = phaseRect_->axis(QCPAxis::atLeft);
+  QColor fill = curve.color;
+  fill.setAlpha(50);
+  auto addBand = [&](QCPAxis* x, QCPAxis* y, std::vector<double> low, std::vector<double> high) {
+    auto* lo = plot_->addGraph(x, y);
+    auto* hi = plot_->addGraph(x, y);
+    lo->setData(w, qv(low), true);
+    hi->setData(w, qv(high), true);
+    for (auto* g : {lo, hi}) {
+      g->setPen(Qt::NoPen);
+      g->removeFromLegend();
+      g->setSelectable(QCP::stNone);
+    }
+    hi->setBrush(fill);
+    hi->setChannelFillGraph(lo);
+    e.band.push_back(lo);
+    e.band.push_back(hi);
+  };
+  const std::size_t n = curve.frequency.size();
+  if (curve.magnitudeLow.size() == n && curve.magnitudeHigh.size() == n) {
+    std::vector<double> lo(n), hi(n);
+    for (std::size_t i = 0; i < n; ++i) {
+      lo[i] = toDb(std::max(curve.magnitudeLow[i], 1e-300));
+      hi[i] = toDb(curve.magnitudeHigh[i]);
+    }
+    addBand(mx, my, lo, hi);
+  }
+  if (curve.phaseLowDeg.size() == n && curve.phaseHighDeg.size() == n) {
+    // Bands are given around the wrapped phase; move them with the unwrapping offset.
+    std::vector<double> lo(n), hi(n);
+    for (std::size_t i = 0; i < n; ++i) {
+      const double offset = e.phaseDeg[i] - std::arg(curve.response[i]) * 180.0 / kPi;
+      lo[i] = curve.phaseLowDeg[i] + offset;
+      hi[i] = curve.phaseHighDeg[i] + offset;
+    }
+    addBand(px, py, lo, hi);
+  }
+  e.mag = plot_->addGraph(mx, my);
+  e.phase = plot_->addGraph(px, py);
+  e.mag->setName(curve.name);
+  e.phase->removeFromLegend();
+  for (auto [g, y] : {std::pair{e.mag, &e.magnitudeDb}, std::pair{e.phase, &e.phaseDeg}}) {
+    g->setData(w, qv(*y), true);
+    if (curve.points) {
+      g->setLineStyle(QCPGraph::lsNone);
+      g->setScatterStyle(QCPScatterStyle(QCPScatterStyle::ssDisc, curve.color, 3));
+    } else {
+      g->setPen(QPen(curve.color, 1.6));
+    }
+  }
+  curves_.push_back(std::move(e));
+  rescale();
+  return static_cast<int>(curves_.size()) - 1;
+}
+
+void BodePlot::setCurveVisible(int index, bool visible) {
+  if (index < 0 || index >= curveCount()) return;
+  Entry& e = curves_[static_cast<std::size_t>(index)];
+  e.mag->setVisible(visible);
+  e.phase->setVisible(visible);
+  for (auto* g : e.band) g->setVisible(visible);
+  if (auto* item = plot_->legend->itemWithPlottable(e.mag))
+    item->setTextColor(visible ? Qt::black : QColor(170, 170, 170));
+  plot_->replot();
+}
+
+bool BodePlot::isCurveVisible(int index) const {
+  return index >= 0 && index < curveCount() && curves_[static_cast<std::size_t>(index)].mag->visible();
+}
+
+void BodePlot::rescale() {
+  bool first = true;
+  for (const auto& e : curves_) {
+    if (!e.mag->visible()) continue;
+    e.mag->rescaleAxes(!first);
+    e.phase->rescaleAxes(!first);
+    for (auto* g : e.band) g->rescaleValueAxis(true);
+    first = false;
+  }
+  for (QCPAxisRect* r : {magRect_, phaseRect_}) {
+    QCPAxis* y = r->axis(QCPAxis::atLeft);
+    const double pad = std::max(1.0, 0.05 * y->range().size());
+    y->setRange(y->range().lower - pad, y->range().upper + pad);
+  }
+  plot_->replot();
+}
+
+std::optional<std::pair<double, double>> BodePlot::extremumNear(int index, double w) const {
+  if (index < 0 || index >= curveCount()) return std::nullopt;
+  const Entry& e = curves_[static_cast<std::size_t>(index)];
+  const auto& f = e.curve.frequency;
+  const auto& m = e.magnitudeDb;
+  std::optional<std::pair<double, double>> best;
+  double bestDistance = 1e300;
+  for (std::size_t i = 1; i + 1 < f.size(); ++i) {
+    const bool peak = m[i] > m[i - 1] && m[i] >= m[i + 1];
+    const bool notch = m[i] < m[i - 1] && m[i] <= m[i + 1];
+    if (!peak && !notch) continue;
+    const double distance = std::abs(std::log(f[i] / w));
+    if (distance < std::log(1.5) && distance < bestDistance) {
+      bestDistance = distance;
+      best = std::make_pair(f[i], m[i]);
+    }
+  }
+  return best;
+}
+
+QString BodePlot::readoutText() const { return readout_->text(); }
+
+void BodePlot::onClick(QMouseEvent* e) {
+  if (!magRect_->rect().contains(e->pos()) || curves_.empty()) return;
+  const double w = magRect_->axis(QCPAxis::atBottom)->pixelToCoord(e->position().x());
+  const double level = magRect_->axis(QCPAxis::atLeft)->pixelToCoord(e->position().y());
+  // The visible curve whose magnitude at w is closest to the click, then its extremum.
+  int chosen = -1;
+  double closest = 1e300;
+  for (int i = 0; i < curveCount(); ++i) {
+    if (!isCurveVisible(i)) continue;
+    const Entry& c = curves_[static_cast<std::size_t>(i)];
+    const auto it = std::lower_bound(c.curve.frequency.begin(), c.curve.frequency.end(), w);
+    if (it == c.curve.frequency.end()) continue;
+    const double d = std::abs(c.magnitudeDb[static_cast<std::size_t>(it - c.curve.frequency.begin())] - level);
+    if (d < closest) closest = d, chosen = i;
+  }
+  if (chosen < 0) return;
+  if (auto x = extremumNear(chosen, w)) {
+    const auto& c = curves_[static_cast<std::size_t>(chosen)];
+    const auto it = std::lower_bound(c.curve.frequency.begin(), c.curve.frequency.end(), x->first);
+    const std::size_t i = static_cast<std::size_t>(it - c.curve.frequency.begin());
+    const bool peak = i > 0 && c.magnitudeDb[i] > c.magnitudeDb[i - 1];
+    readout_->setText(tr("%1: %2 at %3 rad/s (%4 Hz), %5 dB")
+                          .arg(c.curve.name)
+                          .arg(peak ? tr("peak") : tr("notch"))
+                          .arg(x->first, 0, 'f', 1)
+                          .arg(x->first / (2 * kPi), 0, 'f', 2)
+                          .arg(x->second, 0, 'f', 1));
+    emit extremumPicked(chosen, x->first, x->second);
+  } else {
+    readout_->setText(tr("%1: no peak or notch near %2 rad/s")
+                          .arg(curves_[static_cast<std::size_t>(chosen)].curve.name)
+                          .arg(w, 0, 'f', 1));
+  }
+}
+
+bool BodePlot::exportTo(const QString& path, QString* why) const {
+  const QString ext = QFileInfo(path).suffix().toLower();
+  const int w = std::max(plot_->width(), 800), h = std::max(plot_->height(), 600);
+  bool ok = false;
+  if (ext == "png") {
+    ok = plot_->savePng(path, w, h);
+  } else if (ext == "pdf") {
+    ok = plot_->savePdf(path, w, h);
+  } else if (ext == "svg") {
+    QSvgGenerator svg;
+    svg.setFileName(path);
+    svg.setSize(QSize(w, h));
+    svg.setViewBox(QRect(0, 0, w, h));
+    svg.setTitle("FlexArm Bode plot");
+    QCPPainter painter;
+    ok = painter.begin(&svg);
+    if (ok) {
+      plot_->toPainter(&painter, w, h);
+      painter.end();
+    }
+  } else {
+    if (why) *why = tr("unknown format '%1': use .png, .pdf or .svg").arg(ext);
+    return false;
+  }
+  if (!ok && why) *why = tr("could not write %1").arg(path);
+  return ok;
+}
+
+}  // namespace flexarm
