@@ -2,7 +2,6 @@
 
 #include <charconv>
 #include <cmath>
-#include <cstdio>
 
 namespace flexarm {
 
@@ -154,9 +153,10 @@ std::string toString(const Effect& e) {
   const auto& params = effectParameters(e.kind);
   char buf[40];
   for (std::size_t i = 0; i < params.size(); ++i) {
-    std::snprintf(buf, sizeof buf, "%.17g", e.values[i]);
+    // Shortest text that reads back to the same double.
+    const auto res = std::to_chars(buf, buf + sizeof buf, e.values[i]);
     s += (i == 0 ? ":" : ",");
-    s += buf;
+    s.append(buf, res.ptr);
   }
   return s;
 }
