@@ -26,7 +26,7 @@ const char* kSimulateHelpTail =
     "\nEffects (repeatable; values default as shown):\n"
     "  coulomb_friction:F_c,v_s   F_c tanh(phi_m'/v_s) on the motor (0.05 N m, 0.1 rad/s)\n"
     "  backlash:b                 dead zone of half-width b in the gear spring (2e-4 rad)\n"
-    "  nonlinear_spring:beta      gear spring k delta (1 + beta delta^2) (3e5 1/rad^2)\n"
+    "  nonlinear_spring:beta      gear spring k delta (1 + beta delta^2) (2e6 1/rad^2)\n"
     "  input_delay:T_d            the torque acts T_d seconds late (1e-3 s)\n"
     "  torque_ripple:A,n          A sin(n phi_m) on the motor (0.05 N m, 6 per revolution)\n"
     "  extra_mass:omega,fraction  one more mass: the fraction of the outer mass on a spring\n"

@@ -48,7 +48,7 @@ const std::vector<EffectParameterInfo>& effectParameters(EffectKind k) {
   static const std::vector<EffectParameterInfo> kBacklash = {
       {"b", "rad", 2e-4, "half-width of the dead zone in the gear spring (arm side)"}};
   static const std::vector<EffectParameterInfo> kSpring = {
-      {"beta", "1/rad^2", 3e5, "stiffening of the gear spring: k delta (1 + beta delta^2)"}};
+      {"beta", "1/rad^2", 2e6, "stiffening of the gear spring: k delta (1 + beta delta^2)"}};
   static const std::vector<EffectParameterInfo> kDelay = {
       {"T_d", "s", 1e-3, "delay between the torque reference and the applied torque"}};
   static const std::vector<EffectParameterInfo> kRipple = {
