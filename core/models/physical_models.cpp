@@ -89,7 +89,9 @@ struct TwoMass {
   }
 };
 
-// (5.5): theta_1..theta_5, r, k_T mapped to the physical parameters of (3.13).
+// (5.5): theta_1..theta_5, r, k_T mapped to the physical parameters of (3.13). Inserted in
+// (3.13d) this gives A(2,1) = -r theta_1 and A(2,2) = -theta_5; (5.6) prints both without
+// the minus sign. The mapping (5.5) is taken as the definition.
 template <class T> void physicalFromTheta(const std::vector<T>& p, T& Jm, T& Ja, T& fm, T& k,
                                           T& d) {
   const T &t1 = p[0], &t2 = p[1], &t3 = p[2], &t4 = p[3], &t5 = p[4], &r = p[5];
