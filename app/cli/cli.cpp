@@ -9,6 +9,9 @@ const std::vector<Verb>& verbs() {
       {"info", "channels, units, sample rate, length, metadata and ranges of a log", runInfo},
       {"preprocess", "differentiate, decimate with anti-alias filter, detrend, cut; write CSV",
        runPreprocess},
+      {"model", "physical model: matrices, poles, zeros, notch and peak frequencies", runModel},
+      {"simulate", "closed-loop simulation of a model with effects; writes a log and its truth",
+       runSimulate},
   };
   return kVerbs;
 }

@@ -64,5 +64,7 @@ class ArgParser {
 // Verbs. Each lives in its own verb_*.cpp.
 int runInfo(const std::vector<std::string>& args, std::ostream& out, std::ostream& err);
 int runPreprocess(const std::vector<std::string>& args, std::ostream& out, std::ostream& err);
+int runModel(const std::vector<std::string>& args, std::ostream& out, std::ostream& err);
+int runSimulate(const std::vector<std::string>& args, std::ostream& out, std::ostream& err);
 
 }  // namespace flexarm::cli

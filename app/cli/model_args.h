@@ -1,0 +1,28 @@
+#pragma once
+// Options shared by the verbs that build a physical model: --model, --param NAME=VALUE,
+// --free/--fixed NAME, --output, --arm-accel; and the model as JSON.
+#include <iosfwd>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "app/cli/cli.h"
+#include "core/models/physical_models.h"
+
+namespace flexarm::cli {
+
+// Valued options (model, param, free, fixed, output) and flags (arm-accel) these helpers read.
+std::vector<std::string> modelValuedOptions();
+std::vector<std::string> modelFlagOptions();
+// Help lines for the options above.
+std::string modelOptionsHelp();
+
+// The model the options describe, or nullptr after printing "flexarm VERB: ..." to err.
+std::unique_ptr<PhysicalModel> modelFromArgs(const ArgParser& args, const std::string& verb,
+                                             std::ostream& err);
+
+// {"structure", "description", "parameters": [{name, unit, value, lower, upper, free}]}.
+nlohmann::json modelJson(const PhysicalModel& model);
+
+}  // namespace flexarm::cli

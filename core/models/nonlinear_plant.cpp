@@ -1,0 +1,208 @@
+#include "core/models/nonlinear_plant.h"
+
+#include <cmath>
+#include <stdexcept>
+
+namespace flexarm {
+
+NonlinearPlant::NonlinearPlant(const PhysicalModel& model, const std::vector<Effect>& effects)
+    : effects_(effects) {
+  std::vector<bool> seen(allEffectKinds().size(), false);
+  std::unique_ptr<ParametricModel> current = model.clone();
+  for (const Effect& e : effects) {
+    std::string why;
+    if (!e.isValid(&why)) throw std::invalid_argument(why);
+    auto s = seen[static_cast<std::size_t>(e.kind)];
+    if (s) throw std::invalid_argument(std::string("the effect ") + toString(e.kind) +
+                                       " is given twice");
+    s = true;
+    if (e.kind == EffectKind::ExtraMass) {
+      auto bigger = addMass(static_cast<const PhysicalModel&>(*current), e.value(1), e.value(0));
+      if (!bigger)
+        throw std::invalid_argument("extra_mass: the " + current->structureName() +
+                                    " model is the largest structure");
+      current = std::move(bigger);
+    }
+  }
+  model_.reset(static_cast<PhysicalModel*>(current.release()));
+  ModelOptions velocity;
+  model_->setOptions(velocity);
+  const ModelTopology topo = model_->topology();
+  n_ = topo.coreStates;
+  if (n_ + 1 > kMaxStates) throw std::invalid_argument("NonlinearPlant: too many states");
+  mv_ = topo.motorVelocityState;
+  arm_ = topo.armVelocityState < 0 ? mv_ : topo.armVelocityState;
+  armScale_ = topo.armVelocityState < 0 ? model_->value("r") : 1.0;
+  gear_ = topo.gearDeflectionState;
+
+  const StateSpace ss = model_->stateSpace();
+  Eigen::MatrixXd A0 = ss.A;
+  const double Jm = model_->value("J_m");
+  for (int i = 0; i < n_; ++i) {
+    bu_[static_cast<std::size_t>(i)] = ss.B(i, 0);
+  }
+  if (topo.armVelocityState < 0) {
+    // Rigid: one mass J_m + r^2 J_a; torques on the motor act directly, the arm load through r.
+    const double r = model_->value("r");
+    const double J = Jm + r * r * model_->value("J_a");
+    bm_[static_cast<std::size_t>(mv_)] = 1.0 / J;
+    bl_[static_cast<std::size_t>(mv_)] = r / J;
+  } else {
+    bm_[static_cast<std::size_t>(mv_)] = 1.0 / Jm;
+    bl_[static_cast<std::size_t>(arm_)] = 1.0 / model_->value(topo.armInertia);
+  }
+
+  for (const Effect& e : effects_) {
+    switch (e.kind) {
+      case EffectKind::CoulombFriction:
+        coulomb_ = e.value(0);
+        coulombSpeed_ = e.value(1);
+        break;
+      case EffectKind::Backlash:
+        backlash_ = e.value(0);
+        gearNonlinear_ = true;
+        break;
+      case EffectKind::NonlinearSpring:
+        beta_ = e.value(0);
+        gearNonlinear_ = true;
+        break;
+      case EffectKind::InputDelay: delay_ = e.value(0); break;
+      case EffectKind::TorqueRipple:
+        rippleAmp_ = e.value(0);
+        ripplePeriods_ = e.value(1);
+        break;
+      case EffectKind::ExtraMass: break;
+    }
+  }
+  if (gear_ >= 0 && !topo.gearStiffness.empty()) {
+    // Gear spring distribution s_g = dA/dk_g e_delta and deflection rate delta' = A(delta,:) x.
+    const auto dK = model_->derivative(model_->indexOf(topo.gearStiffness));
+    k_ = model_->value(topo.gearStiffness);
+    d_ = model_->value(topo.gearDamping);
+    for (int i = 0; i < n_; ++i) {
+      sg_[static_cast<std::size_t>(i)] = dK.dA(i, gear_);
+      gearRate_[static_cast<std::size_t>(i)] = ss.A(gear_, i);
+    }
+    if (gearNonlinear_)
+      for (int i = 0; i < n_; ++i)
+        for (int j = 0; j < n_; ++j)
+          A0(i, j) -= sg_[static_cast<std::size_t>(i)] *
+                      (k_ * (j == gear_ ? 1.0 : 0.0) + d_ * gearRate_[static_cast<std::size_t>(j)]);
+  } else if (gearNonlinear_) {
+    throw std::invalid_argument("backlash and nonlinear_spring need a model with a gear spring "
+                                "(two-mass, three-mass or four-mass), not " +
+                                model_->structureName());
+  }
+  for (int i = 0; i < n_; ++i)
+    for (int j = 0; j < n_; ++j) A0_[static_cast<std::size_t>(i * kMaxStates + j)] = A0(i, j);
+}
+
+NonlinearPlant::NonlinearPlant(const NonlinearPlant& o)
+    : model_(static_cast<PhysicalModel*>(o.model_->clone().release())),
+      effects_(o.effects_),
+      n_(o.n_), mv_(o.mv_), arm_(o.arm_), gear_(o.gear_), armScale_(o.armScale_), A0_(o.A0_),
+      bu_(o.bu_), bm_(o.bm_), bl_(o.bl_), sg_(o.sg_), gearRate_(o.gearRate_),
+      gearNonlinear_(o.gearNonlinear_), k_(o.k_), d_(o.d_), coulomb_(o.coulomb_),
+      coulombSpeed_(o.coulombSpeed_), backlash_(o.backlash_), beta_(o.beta_), delay_(o.delay_),
+      rippleAmp_(o.rippleAmp_), ripplePeriods_(o.ripplePeriods_) {}
+
+namespace {
+// Gear spring and damper torque with a dead zone of half-width b and stiffening beta: no
+// contact (and no damping) inside the gap.
+double springTorque(double delta, double rate, double k, double d, double b, double beta) {
+  double e = 0.0;
+  if (delta > b) e = delta - b;
+  else if (delta < -b) e = delta + b;
+  else return 0.0;
+  return k * e * (1.0 + beta * e * e) + d * rate;
+}
+}  // namespace
+
+void NonlinearPlant::derivative(const double* x, double u, double load, double* dx) const {
+  const int n = n_;
+  for (int i = 0; i < n; ++i) {
+    const double* row = &A0_[static_cast<std::size_t>(i * kMaxStates)];
+    double s = 0.0;
+    for (int j = 0; j < n; ++j) s += row[j] * x[j];
+    dx[i] = s + bu_[static_cast<std::size_t>(i)] * u + bl_[static_cast<std::size_t>(i)] * load;
+  }
+  double motorTorque = 0.0;
+  if (coulomb_ != 0.0) motorTorque -= coulomb_ * std::tanh(x[mv_] / coulombSpeed_);
+  if (rippleAmp_ != 0.0) motorTorque += rippleAmp_ * std::sin(ripplePeriods_ * x[n]);
+  if (motorTorque != 0.0)
+    for (int i = 0; i < n; ++i) dx[i] += bm_[static_cast<std::size_t>(i)] * motorTorque;
+  if (gearNonlinear_) {
+    double rate = 0.0;
+    for (int j = 0; j < n; ++j) rate += gearRate_[static_cast<std::size_t>(j)] * x[j];
+    const double tg = springTorque(x[gear_], rate, k_, d_, backlash_, beta_);
+    for (int i = 0; i < n; ++i) dx[i] += sg_[static_cast<std::size_t>(i)] * tg;
+  }
+  dx[n] = x[mv_];
+}
+
+double NonlinearPlant::armAcceleration(const State& x, double u, double load) const {
+  State dx;
+  derivative(x.data(), u, load, dx.data());
+  return armScale_ * dx[static_cast<std::size_t>(arm_)];
+}
+
+double NonlinearPlant::gearDeflection(const State& x) const {
+  return gear_ < 0 ? 0.0 : x[static_cast<std::size_t>(gear_)];
+}
+
+double NonlinearPlant::gearTorque(const State& x) const {
+  if (gear_ < 0 || k_ == 0.0) return 0.0;
+  double rate = 0.0;
+  for (int j = 0; j < n_; ++j) rate += gearRate_[static_cast<std::size_t>(j)] * x[j];
+  return springTorque(x[static_cast<std::size_t>(gear_)], rate, k_, d_, backlash_, beta_);
+}
+
+bool TorqueResponseOptions::isValid(std::string* why) const {
+  if (substeps < 1) {
+    if (why) *why = "substeps must be >= 1";
+    return false;
+  }
+  if (why) why->clear();
+  return true;
+}
+
+TorqueResponse simulateTorque(const NonlinearPlant& plant, const std::vector<double>& torque,
+                              double Ts, const TorqueResponseOptions& options) {
+  std::string why;
+  if (!options.isValid(&why)) throw std::invalid_argument("simulateTorque: " + why);
+  if (!(Ts > 0.0) || !std::isfinite(Ts))
+    throw std::invalid_argument("simulateTorque: the sample time must be positive");
+  NonlinearPlant::State x{};
+  if (!options.initialState.empty()) {
+    if (static_cast<int>(options.initialState.size()) != plant.states())
+      throw std::invalid_argument("simulateTorque: the initial state needs " +
+                                  std::to_string(plant.states()) + " values");
+    for (int i = 0; i < plant.states(); ++i) x[static_cast<std::size_t>(i)] = options.initialState[static_cast<std::size_t>(i)];
+  }
+  const std::size_t N = torque.size();
+  TorqueResponse r;
+  for (auto* v : {&r.motorAngle, &r.motorVelocity, &r.armAcceleration, &r.gearDeflection,
+                  &r.gearTorque})
+    v->resize(N);
+  const double delay = plant.inputDelay();
+  // Applied torque: the sample held over [k Ts, (k+1) Ts), shifted by the delay.
+  auto torqueAt = [&torque, Ts, delay, N](double t) {
+    const double tau = (t - delay) / Ts;
+    if (tau < 0.0) return 0.0;
+    const std::size_t k = static_cast<std::size_t>(tau);
+    return torque[k < N ? k : N - 1];
+  };
+  const double h = Ts / options.substeps;
+  for (std::size_t k = 0; k < N; ++k) {
+    const double t = static_cast<double>(k) * Ts;
+    r.motorAngle[k] = plant.motorAngle(x);
+    r.motorVelocity[k] = plant.motorVelocity(x);
+    r.armAcceleration[k] = plant.armAcceleration(x, torqueAt(t), 0.0);
+    r.gearDeflection[k] = plant.gearDeflection(x);
+    r.gearTorque[k] = plant.gearTorque(x);
+    for (int i = 0; i < options.substeps; ++i) plant.step(x, t + i * h, h, torqueAt, 0.0);
+  }
+  return r;
+}
+
+}  // namespace flexarm

@@ -1,0 +1,70 @@
+#pragma once
+// Closed-loop simulation of one robot axis as in the seed's Figure 5.1: a physical model with
+// any effects, under a cascaded controller (P position loop, PI velocity loop) running at the
+// controller rate, with torque-reference noise, a load disturbance on the arm and an encoder
+// of finite resolution on the motor angle. The excitation is added to the position reference
+// phi_ref; the log holds what the seed measured: phi_ref, the torque reference u and the
+// measured motor angle (plus, on request, the true motor velocity and arm acceleration).
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "core/common/progress.h"
+#include "core/models/effects.h"
+#include "core/models/physical_models.h"
+#include "core/signal/id_data.h"
+#include "core/sim/excitation.h"
+
+namespace flexarm {
+
+// u = k_v (e_v + (1/T_i) int e_v), e_v = k_p (phi_ref - phi_m,meas) - phi_m',est, with
+// phi_m',est the backward difference of the measured angle.
+struct ControllerOptions {
+  double rateHz = 2000.0;  // controller sample rate (the seed's S4C: 0.5 ms)
+  double kp = 40.0;        // position gain, 1/s
+  double kv = 0.3;         // velocity gain, N m s/rad
+  double ti = 0.05;        // integral time of the velocity loop, s (0: no integral action)
+  bool isValid(std::string* why) const;
+};
+
+struct DisturbanceOptions {
+  double torqueNoiseStd = 0.02;     // N m, white, added to the torque reference at each tick
+  double loadTorqueStd = 2.0;       // N m on the arm, low-pass noise (first order)
+  double loadBandwidthHz = 2.0;     // corner of the load noise
+  double loadStepNm = 0.0;          // N m on the arm from loadStepTimeS on
+  double loadStepTimeS = 0.0;
+  long encoderCountsPerRev = 65536; // motor encoder resolution; 0: ideal (no quantization)
+  bool isValid(std::string* why) const;
+};
+
+struct SimulationOptions {
+  ControllerOptions controller;
+  DisturbanceOptions disturbance;
+  ExcitationOptions excitation;
+  double durationS = 20.0;
+  double logRateHz = 2000.0;        // must divide the controller rate
+  double referenceVelocity = 0.0;   // rad/s of the motor: phi_ref = v t + excitation
+  int substeps = 10;                // Runge-Kutta steps per controller period
+  std::uint64_t seed = 1;
+  bool logMotorVelocity = false;    // adds motor_velocity_rad_s (true velocity)
+  bool logArmAcceleration = false;  // adds arm_accel_rad_s2 (true acceleration)
+  bool logGear = false;             // adds gear_deflection_rad and gear_torque_nm
+  bool isValid(std::string* why) const;
+};
+
+struct SimulationResult {
+  IdData data;
+  Termination termination = Termination::Failed;
+  std::string message;
+  std::size_t controllerTicks = 0;
+  double seconds = 0.0;
+};
+
+// Simulates the closed loop from rest. Deterministic for a given seed. An unstable loop ends
+// with Termination::Diverged and a message; invalid options or effects throw
+// std::invalid_argument.
+SimulationResult simulateClosedLoop(const PhysicalModel& model, const std::vector<Effect>& effects,
+                                    const SimulationOptions& options,
+                                    const ProgressCallback& progress = {});
+
+}  // namespace flexarm

@@ -1,0 +1,73 @@
+#!/usr/bin/env bash
+# Regenerates sample_logs/ with the FlexArm simulator (flexarm simulate).
+#   scripts/make_sample_logs.sh [FLEXARM] [DIR]          write the logs into DIR
+#   scripts/make_sample_logs.sh --check FLEXARM DIR      regenerate into a temporary
+#       directory and compare every file byte for byte with DIR (exit 1 on a difference)
+# FLEXARM defaults to build/app/flexarm, DIR to sample_logs/ next to this script's folder.
+set -euo pipefail
+
+check=0
+if [[ "${1:-}" == "--check" ]]; then
+  check=1
+  shift
+fi
+here="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+flexarm="${1:-$here/build/app/flexarm}"
+target="${2:-$here/sample_logs}"
+if [[ ! -x "$flexarm" ]]; then
+  echo "make_sample_logs.sh: no flexarm executable at $flexarm" >&2
+  exit 2
+fi
+
+if [[ $check -eq 1 ]]; then
+  out="$(mktemp -d)"
+  trap 'rm -rf "$out"' EXIT
+else
+  out="$target"
+  mkdir -p "$out"
+fi
+
+sim() {  # sim NAME ARGS...
+  local name="$1"
+  shift
+  "$flexarm" simulate "$@" --out "$out/$name.csv" > /dev/null
+}
+
+# Chapter 5: three-mass arm (Table 5.7 p6) at the controller rate, 2 kHz.
+sim three_mass_estimation_chirp --model three-mass --excitation chirp --duration 18 --seed 1
+sim three_mass_validation_multisine --model three-mass --excitation multisine --duration 12 \
+  --seed 2
+
+# Chapters 6-7: 200 Hz logs, multisine 2 pi k/12 rad/s, k = 1..360 (0-60 pi rad/s, (6.50)),
+# five 12 s periods; the same seed, so that only the fault differs between the logs.
+diag=(--model three-mass --excitation multisine --duration 60 --rate 200 --seed 6)
+sim diagnosis_no_fault "${diag[@]}"
+sim diagnosis_fault_k_T "${diag[@]}" --param k_T=1.2              # k_T up 20 %
+sim diagnosis_fault_J_a_inv "${diag[@]}" --param J_a=1.4333333333333333  # 1/J_a up 20 %
+sim diagnosis_fault_f_m "${diag[@]}" --param f_m=0.0426           # f_m up 20 %
+
+# One log per effect (default effect parameters), three-mass arm, chirp, 1 kHz, 10 s. The
+# ripple log adds a constant motor speed of 5 rad/s so that the motor turns several
+# revolutions and the ripple is periodic in time.
+effect_log=(--model three-mass --excitation chirp --duration 10 --rate 1000 --seed 7)
+for effect in coulomb_friction backlash nonlinear_spring input_delay extra_mass; do
+  sim "effect_$effect" "${effect_log[@]}" --effect "$effect"
+done
+sim effect_torque_ripple "${effect_log[@]}" --effect torque_ripple --reference-velocity 5
+
+if [[ $check -eq 1 ]]; then
+  status=0
+  for f in "$out"/*; do
+    name="$(basename "$f")"
+    if ! cmp -s "$f" "$target/$name"; then
+      echo "make_sample_logs.sh: $name differs from $target/$name" >&2
+      status=1
+    fi
+  done
+  for f in "$target"/*.csv "$target"/*.truth.json; do
+    [[ -e "$out/$(basename "$f")" ]] || { echo "extra file $f" >&2; status=1; }
+  done
+  [[ $status -eq 0 ]] && echo "all $(ls "$out" | wc -l) sample files regenerate bit-identically"
+  exit $status
+fi
+echo "wrote $(ls "$out"/*.csv | wc -l) logs to $out"
