@@ -6,7 +6,7 @@ here="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 bash "$here/scripts/install-deps.sh"
 bash "$here/scripts/build.sh"
 build="${BUILD_DIR:-$here/build}"
-log="${1:-$here/sample_logs/dev_synthetic.csv}"
+log="${1:-$here/sample_logs/three_mass_estimation_chirp.csv}"
 if [ -n "${DISPLAY:-}" ] || [ -n "${WAYLAND_DISPLAY:-}" ]; then
   exec "$build/app/flexarm" "$log"
 fi

@@ -11,7 +11,7 @@ using flexarm::test::runFlexarm;
 using nlohmann::json;
 
 namespace {
-const std::string kSample = std::string(FLEXARM_SAMPLE_DIR) + "/dev_synthetic.csv";
+const std::string kSample = std::string(FLEXARM_SAMPLE_DIR) + "/three_mass_estimation_chirp.csv";
 const std::string kDaisy = std::string(FLEXARM_SAMPLE_DIR) + "/daisy_robot_arm.dat";
 std::string bad(const char* f) { return std::string(FLEXARM_TEST_DATA_DIR) + "/bad/" + f; }
 }  // namespace
@@ -47,7 +47,7 @@ TEST(CliLog, InfoPrintsChannelsRateAndLength) {
   ASSERT_EQ(r.code, 0) << r.err;
   json j = json::parse(r.out);
   EXPECT_DOUBLE_EQ(j["sample_rate_hz"].get<double>(), 2000.0);
-  EXPECT_EQ(j["samples"].get<int>(), 40000);
+  EXPECT_EQ(j["samples"].get<int>(), 36000);
   EXPECT_TRUE(j["closed_loop"].get<bool>());
   std::vector<std::string> names;
   for (const auto& c : j["channels"]) names.push_back(c["name"]);

@@ -18,7 +18,7 @@
 using namespace flexarm;
 
 namespace {
-const QString kSampleLog = QString(FLEXARM_SAMPLE_DIR) + "/dev_synthetic.csv";
+const QString kSampleLog = QString(FLEXARM_SAMPLE_DIR) + "/three_mass_estimation_chirp.csv";
 }
 
 class MainWindowTest : public QObject {
