@@ -20,6 +20,7 @@
 #include <QProgressDialog>
 #include <QSettings>
 #include <QSpinBox>
+#include <QUndoStack>
 #include <QStatusBar>
 #include <QtConcurrent>
 #include <fstream>
@@ -29,6 +30,7 @@
 #include "core/io/ranges.h"
 #include "widgets/arm_panel.h"
 #include "widgets/log_panel.h"
+#include "widgets/model_panel.h"
 #include "widgets/preprocess_panel.h"
 #include "widgets/workspace.h"
 
@@ -97,8 +99,10 @@ MainWindow::MainWindow(QWidget* parent)
       logPanel_(new LogPanel(workspace_, this)),
       preprocessPanel_(new PreprocessPanel(workspace_, this)),
       armPanel_(new ArmPanel(workspace_, this)),
+      modelPanel_(new ModelPanel(workspace_, this)),
       preprocessDock_(new QDockWidget(tr("Preprocess"), this)),
-      armDock_(new QDockWidget(tr("Arm"), this)) {
+      armDock_(new QDockWidget(tr("Arm"), this)),
+      modelDock_(new QDockWidget(tr("Model"), this)) {
   setObjectName("mainWindow");
   setWindowTitle("FlexArm");
   setAcceptDrops(true);
@@ -109,6 +113,11 @@ MainWindow::MainWindow(QWidget* parent)
   armDock_->setWidget(armPanel_);
   addDockWidget(Qt::RightDockWidgetArea, preprocessDock_);
   addDockWidget(Qt::RightDockWidgetArea, armDock_);
+  modelDock_->setObjectName("modelDock");
+  modelDock_->setWidget(modelPanel_);
+  addDockWidget(Qt::RightDockWidgetArea, modelDock_);
+  tabifyDockWidget(preprocessDock_, modelDock_);
+  preprocessDock_->raise();
   resize(1280, 860);
   createMenus();
 
@@ -174,6 +183,19 @@ void MainWindow::createMenus() {
   QAction* arm = armDock_->toggleViewAction();
   arm->setShortcut(QKeySequence("Ctrl+Shift+A"));
   view->addAction(arm);
+
+  QAction* model = modelDock_->toggleViewAction();
+  model->setShortcut(QKeySequence("Ctrl+Shift+M"));
+  view->addAction(model);
+
+  QMenu* edit = menuBar()->addMenu(tr("&Edit"));
+  QAction* undo = workspace_->undoStack()->createUndoAction(this, tr("&Undo"));
+  undo->setShortcut(QKeySequence::Undo);
+  edit->addAction(undo);
+  QAction* redo = workspace_->undoStack()->createRedoAction(this, tr("&Redo"));
+  redo->setShortcut(QKeySequence::Redo);
+  edit->addAction(redo);
+  menuBar()->insertMenu(data->menuAction(), edit);
 
   QMenu* help = menuBar()->addMenu(tr("&Help"));
   help->addAction(tr("&Command line..."), this, [this] {

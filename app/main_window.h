@@ -16,6 +16,7 @@ namespace flexarm {
 
 class ArmPanel;
 class LogPanel;
+class ModelPanel;
 class PreprocessPanel;
 class Workspace;
 
@@ -35,6 +36,7 @@ class MainWindow : public QMainWindow {
   LogPanel* logPanel() const { return logPanel_; }
   PreprocessPanel* preprocessPanel() const { return preprocessPanel_; }
   ArmPanel* armPanel() const { return armPanel_; }
+  ModelPanel* modelPanel() const { return modelPanel_; }
   QStringList recentFiles() const;
 
  signals:
@@ -59,8 +61,10 @@ class MainWindow : public QMainWindow {
   LogPanel* logPanel_;
   PreprocessPanel* preprocessPanel_;
   ArmPanel* armPanel_;
+  ModelPanel* modelPanel_;
   QDockWidget* preprocessDock_;
   QDockWidget* armDock_;
+  QDockWidget* modelDock_;
   QMenu* recentMenu_ = nullptr;
   QFutureWatcher<LogReadResult> reader_;
   QProgressDialog* progress_ = nullptr;

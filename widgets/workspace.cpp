@@ -1,5 +1,7 @@
 #include "widgets/workspace.h"
 
+#include <QUndoCommand>
+#include <QUndoStack>
 #include <algorithm>
 
 #include "core/io/ranges.h"
@@ -10,7 +12,64 @@ const char* toString(RangeKind kind) {
   return kind == RangeKind::Estimation ? "estimation" : "validation";
 }
 
-Workspace::Workspace(QObject* parent) : QObject(parent) {}
+namespace {
+
+class ReplaceModelCommand : public QUndoCommand {
+ public:
+  ReplaceModelCommand(Workspace* w, int index, ModelEntry before, ModelEntry after, const QString& text)
+      : QUndoCommand(text), w_(w), index_(index), before_(std::move(before)), after_(std::move(after)) {}
+  void redo() override { w_->setModelDirect(index_, after_); }
+  void undo() override { w_->setModelDirect(index_, before_); }
+
+ private:
+  Workspace* w_;
+  int index_;
+  ModelEntry before_, after_;
+};
+
+class AddModelCommand : public QUndoCommand {
+ public:
+  AddModelCommand(Workspace* w, int index, ModelEntry entry)
+      : QUndoCommand(QObject::tr("add model %1").arg(entry.name)), w_(w), index_(index), entry_(std::move(entry)) {}
+  void redo() override { w_->insertModelDirect(index_, entry_); }
+  void undo() override { w_->removeModelDirect(index_); }
+
+ private:
+  Workspace* w_;
+  int index_;
+  ModelEntry entry_;
+};
+
+}  // namespace
+
+Workspace::Workspace(QObject* parent) : QObject(parent), undo_(new QUndoStack(this)) {}
+
+int Workspace::addModel(ModelEntry entry) {
+  const int index = static_cast<int>(models_.size());
+  undo_->push(new AddModelCommand(this, index, std::move(entry)));
+  return index;
+}
+
+void Workspace::replaceModel(int index, ModelEntry entry, const QString& what) {
+  if (index < 0 || index >= static_cast<int>(models_.size())) return;
+  undo_->push(new ReplaceModelCommand(this, index, models_[static_cast<std::size_t>(index)],
+                                      std::move(entry), what));
+}
+
+void Workspace::setModelDirect(int index, const ModelEntry& entry) {
+  models_[static_cast<std::size_t>(index)] = entry;
+  emit modelsChanged(index);
+}
+
+void Workspace::insertModelDirect(int index, const ModelEntry& entry) {
+  models_.insert(models_.begin() + index, entry);
+  emit modelsChanged(-1);
+}
+
+void Workspace::removeModelDirect(int index) {
+  models_.erase(models_.begin() + index);
+  emit modelsChanged(-1);
+}
 
 void Workspace::setLog(IdData data, const QString& path) {
   std::string ignored;

@@ -7,8 +7,12 @@
 #include <memory>
 #include <optional>
 
+#include "core/models/effects.h"
+#include "core/models/physical_models.h"
 #include "core/signal/id_data.h"
 #include "core/signal/preprocess.h"
+
+class QUndoStack;
 
 namespace flexarm {
 
@@ -17,6 +21,14 @@ enum class RangeKind { Estimation, Validation };
 struct TimeRange {
   double start = 0.0;
   double end = 0.0;
+};
+
+// A model in the shared model list: a physical model (its parameters, free/fixed flags and
+// output options) and the nonlinear effects switched on for it.
+struct ModelEntry {
+  QString name;
+  std::shared_ptr<const PhysicalModel> model;
+  std::vector<Effect> effects;
 };
 
 class Workspace : public QObject {
@@ -45,16 +57,29 @@ class Workspace : public QObject {
   // current() with its estimationRange and validationRange set from the workspace ranges.
   IdData currentWithRanges() const;
 
+  // The model list every panel shares. Changes go through the undo stack.
+  const std::vector<ModelEntry>& models() const { return models_; }
+  int addModel(ModelEntry entry);  // returns its index
+  void replaceModel(int index, ModelEntry entry, const QString& what);
+  QUndoStack* undoStack() const { return undo_; }
+  // Applied by the undo commands; panels use addModel/replaceModel.
+  void setModelDirect(int index, const ModelEntry& entry);
+  void insertModelDirect(int index, const ModelEntry& entry);
+  void removeModelDirect(int index);
+
  signals:
   void logChanged();
   void currentChanged();  // the log or its preprocessing changed
   void rangesChanged();
+  void modelsChanged(int index);  // index of the changed model, -1 when the list changed
 
  private:
   std::shared_ptr<IdData> raw_, processed_;
   PreprocessOptions options_;
   QString path_;
   std::optional<TimeRange> estimation_, validation_;
+  std::vector<ModelEntry> models_;
+  QUndoStack* undo_;
 };
 
 const char* toString(RangeKind kind);

@@ -1,0 +1,397 @@
+#include "widgets/model_panel.h"
+
+#include <QCheckBox>
+#include <QComboBox>
+#include <QGridLayout>
+#include <QHBoxLayout>
+#include <QHeaderView>
+#include <QLabel>
+#include <QPushButton>
+#include <QSplitter>
+#include <QTableWidget>
+#include <QVBoxLayout>
+#include <QtConcurrent>
+#include <cmath>
+#include <qcustomplot.h>
+
+#include "core/ident/evaluation.h"
+#include "core/models/analysis.h"
+#include "core/models/nonlinear_plant.h"
+#include "core/signal/preprocess.h"
+#include "widgets/plots/bode_plot.h"
+#include "widgets/plots/pole_zero_plot.h"
+
+namespace flexarm {
+namespace {
+
+std::vector<double> logGrid(double lo, double hi, int n) {
+  std::vector<double> w(static_cast<std::size_t>(n));
+  for (int i = 0; i < n; ++i) w[static_cast<std::size_t>(i)] = lo * std::pow(hi / lo, static_cast<double>(i) / (n - 1));
+  return w;
+}
+
+std::shared_ptr<PhysicalModel> cloneModel(const PhysicalModel& m) {
+  std::unique_ptr<ParametricModel> c = m.clone();
+  return std::shared_ptr<PhysicalModel>(static_cast<PhysicalModel*>(c.release()));
+}
+
+QString modesText(const std::vector<Mode>& modes) {
+  QStringList parts;
+  for (const auto& m : modes) parts << QString::number(m.frequency, 'f', 1);
+  return parts.isEmpty() ? QString("-") : parts.join(", ");
+}
+
+}  // namespace
+
+ModelPanel::ModelPanel(Workspace* workspace, QWidget* parent)
+    : QWidget(parent), workspace_(workspace), list_(new QComboBox(this)),
+      structure_(new QComboBox(this)), params_(new QTableWidget(0, 4, this)),
+      effects_(new QTableWidget(0, 4, this)), bode_(new BodePlot(this)),
+      poleZero_(new PoleZeroPlot(this)), frequencies_(new QLabel(this)),
+      description_(new QLabel(this)), simulate_(new QPushButton(tr("Simulate against log"), this)),
+      compare_(new QCustomPlot(this)), fit_(new QLabel(this)) {
+  setObjectName("modelPanel");
+  list_->setObjectName("modelList");
+  structure_->setObjectName("structureCombo");
+  for (const auto& s : modelStructureNames()) structure_->addItem(QString::fromStdString(s));
+  structure_->setCurrentText("three-mass");
+  auto* add = new QPushButton(tr("New model"), this);
+  add->setObjectName("newModelButton");
+  auto* top = new QHBoxLayout;
+  top->addWidget(new QLabel(tr("Model"), this));
+  top->addWidget(list_, 1);
+  top->addWidget(structure_);
+  top->addWidget(add);
+
+  params_->setObjectName("parameterTable");
+  params_->setHorizontalHeaderLabels({tr("Parameter"), tr("Value"), tr("Unit"), tr("Free")});
+  params_->verticalHeader()->hide();
+  params_->horizontalHeader()->setSectionResizeMode(QHeaderView::Stretch);
+  effects_->setObjectName("effectTable");
+  effects_->setHorizontalHeaderLabels({tr("Effect"), tr("On"), tr("Value 1"), tr("Value 2")});
+  effects_->verticalHeader()->hide();
+  effects_->horizontalHeader()->setSectionResizeMode(QHeaderView::Stretch);
+  effects_->setRowCount(static_cast<int>(allEffectKinds().size()));
+  for (int r = 0; r < effects_->rowCount(); ++r) {
+    const EffectKind k = allEffectKinds()[static_cast<std::size_t>(r)];
+    auto* name = new QTableWidgetItem(toString(k));
+    name->setFlags(Qt::ItemIsEnabled);
+    QStringList tip;
+    for (const auto& p : effectParameters(k))
+      tip << QString("%1 [%2]: %3").arg(QString::fromStdString(p.name), QString::fromStdString(p.unit),
+                                        QString::fromStdString(p.meaning));
+    name->setToolTip(tip.join("\n"));
+    effects_->setItem(r, 0, name);
+  }
+  description_->setWordWrap(true);
+  frequencies_->setObjectName("frequencyLabel");
+  frequencies_->setWordWrap(true);
+  fit_->setObjectName("fitLabel");
+  simulate_->setObjectName("simulateButton");
+  compare_->setObjectName("comparePlot");
+  compare_->setMinimumHeight(160);
+  compare_->xAxis->setLabel(tr("time [s]"));
+  compare_->yAxis->setLabel(tr("motor velocity [rad/s]"));
+  compare_->legend->setVisible(true);
+  compare_->setInteractions(QCP::iRangeDrag | QCP::iRangeZoom);
+  compare_->axisRect()->setRangeZoom(Qt::Horizontal);
+  compare_->axisRect()->setRangeDrag(Qt::Horizontal);
+  auto* measured = compare_->addGraph();
+  measured->setName(tr("measured"));
+  measured->setPen(QPen(QColor(60, 60, 60), 1));
+  auto* simulated = compare_->addGraph();
+  simulated->setName(tr("simulated"));
+  simulated->setPen(QPen(QColor(214, 39, 40), 1.2));
+
+  auto* left = new QWidget(this);
+  auto* leftLayout = new QVBoxLayout(left);
+  leftLayout->setContentsMargins(0, 0, 0, 0);
+  leftLayout->addWidget(description_);
+  leftLayout->addWidget(params_, 3);
+  leftLayout->addWidget(new QLabel(tr("Effects the linear model lacks:"), this));
+  leftLayout->addWidget(effects_, 2);
+  auto* right = new QWidget(this);
+  auto* rightLayout = new QVBoxLayout(right);
+  rightLayout->setContentsMargins(0, 0, 0, 0);
+  rightLayout->addWidget(bode_, 3);
+  rightLayout->addWidget(frequencies_);
+  rightLayout->addWidget(poleZero_, 2);
+  auto* split = new QSplitter(Qt::Horizontal, this);
+  split->addWidget(left);
+  split->addWidget(right);
+  split->setStretchFactor(1, 2);
+  auto* simRow = new QHBoxLayout;
+  simRow->addWidget(simulate_);
+  simRow->addWidget(fit_, 1);
+  auto* layout = new QVBoxLayout(this);
+  layout->addLayout(top);
+  layout->addWidget(split, 3);
+  layout->addLayout(simRow);
+  layout->addWidget(compare_, 1);
+
+  connect(add, &QPushButton::clicked, this, [this] { newModel(structure_->currentText()); });
+  connect(list_, QOverload<int>::of(&QComboBox::currentIndexChanged), this, [this](int i) {
+    if (!filling_) selectModel(i);
+  });
+  connect(params_, &QTableWidget::cellChanged, this, &ModelPanel::onParameterEdited);
+  connect(effects_, &QTableWidget::cellChanged, this, &ModelPanel::onEffectEdited);
+  connect(simulate_, &QPushButton::clicked, this, &ModelPanel::simulateAgainstLog);
+  connect(&simulation_, &QFutureWatcher<SimOutcome>::finished, this, &ModelPanel::onSimulated);
+  connect(workspace_, &Workspace::modelsChanged, this, [this](int index) {
+    if (index < 0) refreshList();
+    else if (index == current_) refreshModel();
+  });
+  refreshList();
+}
+
+void ModelPanel::refreshList() {
+  filling_ = true;
+  list_->clear();
+  for (const auto& m : workspace_->models()) list_->addItem(m.name);
+  filling_ = false;
+  const int n = static_cast<int>(workspace_->models().size());
+  if (n == 0) {
+    current_ = -1;
+    refreshModel();
+    return;
+  }
+  selectModel(std::clamp(current_, 0, n - 1));
+}
+
+void ModelPanel::selectModel(int index) {
+  if (index < 0 || index >= static_cast<int>(workspace_->models().size())) return;
+  current_ = index;
+  filling_ = true;
+  list_->setCurrentIndex(index);
+  filling_ = false;
+  refreshModel();
+}
+
+int ModelPanel::newModel(const QString& structure) {
+  ModelEntry e;
+  e.model = std::shared_ptr<PhysicalModel>(makeModel(structure.toStdString()));
+  int same = 1;
+  for (const auto& m : workspace_->models())
+    if (m.name.startsWith(structure)) ++same;
+  e.name = same == 1 ? structure : QString("%1 (%2)").arg(structure).arg(same);
+  current_ = static_cast<int>(workspace_->models().size());
+  const int index = workspace_->addModel(std::move(e));
+  selectModel(index);
+  return index;
+}
+
+void ModelPanel::refreshModel() {
+  filling_ = true;
+  params_->setRowCount(0);
+  bode_->clear();
+  poleZero_->clear();
+  const bool has = current_ >= 0 && current_ < static_cast<int>(workspace_->models().size());
+  simulate_->setEnabled(has);
+  if (!has) {
+    description_->setText(tr("No model yet: pick a structure and press New model."));
+    frequencies_->clear();
+    filling_ = false;
+    return;
+  }
+  const ModelEntry& entry = workspace_->models()[static_cast<std::size_t>(current_)];
+  const PhysicalModel& m = *entry.model;
+  description_->setText(QString::fromStdString(m.description()));
+  const auto& ps = m.parameters();
+  params_->setRowCount(static_cast<int>(ps.size()));
+  for (int r = 0; r < static_cast<int>(ps.size()); ++r) {
+    const auto& p = ps[static_cast<std::size_t>(r)];
+    auto* name = new QTableWidgetItem(QString::fromStdString(p.name));
+    name->setFlags(Qt::ItemIsEnabled);
+    name->setToolTip(tr("bounds %1 .. %2").arg(p.lower).arg(p.upper));
+    auto* value = new QTableWidgetItem(QString::number(p.value, 'g', 6));
+    auto* unit = new QTableWidgetItem(QString::fromStdString(p.unit));
+    unit->setFlags(Qt::ItemIsEnabled);
+    auto* free = new QTableWidgetItem;
+    free->setFlags(Qt::ItemIsEnabled | Qt::ItemIsUserCheckable);
+    free->setCheckState(p.free ? Qt::Checked : Qt::Unchecked);
+    params_->setItem(r, 0, name);
+    params_->setItem(r, 1, value);
+    params_->setItem(r, 2, unit);
+    params_->setItem(r, 3, free);
+  }
+  for (int r = 0; r < effects_->rowCount(); ++r) {
+    const EffectKind k = allEffectKinds()[static_cast<std::size_t>(r)];
+    const Effect* on = nullptr;
+    for (const auto& e : entry.effects)
+      if (e.kind == k) on = &e;
+    const Effect shown = on ? *on : Effect::withDefaults(k);
+    auto* check = new QTableWidgetItem;
+    check->setFlags(Qt::ItemIsEnabled | Qt::ItemIsUserCheckable);
+    check->setCheckState(on ? Qt::Checked : Qt::Unchecked);
+    effects_->setItem(r, 1, check);
+    const auto& info = effectParameters(k);
+    for (int c = 0; c < 2; ++c) {
+      auto* v = new QTableWidgetItem(c < static_cast<int>(info.size())
+                                         ? QString("%1 %2").arg(shown.value(c), 0, 'g', 4).arg(QString::fromStdString(info[static_cast<std::size_t>(c)].unit))
+                                         : QString());
+      if (c >= static_cast<int>(info.size())) v->setFlags(Qt::NoItemFlags);
+      effects_->setItem(r, 2 + c, v);
+    }
+  }
+  filling_ = false;
+
+  // Linear analysis of the model with the velocity output (structural effects applied).
+  try {
+    ModelOptions velocity;
+    std::shared_ptr<PhysicalModel> linear = cloneModel(m);
+    linear->setOptions(velocity);
+    StateSpace sys = linear->stateSpace();
+    for (const auto& e : entry.effects)
+      if (e.kind == EffectKind::ExtraMass) sys = NonlinearPlant(*linear, {e}).model().stateSpace();
+    const auto w = logGrid(1.0, 2000.0, 600);
+    BodeCurve curve;
+    curve.name = entry.name;
+    curve.color = QColor(31, 119, 180);
+    curve.frequency = w;
+    curve.response = frequencyResponse(sys, w);
+    bode_->addCurve(curve);
+    poleZero_->addSet(entry.name, QColor(31, 119, 180), poles(sys), zeros(sys));
+    frequencies_->setText(tr("Notches %1 rad/s; peaks %2 rad/s")
+                              .arg(modesText(notchFrequencies(sys)))
+                              .arg(modesText(peakFrequencies(sys))));
+  } catch (const std::exception& e) {
+    frequencies_->setText(tr("Cannot analyse the model: %1").arg(e.what()));
+  }
+}
+
+QString ModelPanel::frequencyText() const { return frequencies_->text(); }
+
+bool ModelPanel::setParameter(const QString& name, double value, QString* why) {
+  if (current_ < 0) return false;
+  ModelEntry entry = workspace_->models()[static_cast<std::size_t>(current_)];
+  auto copy = cloneModel(*entry.model);
+  try {
+    copy->setParameter(name.toStdString(), value);
+  } catch (const std::exception& e) {
+    if (why) *why = QString::fromStdString(e.what());
+    refreshModel();  // show the old value again
+    return false;
+  }
+  entry.model = copy;
+  workspace_->replaceModel(current_, entry, tr("set %1 = %2").arg(name).arg(value));
+  return true;
+}
+
+bool ModelPanel::setEffect(EffectKind kind, bool on, double firstValue) {
+  if (current_ < 0) return false;
+  ModelEntry entry = workspace_->models()[static_cast<std::size_t>(current_)];
+  std::vector<Effect> effects;
+  for (const auto& e : entry.effects)
+    if (e.kind != kind) effects.push_back(e);
+  if (on) {
+    Effect e = Effect::withDefaults(kind);
+    for (const auto& old : entry.effects)
+      if (old.kind == kind) e = old;
+    if (std::isfinite(firstValue)) e.values[0] = firstValue;
+    std::string why;
+    if (!e.isValid(&why)) {
+      refreshModel();
+      return false;
+    }
+    effects.push_back(e);
+  }
+  entry.effects = effects;
+  workspace_->replaceModel(current_, entry,
+                           tr("%1 %2").arg(on ? tr("switch on") : tr("switch off")).arg(toString(kind)));
+  return true;
+}
+
+void ModelPanel::onParameterEdited(int row, int column) {
+  if (filling_ || current_ < 0) return;
+  const auto& ps = workspace_->models()[static_cast<std::size_t>(current_)].model->parameters();
+  const QString name = QString::fromStdString(ps[static_cast<std::size_t>(row)].name);
+  if (column == 1) {
+    bool ok = false;
+    const double v = params_->item(row, 1)->text().toDouble(&ok);
+    QString why;
+    if (!ok || !std::isfinite(v)) {
+      refreshModel();
+      params_->setToolTip(tr("'%1' is not a number").arg(params_->item(row, 1)->text()));
+    } else if (!setParameter(name, v, &why)) {
+      params_->setToolTip(why);
+    }
+  } else if (column == 3) {
+    ModelEntry entry = workspace_->models()[static_cast<std::size_t>(current_)];
+    auto copy = cloneModel(*entry.model);
+    const bool free = params_->item(row, 3)->checkState() == Qt::Checked;
+    copy->setFree(name.toStdString(), free);
+    entry.model = copy;
+    workspace_->replaceModel(current_, entry, tr("%1 %2").arg(free ? tr("free") : tr("fix")).arg(name));
+  }
+}
+
+void ModelPanel::onEffectEdited(int row, int column) {
+  if (filling_ || current_ < 0) return;
+  const EffectKind kind = allEffectKinds()[static_cast<std::size_t>(row)];
+  const bool on = effects_->item(row, 1)->checkState() == Qt::Checked;
+  double first = std::nan("");
+  if (column == 2) {
+    bool ok = false;
+    first = effects_->item(row, 2)->text().split(' ').value(0).toDouble(&ok);
+    if (!ok) first = std::nan("");
+  }
+  setEffect(kind, on, first);
+}
+
+void ModelPanel::simulateAgainstLog() {
+  const IdData* data = workspace_->current();
+  if (current_ < 0 || !data || isSimulating()) return;
+  const Channel* torque = data->channel(columns::kTorqueRef);
+  if (!torque && data->input()) torque = data->input();
+  const Channel* velocity = data->channel(columns::kMotorVelocity);
+  const Channel* angle = data->channel(columns::kMotorAngle);
+  if (!torque || (!velocity && !angle)) {
+    fit_->setText(tr("The log needs a torque reference and a motor angle or velocity."));
+    return;
+  }
+  const ModelEntry entry = workspace_->models()[static_cast<std::size_t>(current_)];
+  auto u = std::make_shared<std::vector<double>>(torque->values);
+  auto y = std::make_shared<std::vector<double>>(velocity ? velocity->values : differentiate(angle->values, data->sampleTime));
+  const double ts = data->sampleTime, t0 = data->startTime;
+  simulate_->setEnabled(false);
+  fit_->setText(tr("Simulating..."));
+  simulation_.setFuture(QtConcurrent::run([entry, u, y, ts, t0]() {
+    SimOutcome out;
+    try {
+      NonlinearPlant plant(*entry.model, entry.effects);
+      TorqueResponseOptions o;
+      o.substeps = std::max(2, static_cast<int>(std::ceil(ts / 2.5e-4)));
+      TorqueResponse r = simulateTorque(plant, *u, ts, o);
+      out.simulated = r.motorVelocity;
+      out.measured = *y;
+      out.time.resize(u->size());
+      for (std::size_t i = 0; i < u->size(); ++i) out.time[i] = t0 + i * ts;
+      const Eigen::VectorXd ym = Eigen::Map<const Eigen::VectorXd>(y->data(), static_cast<Eigen::Index>(y->size()));
+      const Eigen::VectorXd ys = Eigen::Map<const Eigen::VectorXd>(out.simulated.data(), static_cast<Eigen::Index>(out.simulated.size()));
+      out.fit = fitPercent(ym, ys);
+    } catch (const std::exception& e) {
+      out.error = QString::fromStdString(e.what());
+    }
+    return out;
+  }));
+}
+
+void ModelPanel::onSimulated() {
+  simulate_->setEnabled(true);
+  SimOutcome out = simulation_.result();
+  if (!out.error.isEmpty()) {
+    fit_->setText(tr("Simulation failed: %1").arg(out.error));
+    return;
+  }
+  auto qv = [](const std::vector<double>& v) { return QVector<double>(v.begin(), v.end()); };
+  compare_->graph(0)->setData(qv(out.time), qv(out.measured), true);
+  compare_->graph(1)->setData(qv(out.time), qv(out.simulated), true);
+  compare_->rescaleAxes();
+  compare_->replot();
+  lastFit_ = out.fit;
+  fit_->setText(tr("Fit %1 % (5.2), simulated from the log's torque reference")
+                    .arg(out.fit, 0, 'f', 1));
+  emit simulationFinished(out.fit);
+}
+
+}  // namespace flexarm
