@@ -1,5 +1,7 @@
 #include "core/ident/blackbox.h"
 
+#include "core/ident/levenberg_marquardt.h"
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -153,12 +155,6 @@ Eigen::MatrixXd regressors(const std::vector<Block>& blocks, Eigen::Index first,
   return phi;
 }
 
-void fillStatistics(EstimateSummary& s, double sumSq, Eigen::Index n, int p) {
-  const double N = static_cast<double>(n);
-  s.loss = sumSq / N;
-  s.fpe = p < n ? s.loss * (1.0 + p / N) / (1.0 - p / N) : INFINITY;
-  s.aic = N * std::log(std::max(s.loss, 1e-300)) + 2.0 * p;
-}
 
 // psi (4.20) = -d eps / d theta for the general structure (4.8), obtained by filtering.
 void errorsAndPsi(const PolynomialModel& m, const Eigen::VectorXd& u, const Eigen::VectorXd& y,
@@ -394,78 +390,29 @@ PolyEstimate refinePolynomial(const Eigen::VectorXd& u, const Eigen::VectorXd& y
     s.message = "the data contain NaN or infinite values";
     return r;
   }
-  PolynomialModel m = initial;
-  if (options.enforceStability) stabilize(m);
-  Eigen::VectorXd eps;
-  Eigen::MatrixXd psi;
-  errorsAndPsi(m, u, y, eps, &psi);
-  double sumSq = eps.squaredNorm();
-  if (!std::isfinite(sumSq)) {
-    s.message = "the initial model gives non-finite prediction errors";
-    return r;
-  }
-  s.lossHistory.push_back(sumSq / n);
-  double mu = options.initialDamping;
-  s.termination = Termination::MaxIterations;
-  s.message = "reached the maximum number of iterations";
-  for (int it = 0; it < options.maxIterations; ++it) {
-    if (reportProgress(progress, static_cast<double>(it) / options.maxIterations, "iterating")) {
-      s.termination = Termination::Cancelled;
-      s.message = "cancelled by the user";
-      break;
-    }
-    const Eigen::MatrixXd R = psi.transpose() * psi;  // (4.21) times N
-    const Eigen::VectorXd g = psi.transpose() * eps;  // -(4.19) times N
-    const Eigen::VectorXd scale = R.diagonal().cwiseMax(1e-12 * std::max(1.0, R.diagonal().maxCoeff()));
-    bool accepted = false;
-    double newSumSq = sumSq;
-    while (mu < 1e12) {
-      Eigen::MatrixXd Rl = R;
-      Rl.diagonal() += mu * scale;
-      const Eigen::VectorXd delta = Rl.ldlt().solve(g);
-      PolynomialModel trial = m;
-      trial.setParameterVector(m.parameterVector() + delta);
-      if (options.enforceStability) stabilize(trial);
-      Eigen::VectorXd e2;
-      errorsAndPsi(trial, u, y, e2, nullptr);
-      const double ss = e2.squaredNorm();
-      if (std::isfinite(ss) && ss < sumSq) {
-        m = trial;
-        newSumSq = ss;
-        accepted = true;
-        mu = std::max(mu / 10.0, 1e-12);
-        break;
-      }
-      mu *= 10.0;
-    }
-    s.iterations = it + 1;
-    if (!accepted) {
-      s.termination = Termination::Converged;
-      s.message = "no step reduces the loss: a local minimum";
-      break;
-    }
-    const double rel = (sumSq - newSumSq) / sumSq;
-    sumSq = newSumSq;
-    errorsAndPsi(m, u, y, eps, &psi);
-    s.lossHistory.push_back(sumSq / n);
-    if (rel < options.relativeTolerance) {
-      s.termination = Termination::Converged;
-      s.message = "the relative loss improvement fell below the tolerance";
-      break;
-    }
-  }
-  r.model = m;
-  const Eigen::MatrixXd R = psi.transpose() * psi;
-  m.noiseVariance = sumSq / static_cast<double>(n - p);
-  Eigen::LDLT<Eigen::MatrixXd> ldlt(R);
-  r.model.noiseVariance = m.noiseVariance;
-  if (ldlt.info() == Eigen::Success && (ldlt.vectorD().array() > 0).all())
-    r.model.covariance = m.noiseVariance * ldlt.solve(Eigen::MatrixXd::Identity(p, p));
-  else {
-    r.model.covariance.resize(0, 0);
+  PolynomialModel work = initial;
+  LeastSquaresProblem problem;
+  problem.evaluate = [&](const Eigen::VectorXd& th, Eigen::VectorXd& eps, Eigen::MatrixXd* psi) {
+    work.setParameterVector(th);
+    errorsAndPsi(work, u, y, eps, psi);
+    return true;
+  };
+  if (options.enforceStability)
+    problem.project = [&](Eigen::VectorXd& th) {
+      work.setParameterVector(th);
+      if (stabilize(work)) th = work.parameterVector();
+    };
+  LeastSquaresSolution sol = levenbergMarquardt(problem, initial.parameterVector(),
+                                                options.maxIterations, options.relativeTolerance,
+                                                options.initialDamping, progress);
+  s = sol.summary;
+  if (s.termination == Termination::Failed) return r;
+  r.model.setParameterVector(sol.phi);
+  r.model.noiseVariance = sol.sumSquares / static_cast<double>(n - p);
+  r.model.covariance = gaussNewtonCovariance(sol.psi, sol.sumSquares);
+  if (r.model.covariance.size() == 0)
     s.message += "; the Hessian is singular, so no covariance (the model is over-parameterized)";
-  }
-  fillStatistics(s, sumSq, n, p);
+  fillStatistics(s, sol.sumSquares, n, p);
   s.seconds = since(t0);
   return r;
 }
