@@ -9,6 +9,9 @@ const std::vector<Verb>& verbs() {
       {"info", "channels, units, sample rate, length, metadata and ranges of a log", runInfo},
       {"preprocess", "differentiate, decimate with anti-alias filter, detrend, cut; write CSV",
        runPreprocess},
+      {"fit", "estimate ARX/ARMAX/OE/BJ or physical models with std, fit %, notches, peaks",
+       runFit},
+      {"bode", "frequency response of a fitted model or SPA/ETFE with bands, to CSV", runBode},
   };
   return kVerbs;
 }

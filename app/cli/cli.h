@@ -64,5 +64,7 @@ class ArgParser {
 // Verbs. Each lives in its own verb_*.cpp.
 int runInfo(const std::vector<std::string>& args, std::ostream& out, std::ostream& err);
 int runPreprocess(const std::vector<std::string>& args, std::ostream& out, std::ostream& err);
+int runFit(const std::vector<std::string>& args, std::ostream& out, std::ostream& err);
+int runBode(const std::vector<std::string>& args, std::ostream& out, std::ostream& err);
 
 }  // namespace flexarm::cli

@@ -156,14 +156,23 @@ Eigen::MatrixXd regressors(const std::vector<Block>& blocks, Eigen::Index first,
 }
 
 
+int criterionStart(const PolyOrders& o) {
+  return std::max({o.na, o.nb + o.nk - 1, o.nc, o.nd, o.nf});
+}
+
 // psi (4.20) = -d eps / d theta for the general structure (4.8), obtained by filtering.
 void errorsAndPsi(const PolynomialModel& m, const Eigen::VectorXd& u, const Eigen::VectorXd& y,
-                  Eigen::VectorXd& eps, Eigen::MatrixXd* psi) {
+                  Eigen::VectorXd& eps, Eigen::MatrixXd* psi, bool skipStart = true) {
   const Poly one{1.0};
   const Eigen::VectorXd ay = m.orders.na ? filter(m.a, one, y) : y;
   const Eigen::VectorXd w = filter(m.b, m.f, u);
   const Eigen::VectorXd v = ay - w;
   eps = filter(m.d, m.c, v);
+  // The criterion starts once every regressor holds data (as ARX does): the zero initial
+  // conditions would otherwise dominate the loss of a nearly noise-free system.
+  const Eigen::Index n0 =
+      skipStart ? std::min<Eigen::Index>(criterionStart(m.orders), y.size()) : 0;
+  eps.head(n0).setZero();
   if (!psi) return;
   const auto& o = m.orders;
   const Poly cf = polyMultiply(m.c, m.f);
@@ -189,6 +198,7 @@ void errorsAndPsi(const PolynomialModel& m, const Eigen::VectorXd& u, const Eige
     const Eigen::VectorXd wf = filter(m.d, cf, w);
     for (int k = 1; k <= o.nf; ++k) psi->col(col++) = -delayed(wf, k);
   }
+  psi->topRows(n0).setZero();
 }
 
 bool stabilize(PolynomialModel& m) {
@@ -282,6 +292,19 @@ PolynomialModel initialModel(const Eigen::VectorXd& u, const Eigen::VectorXd& y,
         y.tail(n - first));
     if (th.size()) m.setParameterVector(th);
     reflectIntoUnitCircle(m.c);
+    // The plain ARX estimate (C = 1) is a candidate too: on nearly noise-free data the
+    // estimated innovations are poor and the ARX start is the better one.
+    PolynomialModel plain = PolynomialModel::zero(s, o, ts);
+    const PolyEstimate a0 = arx(u, y, o.na, o.nb, o.nk, ts);
+    if (a0.summary.ok()) {
+      plain.a = a0.model.a;
+      plain.b = a0.model.b;
+      Eigen::VectorXd em, ep;
+      errorsAndPsi(m, u, y, em, nullptr);
+      errorsAndPsi(plain, u, y, ep, nullptr);
+      const double lm = em.squaredNorm(), lp = ep.squaredNorm();
+      if (!(lm <= lp)) return plain;
+    }
     return m;
   }
   oeInit(u, y, m);
@@ -312,7 +335,7 @@ Eigen::VectorXd predictionErrors(const PolynomialModel& m, const Eigen::VectorXd
                                  const Eigen::VectorXd& y) {
   checkData(u, y);
   Eigen::VectorXd eps;
-  errorsAndPsi(m, u, y, eps, nullptr);
+  errorsAndPsi(m, u, y, eps, nullptr, false);
   return eps;
 }
 
@@ -408,11 +431,12 @@ PolyEstimate refinePolynomial(const Eigen::VectorXd& u, const Eigen::VectorXd& y
   s = sol.summary;
   if (s.termination == Termination::Failed) return r;
   r.model.setParameterVector(sol.phi);
-  r.model.noiseVariance = sol.sumSquares / static_cast<double>(n - p);
-  r.model.covariance = gaussNewtonCovariance(sol.psi, sol.sumSquares);
+  const Eigen::Index used = n - std::min<Eigen::Index>(criterionStart(initial.orders), n);
+  r.model.noiseVariance = sol.sumSquares / static_cast<double>(used - p);
+  r.model.covariance = gaussNewtonCovariance(sol.psi.bottomRows(used), sol.sumSquares);
   if (r.model.covariance.size() == 0)
     s.message += "; the Hessian is singular, so no covariance (the model is over-parameterized)";
-  fillStatistics(s, sol.sumSquares, n, p);
+  fillStatistics(s, sol.sumSquares, used, p);
   s.seconds = since(t0);
   return r;
 }
