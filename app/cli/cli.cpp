@@ -12,6 +12,9 @@ const std::vector<Verb>& verbs() {
       {"model", "physical model: matrices, poles, zeros, notch and peak frequencies", runModel},
       {"simulate", "closed-loop simulation of a model with effects; writes a log and its truth",
        runSimulate},
+      {"fit", "estimate ARX/ARMAX/OE/BJ or physical models with std, fit %, notches, peaks",
+       runFit},
+      {"bode", "frequency response of a fitted model or SPA/ETFE with bands, to CSV", runBode},
   };
   return kVerbs;
 }

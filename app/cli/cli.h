@@ -66,5 +66,7 @@ int runInfo(const std::vector<std::string>& args, std::ostream& out, std::ostrea
 int runPreprocess(const std::vector<std::string>& args, std::ostream& out, std::ostream& err);
 int runModel(const std::vector<std::string>& args, std::ostream& out, std::ostream& err);
 int runSimulate(const std::vector<std::string>& args, std::ostream& out, std::ostream& err);
+int runFit(const std::vector<std::string>& args, std::ostream& out, std::ostream& err);
+int runBode(const std::vector<std::string>& args, std::ostream& out, std::ostream& err);
 
 }  // namespace flexarm::cli

@@ -1,0 +1,478 @@
+#include "core/ident/blackbox.h"
+
+#include "core/ident/levenberg_marquardt.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <sstream>
+#include <stdexcept>
+
+namespace flexarm {
+
+const char* toString(PolyStructure s) {
+  switch (s) {
+    case PolyStructure::Arx: return "arx";
+    case PolyStructure::Armax: return "armax";
+    case PolyStructure::Oe: return "oe";
+    case PolyStructure::Bj: return "bj";
+  }
+  return "arx";
+}
+
+std::optional<PolyStructure> polyStructureFromString(std::string_view s) {
+  for (auto v : {PolyStructure::Arx, PolyStructure::Armax, PolyStructure::Oe, PolyStructure::Bj})
+    if (s == toString(v)) return v;
+  return std::nullopt;
+}
+
+bool PolyOrders::isValid(std::string* why) const {
+  auto fail = [&](const char* text) {
+    if (why) *why = text;
+    return false;
+  };
+  if (na < 0 || nb < 0 || nc < 0 || nd < 0 || nf < 0) return fail("orders must not be negative");
+  if (nb < 1) return fail("nb must be at least 1");
+  if (nk < 0) return fail("the delay nk must not be negative");
+  if (parameters() > 2000) return fail("more than 2000 parameters");
+  return true;
+}
+
+bool PolyEstimateOptions::isValid(std::string* why) const {
+  if (maxIterations < 0 || !(relativeTolerance > 0.0) || !(initialDamping > 0.0)) {
+    if (why) *why = "maxIterations >= 0, relativeTolerance > 0 and initialDamping > 0 required";
+    return false;
+  }
+  return true;
+}
+
+std::string PolynomialModel::name() const {
+  std::ostringstream s;
+  s << toString(structure) << "[";
+  const auto& o = orders;
+  switch (structure) {
+    case PolyStructure::Arx: s << o.na << " " << o.nb << " " << o.nk; break;
+    case PolyStructure::Armax: s << o.na << " " << o.nb << " " << o.nc << " " << o.nk; break;
+    case PolyStructure::Oe: s << o.nb << " " << o.nf << " " << o.nk; break;
+    case PolyStructure::Bj:
+      s << o.nb << " " << o.nc << " " << o.nd << " " << o.nf << " " << o.nk;
+      break;
+  }
+  s << "]";
+  return s.str();
+}
+
+PolynomialModel PolynomialModel::zero(PolyStructure s, const PolyOrders& o, double ts) {
+  std::string why;
+  if (!o.isValid(&why)) throw std::invalid_argument("PolynomialModel: " + why);
+  PolynomialModel m;
+  m.structure = s;
+  m.orders = o;
+  m.sampleTime = ts;
+  m.a.assign(o.na + 1, 0.0);
+  m.a[0] = 1.0;
+  m.b.assign(o.nk + o.nb, 0.0);
+  m.c.assign(o.nc + 1, 0.0);
+  m.c[0] = 1.0;
+  m.d.assign(o.nd + 1, 0.0);
+  m.d[0] = 1.0;
+  m.f.assign(o.nf + 1, 0.0);
+  m.f[0] = 1.0;
+  return m;
+}
+
+Eigen::VectorXd PolynomialModel::parameterVector() const {
+  Eigen::VectorXd th(orders.parameters());
+  int i = 0;
+  for (int k = 1; k <= orders.na; ++k) th[i++] = a[k];
+  for (int k = 0; k < orders.nb; ++k) th[i++] = b[orders.nk + k];
+  for (int k = 1; k <= orders.nc; ++k) th[i++] = c[k];
+  for (int k = 1; k <= orders.nd; ++k) th[i++] = d[k];
+  for (int k = 1; k <= orders.nf; ++k) th[i++] = f[k];
+  return th;
+}
+
+void PolynomialModel::setParameterVector(const Eigen::VectorXd& th) {
+  if (th.size() != orders.parameters())
+    throw std::invalid_argument("PolynomialModel: parameter vector of the wrong length");
+  int i = 0;
+  for (int k = 1; k <= orders.na; ++k) a[k] = th[i++];
+  for (int k = 0; k < orders.nb; ++k) b[orders.nk + k] = th[i++];
+  for (int k = 1; k <= orders.nc; ++k) c[k] = th[i++];
+  for (int k = 1; k <= orders.nd; ++k) d[k] = th[i++];
+  for (int k = 1; k <= orders.nf; ++k) f[k] = th[i++];
+}
+
+std::vector<std::string> PolynomialModel::parameterNames() const {
+  std::vector<std::string> n;
+  auto add = [&](const char* p, int count) {
+    for (int k = 1; k <= count; ++k) n.push_back(p + std::to_string(k));
+  };
+  add("a", orders.na);
+  add("b", orders.nb);
+  add("c", orders.nc);
+  add("d", orders.nd);
+  add("f", orders.nf);
+  return n;
+}
+
+Eigen::VectorXd PolynomialModel::standardDeviations() const {
+  if (covariance.size() == 0) return {};
+  return covariance.diagonal().cwiseMax(0.0).cwiseSqrt();
+}
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double since(Clock::time_point t0) {
+  return std::chrono::duration<double>(Clock::now() - t0).count();
+}
+
+void checkData(const Eigen::VectorXd& u, const Eigen::VectorXd& y) {
+  if (u.size() != y.size())
+    throw std::invalid_argument("input and output must have the same number of samples");
+}
+
+// Regression matrix whose columns are sign * signal(t - lag), rows t = first..N-1.
+struct Block {
+  const Eigen::VectorXd* signal;
+  double sign;
+  int firstLag;
+  int count;
+};
+
+Eigen::MatrixXd regressors(const std::vector<Block>& blocks, Eigen::Index first, Eigen::Index n) {
+  int cols = 0;
+  for (const auto& b : blocks) cols += b.count;
+  Eigen::MatrixXd phi(n - first, cols);
+  int c = 0;
+  for (const auto& b : blocks)
+    for (int j = 0; j < b.count; ++j, ++c) {
+      const int lag = b.firstLag + j;
+      for (Eigen::Index t = first; t < n; ++t)
+        phi(t - first, c) = t - lag >= 0 ? b.sign * (*b.signal)[t - lag] : 0.0;
+    }
+  return phi;
+}
+
+
+int criterionStart(const PolyOrders& o) {
+  return std::max({o.na, o.nb + o.nk - 1, o.nc, o.nd, o.nf});
+}
+
+// psi (4.20) = -d eps / d theta for the general structure (4.8), obtained by filtering.
+void errorsAndPsi(const PolynomialModel& m, const Eigen::VectorXd& u, const Eigen::VectorXd& y,
+                  Eigen::VectorXd& eps, Eigen::MatrixXd* psi, bool skipStart = true) {
+  const Poly one{1.0};
+  const Eigen::VectorXd ay = m.orders.na ? filter(m.a, one, y) : y;
+  const Eigen::VectorXd w = filter(m.b, m.f, u);
+  const Eigen::VectorXd v = ay - w;
+  eps = filter(m.d, m.c, v);
+  // The criterion starts once every regressor holds data (as ARX does): the zero initial
+  // conditions would otherwise dominate the loss of a nearly noise-free system.
+  const Eigen::Index n0 =
+      skipStart ? std::min<Eigen::Index>(criterionStart(m.orders), y.size()) : 0;
+  eps.head(n0).setZero();
+  if (!psi) return;
+  const auto& o = m.orders;
+  const Poly cf = polyMultiply(m.c, m.f);
+  psi->resize(y.size(), o.parameters());
+  int col = 0;
+  if (o.na) {
+    const Eigen::VectorXd yf = filter(m.d, m.c, y);
+    for (int k = 1; k <= o.na; ++k) psi->col(col++) = -delayed(yf, k);
+  }
+  {
+    const Eigen::VectorXd uf = filter(m.d, cf, u);
+    for (int j = 0; j < o.nb; ++j) psi->col(col++) = delayed(uf, o.nk + j);
+  }
+  if (o.nc) {
+    const Eigen::VectorXd ef = filter(one, m.c, eps);
+    for (int k = 1; k <= o.nc; ++k) psi->col(col++) = delayed(ef, k);
+  }
+  if (o.nd) {
+    const Eigen::VectorXd vf = filter(one, m.c, v);
+    for (int k = 1; k <= o.nd; ++k) psi->col(col++) = -delayed(vf, k);
+  }
+  if (o.nf) {
+    const Eigen::VectorXd wf = filter(m.d, cf, w);
+    for (int k = 1; k <= o.nf; ++k) psi->col(col++) = -delayed(wf, k);
+  }
+  psi->topRows(n0).setZero();
+}
+
+bool stabilize(PolynomialModel& m) {
+  bool changed = false;
+  changed |= reflectIntoUnitCircle(m.c);
+  changed |= reflectIntoUnitCircle(m.d);
+  changed |= reflectIntoUnitCircle(m.f);
+  return changed;
+}
+
+double oeLoss(const PolynomialModel& m, const Eigen::VectorXd& u, const Eigen::VectorXd& y) {
+  return (y - filter(m.b, m.f, u)).squaredNorm();
+}
+
+// Least squares on regressors via column-pivoting QR; empty when rank deficient.
+Eigen::VectorXd leastSquares(const Eigen::MatrixXd& phi, const Eigen::VectorXd& rhs) {
+  Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(phi);
+  if (qr.rank() < phi.cols()) return {};
+  return qr.solve(rhs);
+}
+
+// Noise model C/D of an ARMA process v by Hannan-Rissanen: a long AR model gives estimates of
+// e, then D v = C e is solved by least squares.
+void armaInit(const Eigen::VectorXd& v, PolynomialModel& m) {
+  const int nc = m.orders.nc, nd = m.orders.nd;
+  if (nc == 0 && nd == 0) return;
+  const Eigen::Index n = v.size();
+  const int nh = static_cast<int>(std::min<Eigen::Index>(std::max(20, 3 * (nc + nd)), n / 10));
+  Eigen::VectorXd ehat = v;
+  if (nh > 0) {
+    Eigen::VectorXd th = leastSquares(regressors({{&v, -1.0, 1, nh}}, nh, n), v.tail(n - nh));
+    if (th.size()) {
+      Poly ar(nh + 1, 1.0);
+      for (int k = 0; k < nh; ++k) ar[k + 1] = th[k];
+      ehat = filter(ar, {1.0}, v);
+    }
+  }
+  const int first = std::max({nc, nd, nh});
+  Eigen::VectorXd th = leastSquares(regressors({{&v, -1.0, 1, nd}, {&ehat, 1.0, 1, nc}}, first, n),
+                                    v.tail(n - first));
+  if (!th.size()) return;
+  for (int k = 0; k < nd; ++k) m.d[k + 1] = th[k];
+  for (int k = 0; k < nc; ++k) m.c[k + 1] = th[nd + k];
+}
+
+// B/F from ARX followed by instrumental variables with the ARX simulation as instruments.
+void oeInit(const Eigen::VectorXd& u, const Eigen::VectorXd& y, PolynomialModel& m) {
+  const auto& o = m.orders;
+  PolyEstimate a0 = arx(u, y, o.nf, o.nb, o.nk, m.sampleTime);
+  PolynomialModel best = m;
+  for (int k = 1; k <= o.nf; ++k) best.f[k] = a0.model.a[k];
+  for (int j = 0; j < o.nb; ++j) best.b[o.nk + j] = a0.model.b[o.nk + j];
+  reflectIntoUnitCircle(best.f);
+  double bestLoss = oeLoss(best, u, y);
+  PolynomialModel cur = best;
+  const Eigen::Index n = y.size();
+  const int first = std::max(o.nf, o.nb + o.nk - 1);
+  for (int iter = 0; iter < 3; ++iter) {
+    const Eigen::VectorXd x = filter(cur.b, cur.f, u);
+    const Eigen::MatrixXd phi =
+        regressors({{&y, -1.0, 1, o.nf}, {&u, 1.0, o.nk, o.nb}}, first, n);
+    const Eigen::MatrixXd zeta =
+        regressors({{&x, -1.0, 1, o.nf}, {&u, 1.0, o.nk, o.nb}}, first, n);
+    Eigen::VectorXd th = leastSquares(zeta.transpose() * phi, zeta.transpose() * y.tail(n - first));
+    if (!th.size() || !th.allFinite()) break;
+    for (int k = 0; k < o.nf; ++k) cur.f[k + 1] = th[k];
+    for (int j = 0; j < o.nb; ++j) cur.b[o.nk + j] = th[o.nf + j];
+    reflectIntoUnitCircle(cur.f);
+    const double l = oeLoss(cur, u, y);
+    if (std::isfinite(l) && l < bestLoss) {
+      bestLoss = l;
+      best = cur;
+    }
+  }
+  m.b = best.b;
+  m.f = best.f;
+}
+
+PolynomialModel initialModel(const Eigen::VectorXd& u, const Eigen::VectorXd& y,
+                             PolyStructure s, const PolyOrders& o, double ts) {
+  PolynomialModel m = PolynomialModel::zero(s, o, ts);
+  const Eigen::Index n = y.size();
+  if (s == PolyStructure::Armax) {
+    const int nh = static_cast<int>(
+        std::min<Eigen::Index>(std::max(20, 2 * (o.na + o.nc + o.nb)), n / 10));
+    PolyEstimate high = arx(u, y, nh, nh, o.nk, ts);
+    const Eigen::VectorXd ehat = predictionErrors(high.model, u, y);
+    const int first = std::max({o.na, o.nb + o.nk - 1, o.nc, nh});
+    Eigen::VectorXd th = leastSquares(
+        regressors({{&y, -1.0, 1, o.na}, {&u, 1.0, o.nk, o.nb}, {&ehat, 1.0, 1, o.nc}}, first, n),
+        y.tail(n - first));
+    if (th.size()) m.setParameterVector(th);
+    reflectIntoUnitCircle(m.c);
+    // The plain ARX estimate (C = 1) is a candidate too: on nearly noise-free data the
+    // estimated innovations are poor and the ARX start is the better one.
+    PolynomialModel plain = PolynomialModel::zero(s, o, ts);
+    const PolyEstimate a0 = arx(u, y, o.na, o.nb, o.nk, ts);
+    if (a0.summary.ok()) {
+      plain.a = a0.model.a;
+      plain.b = a0.model.b;
+      Eigen::VectorXd em, ep;
+      errorsAndPsi(m, u, y, em, nullptr);
+      errorsAndPsi(plain, u, y, ep, nullptr);
+      const double lm = em.squaredNorm(), lp = ep.squaredNorm();
+      if (!(lm <= lp)) return plain;
+    }
+    return m;
+  }
+  oeInit(u, y, m);
+  if (s == PolyStructure::Bj && (o.nc > 0 || o.nd > 0)) {
+    // Refine B/F as an output-error model first, then model its residual as ARMA.
+    PolynomialModel oem = PolynomialModel::zero(PolyStructure::Oe, o, ts);
+    oem.orders.nc = oem.orders.nd = 0;
+    oem.c = oem.d = Poly{1.0};
+    oem.b = m.b;
+    oem.f = m.f;
+    PolyEstimateOptions opt;
+    opt.maxIterations = 30;
+    PolyEstimate r = refinePolynomial(u, y, oem, opt);
+    if (r.summary.ok()) {
+      m.b = r.model.b;
+      m.f = r.model.f;
+    }
+    armaInit(y - filter(m.b, m.f, u), m);
+    reflectIntoUnitCircle(m.c);
+    reflectIntoUnitCircle(m.d);
+  }
+  return m;
+}
+
+}  // namespace
+
+Eigen::VectorXd predictionErrors(const PolynomialModel& m, const Eigen::VectorXd& u,
+                                 const Eigen::VectorXd& y) {
+  checkData(u, y);
+  Eigen::VectorXd eps;
+  errorsAndPsi(m, u, y, eps, nullptr, false);
+  return eps;
+}
+
+PolyEstimate arx(const Eigen::VectorXd& u, const Eigen::VectorXd& y, int na, int nb, int nk,
+                 double sampleTime) {
+  checkData(u, y);
+  PolyOrders o;
+  o.na = na;
+  o.nb = nb;
+  o.nk = nk;
+  std::string why;
+  if (!o.isValid(&why)) throw std::invalid_argument("arx: " + why);
+  const auto t0 = Clock::now();
+  PolyEstimate r;
+  r.model = PolynomialModel::zero(PolyStructure::Arx, o, sampleTime);
+  const Eigen::Index n = y.size();
+  const int first = std::max(na, nb + nk - 1);
+  const int p = o.parameters();
+  if (n - first <= p) {
+    r.summary.message = "too few samples (" + std::to_string(n) + ") for " +
+                        std::to_string(p) + " parameters";
+    return r;
+  }
+  if (!u.allFinite() || !y.allFinite()) {
+    r.summary.message = "the data contain NaN or infinite values";
+    return r;
+  }
+  const Eigen::MatrixXd phi = regressors({{&y, -1.0, 1, na}, {&u, 1.0, nk, nb}}, first, n);
+  const Eigen::VectorXd rhs = y.tail(n - first);
+  Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(phi);
+  if (qr.rank() < p) {
+    r.summary.message = "the regressors are rank deficient (rank " + std::to_string(qr.rank()) +
+                        " of " + std::to_string(p) + "): the input is not exciting enough";
+    r.summary.seconds = since(t0);
+    return r;
+  }
+  const Eigen::VectorXd th = qr.solve(rhs);
+  r.model.setParameterVector(th);
+  const Eigen::VectorXd res = rhs - phi * th;
+  const double sumSq = res.squaredNorm();
+  const Eigen::Index m = n - first;
+  r.model.noiseVariance = sumSq / static_cast<double>(m - p);
+  // (Phi^T Phi)^{-1} = P R^{-1} R^{-T} P^T from the QR factors.
+  const Eigen::MatrixXd R = qr.matrixR().topLeftCorner(p, p).template triangularView<Eigen::Upper>();
+  const Eigen::MatrixXd Rinv = R.triangularView<Eigen::Upper>().solve(Eigen::MatrixXd::Identity(p, p));
+  const Eigen::MatrixXd inner = Rinv * Rinv.transpose();
+  const auto& perm = qr.colsPermutation();
+  r.model.covariance = r.model.noiseVariance * (perm * inner * perm.transpose());
+  fillStatistics(r.summary, sumSq, m, p);
+  r.summary.termination = Termination::Converged;
+  r.summary.message = "least squares solution";
+  r.summary.lossHistory = {r.summary.loss};
+  r.summary.seconds = since(t0);
+  return r;
+}
+
+PolyEstimate refinePolynomial(const Eigen::VectorXd& u, const Eigen::VectorXd& y,
+                              const PolynomialModel& initial, const PolyEstimateOptions& options,
+                              const ProgressCallback& progress) {
+  checkData(u, y);
+  std::string why;
+  if (!options.isValid(&why)) throw std::invalid_argument("refinePolynomial: " + why);
+  const auto t0 = Clock::now();
+  PolyEstimate r;
+  r.model = initial;
+  auto& s = r.summary;
+  const Eigen::Index n = y.size();
+  const int p = initial.orders.parameters();
+  if (n <= 2 * p) {
+    s.message = "too few samples (" + std::to_string(n) + ") for " + std::to_string(p) +
+                " parameters";
+    return r;
+  }
+  if (!u.allFinite() || !y.allFinite()) {
+    s.message = "the data contain NaN or infinite values";
+    return r;
+  }
+  PolynomialModel work = initial;
+  LeastSquaresProblem problem;
+  problem.evaluate = [&](const Eigen::VectorXd& th, Eigen::VectorXd& eps, Eigen::MatrixXd* psi) {
+    work.setParameterVector(th);
+    errorsAndPsi(work, u, y, eps, psi);
+    return true;
+  };
+  if (options.enforceStability)
+    problem.project = [&](Eigen::VectorXd& th) {
+      work.setParameterVector(th);
+      if (stabilize(work)) th = work.parameterVector();
+    };
+  LeastSquaresSolution sol = levenbergMarquardt(problem, initial.parameterVector(),
+                                                options.maxIterations, options.relativeTolerance,
+                                                options.initialDamping, progress);
+  s = sol.summary;
+  if (s.termination == Termination::Failed) return r;
+  r.model.setParameterVector(sol.phi);
+  const Eigen::Index used = n - std::min<Eigen::Index>(criterionStart(initial.orders), n);
+  r.model.noiseVariance = sol.sumSquares / static_cast<double>(used - p);
+  r.model.covariance = gaussNewtonCovariance(sol.psi.bottomRows(used), sol.sumSquares);
+  if (r.model.covariance.size() == 0)
+    s.message += "; the Hessian is singular, so no covariance (the model is over-parameterized)";
+  fillStatistics(s, sol.sumSquares, used, p);
+  s.seconds = since(t0);
+  return r;
+}
+
+PolyEstimate estimatePolynomial(const Eigen::VectorXd& u, const Eigen::VectorXd& y,
+                                PolyStructure structure, const PolyOrders& orders0,
+                                double sampleTime, const PolyEstimateOptions& options,
+                                const ProgressCallback& progress) {
+  checkData(u, y);
+  PolyOrders o = orders0;
+  // The structure decides which polynomials exist.
+  if (structure == PolyStructure::Arx) o.nc = o.nd = o.nf = 0;
+  if (structure == PolyStructure::Armax) o.nd = o.nf = 0;
+  if (structure == PolyStructure::Oe) o.na = o.nc = o.nd = 0;
+  if (structure == PolyStructure::Bj) o.na = 0;
+  std::string why;
+  if (!o.isValid(&why)) throw std::invalid_argument(std::string(toString(structure)) + ": " + why);
+  const auto t0 = Clock::now();
+  if (structure == PolyStructure::Arx) return arx(u, y, o.na, o.nb, o.nk, sampleTime);
+  if (y.size() <= 2 * o.parameters() + 20) {
+    PolyEstimate r;
+    r.model = PolynomialModel::zero(structure, o, sampleTime);
+    r.summary.message = "too few samples (" + std::to_string(y.size()) + ") for " +
+                        std::to_string(o.parameters()) + " parameters";
+    return r;
+  }
+  if (!u.allFinite() || !y.allFinite()) {
+    PolyEstimate r;
+    r.model = PolynomialModel::zero(structure, o, sampleTime);
+    r.summary.message = "the data contain NaN or infinite values";
+    return r;
+  }
+  PolyEstimate r = refinePolynomial(u, y, initialModel(u, y, structure, o, sampleTime), options,
+                                    progress);
+  r.summary.seconds = since(t0);
+  return r;
+}
+
+}  // namespace flexarm

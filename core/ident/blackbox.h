@@ -1,0 +1,118 @@
+#pragma once
+// Black-box models of the general structure (4.8), A y = B/F u + C/D e, and their estimation
+// by prediction error: ARX by least squares via QR (4.13)-(4.16); ARMAX, OE and Box-Jenkins
+// by damped Gauss-Newton / Levenberg-Marquardt (4.17)-(4.21) with psi (4.20) from filtering.
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include <Eigen/Dense>
+
+#include "core/common/progress.h"
+#include "core/ident/polynomial.h"
+
+namespace flexarm {
+
+enum class PolyStructure { Arx, Armax, Oe, Bj };
+const char* toString(PolyStructure s);
+std::optional<PolyStructure> polyStructureFromString(std::string_view s);
+
+// Orders of (4.8): na, nb, nc, nd, nf and the delay nk (B = b1 q^{-nk} + ... (4.10)).
+struct PolyOrders {
+  int na = 0, nb = 1, nc = 0, nd = 0, nf = 0, nk = 1;
+  int parameters() const { return na + nb + nc + nd + nf; }
+  bool isValid(std::string* why) const;
+};
+
+// One estimated polynomial model (4.8) with its parameter covariance. The parameter vector is
+// [a1..a_na b1..b_nb c1..c_nc d1..d_nd f1..f_nf].
+struct PolynomialModel {
+  PolyStructure structure = PolyStructure::Arx;
+  PolyOrders orders;
+  Poly a{1.0}, b{0.0}, c{1.0}, d{1.0}, f{1.0};  // b holds nk leading zeros
+  double sampleTime = 1.0;
+  double noiseVariance = 0.0;  // lambda, variance of e
+  Eigen::MatrixXd covariance;  // of the parameter vector; empty when unknown
+
+  // Short name such as "bj[5 5 5 5 1]".
+  std::string name() const;
+  Eigen::VectorXd parameterVector() const;
+  void setParameterVector(const Eigen::VectorXd& theta);
+  std::vector<std::string> parameterNames() const;
+  // Standard deviations (square roots of the covariance diagonal), empty when unknown.
+  Eigen::VectorXd standardDeviations() const;
+  // A model of the given structure and orders with all parameters zero.
+  static PolynomialModel zero(PolyStructure s, const PolyOrders& o, double sampleTime);
+};
+
+// How an iterative estimate ended, with its statistics.
+struct EstimateSummary {
+  Termination termination = Termination::Failed;
+  std::string message;
+  int iterations = 0;
+  double seconds = 0.0;
+  double loss = 0.0;  // V_N (4.6): mean squared one-step prediction error
+  double fpe = 0.0;   // Akaike's final prediction error V (1 + p/N) / (1 - p/N)
+  double aic = 0.0;   // N log V + 2 p
+  std::vector<double> lossHistory;
+  bool ok() const {
+    return termination == Termination::Converged || termination == Termination::MaxIterations;
+  }
+};
+
+struct PolyEstimate {
+  PolynomialModel model;
+  EstimateSummary summary;
+};
+
+struct PolyEstimateOptions {
+  int maxIterations = 100;
+  double relativeTolerance = 1e-7;   // stop when the loss improves by less than this fraction
+  double initialDamping = 1e-3;      // Levenberg-Marquardt lambda relative to diag(R) (4.21)
+  bool enforceStability = true;      // reflect roots of C, D, F into the unit circle
+  bool isValid(std::string* why) const;
+};
+
+// ARX by least squares via QR (4.16); any orders (very high order included). u, y equal length.
+PolyEstimate arx(const Eigen::VectorXd& u, const Eigen::VectorXd& y, int na, int nb, int nk,
+                 double sampleTime = 1.0);
+
+// Prediction-error estimate of any structure (4.8) by Levenberg-Marquardt (4.17)-(4.21), started
+// from SITB-like initial values (ARX, instrumental variables, Hannan-Rissanen for the noise).
+PolyEstimate estimatePolynomial(const Eigen::VectorXd& u, const Eigen::VectorXd& y,
+                                PolyStructure structure, const PolyOrders& orders,
+                                double sampleTime = 1.0, const PolyEstimateOptions& options = {},
+                                const ProgressCallback& progress = {});
+
+// Prediction-error estimate from a given initial model (its structure and orders are kept).
+PolyEstimate refinePolynomial(const Eigen::VectorXd& u, const Eigen::VectorXd& y,
+                              const PolynomialModel& initial,
+                              const PolyEstimateOptions& options = {},
+                              const ProgressCallback& progress = {});
+
+inline PolyEstimate armax(const Eigen::VectorXd& u, const Eigen::VectorXd& y, int na, int nb,
+                          int nc, int nk, double ts = 1.0, const PolyEstimateOptions& o = {}) {
+  PolyOrders ord;
+  ord.na = na; ord.nb = nb; ord.nc = nc; ord.nk = nk;
+  return estimatePolynomial(u, y, PolyStructure::Armax, ord, ts, o);
+}
+inline PolyEstimate oe(const Eigen::VectorXd& u, const Eigen::VectorXd& y, int nb, int nf,
+                       int nk, double ts = 1.0, const PolyEstimateOptions& o = {}) {
+  PolyOrders ord;
+  ord.nb = nb; ord.nf = nf; ord.nk = nk;
+  return estimatePolynomial(u, y, PolyStructure::Oe, ord, ts, o);
+}
+inline PolyEstimate bj(const Eigen::VectorXd& u, const Eigen::VectorXd& y, int nb, int nc,
+                       int nd, int nf, int nk, double ts = 1.0,
+                       const PolyEstimateOptions& o = {}) {
+  PolyOrders ord;
+  ord.nb = nb; ord.nc = nc; ord.nd = nd; ord.nf = nf; ord.nk = nk;
+  return estimatePolynomial(u, y, PolyStructure::Bj, ord, ts, o);
+}
+
+// One-step prediction errors eps (4.5)-(4.6) of a polynomial model on data.
+Eigen::VectorXd predictionErrors(const PolynomialModel& m, const Eigen::VectorXd& u,
+                                 const Eigen::VectorXd& y);
+
+}  // namespace flexarm

@@ -1,0 +1,206 @@
+#include "core/ident/evaluation.h"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+namespace flexarm {
+
+Eigen::VectorXd simulate(const PolynomialModel& m, const Eigen::VectorXd& u) {
+  return filter(m.b, polyMultiply(m.a, m.f), u);
+}
+
+Eigen::VectorXd predict(const PolynomialModel& m, const Eigen::VectorXd& u,
+                        const Eigen::VectorXd& y, int k) {
+  if (u.size() != y.size())
+    throw std::invalid_argument("predict: input and output must have the same length");
+  if (k <= 0) return simulate(m, u);
+  // H = C/(D A); Hbar_k = first k impulse-response coefficients of H; the k-step predictor is
+  // Hbar_k H^{-1} G u + (1 - Hbar_k H^{-1}) y with H^{-1} G = D B / (C F).
+  Eigen::VectorXd imp = Eigen::VectorXd::Zero(k);
+  imp[0] = 1.0;
+  const Eigen::VectorXd h = filter(m.c, polyMultiply(m.d, m.a), imp);
+  Poly hbar(h.data(), h.data() + k);
+  const Poly num = polyMultiply(hbar, m.d);
+  const Eigen::VectorXd gu = filter(m.b, m.f, u);
+  return filter(num, m.c, gu) + y - filter(polyMultiply(num, m.a), m.c, y);
+}
+
+double fitPercent(const Eigen::VectorXd& y, const Eigen::VectorXd& yhat, Eigen::Index begin,
+                  Eigen::Index end) {
+  if (y.size() != yhat.size())
+    throw std::invalid_argument("fitPercent: signals of different length");
+  if (end == 0) end = y.size();
+  if (begin < 0 || end > y.size() || end - begin < 2)
+    throw std::invalid_argument("fitPercent: range outside the data or shorter than 2 samples");
+  const auto ys = y.segment(begin, end - begin);
+  const auto es = ys - yhat.segment(begin, end - begin);
+  const double den = (ys.array() - ys.mean()).square().sum();
+  if (!(den > 0.0)) return -INFINITY;
+  return (1.0 - es.squaredNorm() / den) * 100.0;
+}
+
+double twoSidedNormalQuantile(double level) {
+  if (!(level > 0.0 && level < 1.0))
+    throw std::invalid_argument("confidence level must lie strictly between 0 and 1");
+  // Bisection on erf(z / sqrt 2) = level.
+  double lo = 0.0, hi = 40.0;
+  for (int i = 0; i < 200; ++i) {
+    const double mid = 0.5 * (lo + hi);
+    (std::erf(mid / std::sqrt(2.0)) < level ? lo : hi) = mid;
+  }
+  return 0.5 * (lo + hi);
+}
+
+std::vector<double> logGrid(double wMin, double wMax, int n) {
+  if (!(wMin > 0.0) || !(wMax > wMin) || n < 2)
+    throw std::invalid_argument("logGrid: need 0 < wMin < wMax and n >= 2");
+  std::vector<double> w(n);
+  for (int i = 0; i < n; ++i)
+    w[i] = wMin * std::pow(wMax / wMin, static_cast<double>(i) / (n - 1));
+  return w;
+}
+
+void finishFrequencyResponse(FrequencyResponse& r, const std::vector<Eigen::Matrix2d>& cov) {
+  const std::size_t n = r.value.size();
+  r.magnitude.resize(n);
+  r.phase.resize(n);
+  double offset = 0.0;
+  for (std::size_t i = 0; i < n; ++i) {
+    r.magnitude[i] = std::abs(r.value[i]);
+    double ph = std::arg(r.value[i]) + offset;
+    if (i > 0) {
+      while (ph - r.phase[i - 1] > M_PI) { ph -= 2 * M_PI; offset -= 2 * M_PI; }
+      while (ph - r.phase[i - 1] < -M_PI) { ph += 2 * M_PI; offset += 2 * M_PI; }
+    }
+    r.phase[i] = ph;
+  }
+  r.magnitudeStd.clear();
+  r.phaseStd.clear();
+  r.magnitudeLower.clear();
+  r.magnitudeUpper.clear();
+  r.phaseLower.clear();
+  r.phaseUpper.clear();
+  if (cov.empty()) return;
+  const double z = twoSidedNormalQuantile(r.level);
+  for (std::size_t i = 0; i < n; ++i) {
+    const double re = r.value[i].real(), im = r.value[i].imag();
+    const double mag = std::max(r.magnitude[i], 1e-300);
+    // d|G| = (re dRe + im dIm)/|G|, dphase = (re dIm - im dRe)/|G|^2.
+    const Eigen::Vector2d jm(re / mag, im / mag);
+    const Eigen::Vector2d jp(-im / (mag * mag), re / (mag * mag));
+    const double sm = std::sqrt(std::max(0.0, jm.dot(cov[i] * jm)));
+    const double sp = std::sqrt(std::max(0.0, jp.dot(cov[i] * jp)));
+    r.magnitudeStd.push_back(sm);
+    r.phaseStd.push_back(sp);
+    r.magnitudeLower.push_back(std::max(0.0, r.magnitude[i] - z * sm));
+    r.magnitudeUpper.push_back(r.magnitude[i] + z * sm);
+    r.phaseLower.push_back(r.phase[i] - z * sp);
+    r.phaseUpper.push_back(r.phase[i] + z * sp);
+  }
+}
+
+FrequencyResponse frequencyResponse(const PolynomialModel& m, const std::vector<double>& omega,
+                                    double level) {
+  FrequencyResponse r;
+  r.omega = omega;
+  r.level = level;
+  twoSidedNormalQuantile(level);
+  const auto& o = m.orders;
+  const int p = o.parameters();
+  const bool bands = m.covariance.rows() == p && p > 0;
+  std::vector<Eigen::Matrix2d> cov;
+  for (double w : omega) {
+    const double wt = w * m.sampleTime;
+    const std::complex<double> A = polyEval(m.a, wt), B = polyEval(m.b, wt),
+                               F = polyEval(m.f, wt);
+    const std::complex<double> G = B / (A * F);
+    r.value.push_back(G);
+    if (!bands) continue;
+    // dG/dtheta: a_k -> -G z^-k / A; b_j -> z^-(nk+j) / (A F); f_k -> -G z^-k / F.
+    Eigen::MatrixXd J = Eigen::MatrixXd::Zero(2, p);
+    int col = 0;
+    auto put = [&](std::complex<double> d) {
+      J(0, col) = d.real();
+      J(1, col) = d.imag();
+      ++col;
+    };
+    auto zk = [&](int k) { return std::polar(1.0, -wt * k); };
+    for (int k = 1; k <= o.na; ++k) put(-G * zk(k) / A);
+    for (int j = 0; j < o.nb; ++j) put(zk(o.nk + j) / (A * F));
+    col += o.nc + o.nd;
+    for (int k = 1; k <= o.nf; ++k) put(-G * zk(k) / F);
+    cov.push_back(J * m.covariance * J.transpose());
+  }
+  finishFrequencyResponse(r, cov);
+  return r;
+}
+
+std::vector<std::complex<double>> poles(const PolynomialModel& m) {
+  return polyRoots(polyMultiply(m.a, m.f));
+}
+
+std::vector<std::complex<double>> zeros(const PolynomialModel& m) { return polyRoots(m.b); }
+
+NotchesPeaks notchesAndPeaks(const FrequencyResponse& r, double minDepthDb) {
+  NotchesPeaks out;
+  const std::size_t n = r.magnitude.size();
+  if (n < 3) return out;
+  std::vector<double> db(n);
+  for (std::size_t i = 0; i < n; ++i) db[i] = 20.0 * std::log10(std::max(r.magnitude[i], 1e-300));
+  // Indices of all strict local extrema, with the ends as anchors.
+  std::vector<std::size_t> ext{0};
+  for (std::size_t i = 1; i + 1 < n; ++i)
+    if ((db[i] < db[i - 1] && db[i] <= db[i + 1]) || (db[i] > db[i - 1] && db[i] >= db[i + 1]))
+      ext.push_back(i);
+  ext.push_back(n - 1);
+  auto refine = [&](std::size_t i) {
+    // Parabola through three points in log-frequency.
+    const double x0 = std::log(r.omega[i - 1]), x1 = std::log(r.omega[i]),
+                 x2 = std::log(r.omega[i + 1]);
+    const double y0 = db[i - 1], y1 = db[i], y2 = db[i + 1];
+    const double den = (x0 - x1) * (x0 - x2) * (x1 - x2);
+    const double a = (x2 * (y1 - y0) + x1 * (y0 - y2) + x0 * (y2 - y1)) / den;
+    const double b = (x2 * x2 * (y0 - y1) + x1 * x1 * (y2 - y0) + x0 * x0 * (y1 - y2)) / den;
+    if (a == 0.0) return r.omega[i];
+    const double xv = std::clamp(-b / (2 * a), std::min(x0, x2), std::max(x0, x2));
+    return std::exp(xv);
+  };
+  for (std::size_t k = 1; k + 1 < ext.size(); ++k) {
+    const std::size_t i = ext[k];
+    double left = db[ext[k - 1]], right = db[ext[k + 1]];
+    // Compare with the highest/lowest value on each side up to the next extremum of the
+    // same kind, so that ripples do not hide a real notch.
+    const bool isMin = db[i] < db[i - 1];
+    for (std::size_t j = ext[k - 1]; j < i; ++j)
+      left = isMin ? std::max(left, db[j]) : std::min(left, db[j]);
+    for (std::size_t j = i + 1; j <= ext[k + 1]; ++j)
+      right = isMin ? std::max(right, db[j]) : std::min(right, db[j]);
+    if (isMin && left - db[i] >= minDepthDb && right - db[i] >= minDepthDb)
+      out.notches.push_back(refine(i));
+    if (!isMin && db[i] - left >= minDepthDb && db[i] - right >= minDepthDb)
+      out.peaks.push_back(refine(i));
+  }
+  return out;
+}
+
+NotchesPeaks notchesAndPeaksFromRoots(const std::vector<std::complex<double>>& zerosZ,
+                                      const std::vector<std::complex<double>>& polesZ,
+                                      double sampleTime, double maxDamping) {
+  NotchesPeaks out;
+  auto collect = [&](const std::vector<std::complex<double>>& roots, std::vector<double>& to) {
+    for (const auto& z : roots) {
+      if (z.imag() <= 0.0 || std::abs(z) <= 0.0) continue;  // one of each conjugate pair
+      const std::complex<double> s = std::log(z) / sampleTime;
+      const double wn = std::abs(s);
+      const double zeta = -s.real() / wn;
+      if (zeta < maxDamping) to.push_back(wn);
+    }
+    std::sort(to.begin(), to.end());
+  };
+  collect(zerosZ, out.notches);
+  collect(polesZ, out.peaks);
+  return out;
+}
+
+}  // namespace flexarm

@@ -1,0 +1,246 @@
+#include "core/ident/nonparametric.h"
+
+#include <chrono>
+#include <cmath>
+#include <complex>
+#include <stdexcept>
+
+#include <fftw3.h>
+
+namespace flexarm {
+
+const char* const kClosedLoopBiasWarning =
+    "The data were logged in closed loop (a reference channel is present): ETFE and SPA are "
+    "biased towards minus the inverse controller wherever noise dominates the reference (4.30).";
+
+const char* toString(LagWindow w) { return w == LagWindow::Hann ? "hann" : "hamming"; }
+std::optional<LagWindow> lagWindowFromString(std::string_view s) {
+  if (s == "hann") return LagWindow::Hann;
+  if (s == "hamming") return LagWindow::Hamming;
+  return std::nullopt;
+}
+
+namespace {
+
+bool positiveOmega(const std::vector<double>& omega, std::string* why) {
+  for (double w : omega)
+    if (!(w > 0.0) || !std::isfinite(w)) {
+      if (why) *why = "frequencies must be positive and finite";
+      return false;
+    }
+  return true;
+}
+
+using Clock = std::chrono::steady_clock;
+
+// DFT X(k) = sum_t x(t) e^{-i 2 pi k t / N}, k = 0..N/2 (scaling cancels in the ratios).
+std::vector<std::complex<double>> rfft(const Eigen::VectorXd& x) {
+  const int n = static_cast<int>(x.size());
+  std::vector<double> in(x.data(), x.data() + n);
+  std::vector<fftw_complex> out(n / 2 + 1);
+  fftw_plan plan = fftw_plan_dft_r2c_1d(n, in.data(), out.data(), FFTW_ESTIMATE);
+  fftw_execute(plan);
+  fftw_destroy_plan(plan);
+  std::vector<std::complex<double>> r(n / 2 + 1);
+  for (int k = 0; k <= n / 2; ++k) r[k] = {out[k][0], out[k][1]};
+  return r;
+}
+
+bool checkSignals(const Eigen::VectorXd& u, const Eigen::VectorXd& y, double ts,
+                  NonparametricEstimate& r, Eigen::Index minSamples) {
+  if (u.size() != y.size())
+    throw std::invalid_argument("input and output must have the same number of samples");
+  if (!(ts > 0.0)) throw std::invalid_argument("the sample time must be positive");
+  if (u.size() < minSamples) {
+    r.message = "too few samples (" + std::to_string(u.size()) + ", need at least " +
+                std::to_string(minSamples) + ")";
+    return false;
+  }
+  if (!u.allFinite() || !y.allFinite()) {
+    r.message = "the data contain NaN or infinite values";
+    return false;
+  }
+  if (u.squaredNorm() == 0.0) {
+    r.message = "the input is identically zero: nothing to estimate";
+    return false;
+  }
+  return true;
+}
+
+NonparametricEstimate flagClosedLoop(NonparametricEstimate r, const IdData& data) {
+  if (data.isClosedLoop()) {
+    r.closedLoopBias = true;
+    r.warning = kClosedLoopBiasWarning;
+  }
+  return r;
+}
+
+}  // namespace
+
+bool EtfeOptions::isValid(std::string* why) const {
+  if (smoothingWidth < 0) {
+    if (why) *why = "the smoothing width must not be negative";
+    return false;
+  }
+  return positiveOmega(omega, why);
+}
+
+bool SpaOptions::isValid(std::string* why) const {
+  if (windowWidth < 0) {
+    if (why) *why = "the lag-window width must not be negative";
+    return false;
+  }
+  if (!(level > 0.0 && level < 1.0)) {
+    if (why) *why = "the confidence level must lie strictly between 0 and 1";
+    return false;
+  }
+  return positiveOmega(omega, why);
+}
+
+NonparametricEstimate etfe(const Eigen::VectorXd& u, const Eigen::VectorXd& y, double ts,
+                           const EtfeOptions& options) {
+  std::string why;
+  if (!options.isValid(&why)) throw std::invalid_argument("etfe: " + why);
+  const auto t0 = Clock::now();
+  NonparametricEstimate r;
+  if (!checkSignals(u, y, ts, r, 8)) return r;
+  const auto U = rfft(u), Y = rfft(y);
+  const int n = static_cast<int>(u.size());
+  const int nb = n / 2;
+  const double dw = 2.0 * M_PI / (n * ts);
+  std::vector<double> omega = options.omega;
+  if (omega.empty())
+    for (int k = 1; k <= nb; ++k) omega.push_back(k * dw);
+  const double width = std::max(1, options.smoothingWidth);
+  for (double w : omega) {
+    const double kc = w / dw;  // fractional bin
+    std::complex<double> num = 0.0;
+    double den = 0.0;
+    if (width <= 1.0) {
+      const int k = std::min(nb, std::max(0, static_cast<int>(std::lround(kc))));
+      num = Y[k] * std::conj(U[k]);
+      den = std::norm(U[k]);
+    } else {
+      // Hann window over frequency (4.25), half-width `width` bins, weighted by |U|^2.
+      const int lo = std::max(0, static_cast<int>(std::floor(kc - width)));
+      const int hi = std::min(nb, static_cast<int>(std::ceil(kc + width)));
+      for (int k = lo; k <= hi; ++k) {
+        const double x = (k - kc) / width;
+        if (std::abs(x) >= 1.0) continue;
+        const double a = 0.5 * (1.0 + std::cos(M_PI * x));
+        num += a * Y[k] * std::conj(U[k]);
+        den += a * std::norm(U[k]);
+      }
+    }
+    r.response.omega.push_back(w);
+    r.response.value.push_back(den > 0.0 ? num / den
+                                         : std::complex<double>(NAN, NAN));
+  }
+  finishFrequencyResponse(r.response, {});
+  r.termination = Termination::Converged;
+  r.message = options.smoothingWidth > 1
+                  ? "ETFE smoothed over " + std::to_string(options.smoothingWidth) + " bins"
+                  : "raw ETFE";
+  for (const auto& v : r.response.value)
+    if (!std::isfinite(v.real())) {
+      r.message += "; the input has no energy at some frequencies, where G is undefined (NaN)";
+      break;
+    }
+  r.seconds = std::chrono::duration<double>(Clock::now() - t0).count();
+  return r;
+}
+
+NonparametricEstimate spa(const Eigen::VectorXd& u, const Eigen::VectorXd& y, double ts,
+                          const SpaOptions& options) {
+  std::string why;
+  if (!options.isValid(&why)) throw std::invalid_argument("spa: " + why);
+  const auto t0 = Clock::now();
+  NonparametricEstimate r;
+  if (!checkSignals(u, y, ts, r, 8)) return r;
+  const Eigen::Index n = u.size();
+  int M = options.windowWidth > 0 ? options.windowWidth
+                                  : static_cast<int>(std::min<Eigen::Index>(n / 10, 30));
+  M = static_cast<int>(std::max<Eigen::Index>(1, std::min<Eigen::Index>(M, n - 1)));
+  // Covariances R_yu(tau) = 1/N sum y(t + tau) u(t), tau = -M..M, and R_u, R_y for tau >= 0.
+  auto cov = [&](const Eigen::VectorXd& a, const Eigen::VectorXd& b, int tau) {
+    double s = 0.0;
+    if (tau >= 0)
+      s = a.tail(n - tau).dot(b.head(n - tau));
+    else
+      s = a.head(n + tau).dot(b.tail(n + tau));
+    return s / static_cast<double>(n);
+  };
+  std::vector<double> ryu(2 * M + 1), ru(M + 1), ry(M + 1), win(M + 1);
+  for (int tau = -M; tau <= M; ++tau) ryu[tau + M] = cov(y, u, tau);
+  double cw = 0.0;
+  for (int tau = 0; tau <= M; ++tau) {
+    ru[tau] = cov(u, u, tau);
+    ry[tau] = cov(y, y, tau);
+    const double c = std::cos(M_PI * tau / M);
+    win[tau] = options.window == LagWindow::Hann ? 0.5 * (1.0 + c) : 0.54 + 0.46 * c;
+    cw += (tau == 0 ? 1.0 : 2.0) * win[tau] * win[tau];
+  }
+  std::vector<double> omega = options.omega;
+  if (omega.empty())
+    for (int k = 1; k <= 128; ++k) omega.push_back(M_PI / ts * k / 128.0);
+  std::vector<Eigen::Matrix2d> covs;
+  bool undefined = false;
+  for (double w : omega) {
+    const double wt = w * ts;
+    double phiU = ru[0] * win[0], phiY = ry[0] * win[0];
+    std::complex<double> phiYU = ryu[M] * win[0];
+    for (int tau = 1; tau <= M; ++tau) {
+      const double c = std::cos(wt * tau);
+      phiU += 2.0 * win[tau] * ru[tau] * c;
+      phiY += 2.0 * win[tau] * ry[tau] * c;
+      phiYU += win[tau] * (ryu[M + tau] * std::polar(1.0, -wt * tau) +
+                           ryu[M - tau] * std::polar(1.0, wt * tau));
+    }
+    r.response.omega.push_back(w);
+    if (!(phiU > 0.0)) {
+      undefined = true;
+      r.response.value.push_back({NAN, NAN});
+      covs.push_back(Eigen::Matrix2d::Constant(NAN));
+      continue;
+    }
+    const std::complex<double> G = phiYU / phiU;
+    r.response.value.push_back(G);
+    const double phiV = std::max(0.0, phiY - std::norm(phiYU) / phiU);
+    const double varG = cw / static_cast<double>(n) * phiV / phiU;
+    covs.push_back(Eigen::Matrix2d::Identity() * (varG / 2.0));  // circular complex normal
+  }
+  r.response.level = options.level;
+  finishFrequencyResponse(r.response, covs);
+  r.termination = Termination::Converged;
+  r.message = std::string("SPA with a ") + toString(options.window) + " lag window of width " +
+              std::to_string(M);
+  if (undefined)
+    r.message += "; the smoothed input spectrum is not positive at some frequencies (NaN)";
+  r.seconds = std::chrono::duration<double>(Clock::now() - t0).count();
+  return r;
+}
+
+void inputOutput(const IdData& data, Eigen::VectorXd& u, Eigen::VectorXd& y, SampleRange range) {
+  const Channel* in = data.input();
+  const Channel* out = data.output();
+  if (!in || !out) throw std::invalid_argument("the data need an input and an output channel");
+  if (range.empty()) range = {0, data.samples()};
+  if (range.end > data.samples()) throw std::invalid_argument("range outside the data");
+  const auto n = static_cast<Eigen::Index>(range.size());
+  u = Eigen::Map<const Eigen::VectorXd>(in->values.data() + range.begin, n);
+  y = Eigen::Map<const Eigen::VectorXd>(out->values.data() + range.begin, n);
+}
+
+NonparametricEstimate etfe(const IdData& data, const EtfeOptions& options) {
+  Eigen::VectorXd u, y;
+  inputOutput(data, u, y);
+  return flagClosedLoop(etfe(u, y, data.sampleTime, options), data);
+}
+
+NonparametricEstimate spa(const IdData& data, const SpaOptions& options) {
+  Eigen::VectorXd u, y;
+  inputOutput(data, u, y);
+  return flagClosedLoop(spa(u, y, data.sampleTime, options), data);
+}
+
+}  // namespace flexarm
