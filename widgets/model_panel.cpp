@@ -24,12 +24,6 @@
 namespace flexarm {
 namespace {
 
-std::vector<double> logGrid(double lo, double hi, int n) {
-  std::vector<double> w(static_cast<std::size_t>(n));
-  for (int i = 0; i < n; ++i) w[static_cast<std::size_t>(i)] = lo * std::pow(hi / lo, static_cast<double>(i) / (n - 1));
-  return w;
-}
-
 std::shared_ptr<PhysicalModel> cloneModel(const PhysicalModel& m) {
   std::unique_ptr<ParametricModel> c = m.clone();
   return std::shared_ptr<PhysicalModel>(static_cast<PhysicalModel*>(c.release()));
