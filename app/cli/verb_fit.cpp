@@ -134,7 +134,8 @@ const char* fitOptionsHelp() {
          "  --free P1,P2          physical models: estimate only these parameters\n"
          "  --fix P=V             physical models: hold P at V (repeatable)\n"
          "  --noise-model         physical models: innovations form, K estimated (else K = 0)\n"
-         "  --starts N            physical models: N random starts besides the nominal one\n"
+         "  --starts N            physical models: N random starts besides the nominal one,\n"
+         "                        plus two whose notches and peaks match the SPA estimate\n"
          "  --seed N              random seed for the starts (default 1)\n"
          "  --decimate N          decimate by N with the anti-alias FIR before fitting\n"
          "  --range A:B           estimation data from A to B seconds (default: the log's\n"
@@ -364,6 +365,16 @@ int prepareAndFit(ArgParser& args, const std::string& verb, FitOutcome& out, std
     po.noiseModel = args.flag("noise-model") ? NoiseModel::Innovations : NoiseModel::OutputError;
     po.randomStarts = static_cast<int>(starts);
     po.seed = static_cast<unsigned>(seed);
+    if (starts > 0) {
+      // Two more starts whose notches and peaks match those of the SPA estimate.
+      const NonparametricEstimate sp = spa(out.uEst, out.yEst, out.sampleTime);
+      if (sp.termination == Termination::Converged) {
+        const auto np = notchesAndPeaks(sp.response, 3.0);
+        po.targetNotches = np.notches;
+        po.targetPeaks = np.peaks;
+        if (!np.notches.empty() || !np.peaks.empty()) po.notchPeakStarts = 2;
+      }
+    }
     try {
       out.grey = pem(*physical, out.uEst, out.yEst, out.sampleTime, po);
     } catch (const std::invalid_argument& e) {

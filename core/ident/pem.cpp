@@ -117,6 +117,22 @@ void expWithDerivatives(const Eigen::MatrixXd& M, const std::vector<Eigen::Matri
   }
 }
 
+// A derivative with every matrix sized like the model's (an empty matrix means zero);
+// throws std::invalid_argument on other sizes.
+StateSpaceDerivative completeDerivative(StateSpaceDerivative d, const StateSpace& ss) {
+  auto fix = [](Eigen::MatrixXd& m, const Eigen::MatrixXd& like, const char* what) {
+    if (m.size() == 0) m = Eigen::MatrixXd::Zero(like.rows(), like.cols());
+    if (m.rows() != like.rows() || m.cols() != like.cols())
+      throw std::invalid_argument(std::string("grey-box model: derivative ") + what +
+                                  " has the wrong size");
+  };
+  fix(d.dA, ss.A, "dA");
+  fix(d.dB, ss.B, "dB");
+  fix(d.dC, ss.C, "dC");
+  fix(d.dD, ss.D, "dD");
+  return d;
+}
+
 struct Sampled {
   Eigen::MatrixXd Ad, Bd, C, D;
   std::vector<Eigen::MatrixXd> dAd, dBd, dC, dD;  // per free parameter
@@ -135,7 +151,7 @@ Sampled sample(const ParametricModel& model, double T, const std::vector<int>& f
   std::vector<StateSpaceDerivative> der;
   if (withGradient)
     for (int idx : free) {
-      der.push_back(model.derivative(idx));
+      der.push_back(completeDerivative(model.derivative(idx), ss));
       dMs.push_back(augmented(der.back().dA, der.back().dB) * T);
     }
   Eigen::MatrixXd E;
@@ -249,7 +265,7 @@ FrequencyResponse frequencyResponse(const ParametricModel& model,
     throw std::invalid_argument("frequencyResponse: covariance does not match the free parameters");
   std::vector<StateSpaceDerivative> der;
   if (bands)
-    for (int idx : free) der.push_back(model.derivative(idx));
+    for (int idx : free) der.push_back(completeDerivative(model.derivative(idx), ss));
   const Eigen::MatrixXcd A = ss.A.cast<std::complex<double>>();
   const Eigen::MatrixXcd B = ss.B.cast<std::complex<double>>();
   const Eigen::MatrixXcd C = ss.C.cast<std::complex<double>>();

@@ -20,13 +20,14 @@ inline Eigen::VectorXd whiteNoise(Eigen::Index n, double sigma, std::mt19937& rn
   return x;
 }
 
-// y = B/(A F) u + C/(A D) e, with u = r - gain * y when gain != 0 (B must have a delay).
+// y = B/(A F) u + C/(A D) e, with u = r - gain * y when gain != 0 (B must have a delay);
+// r is white with standard deviation referenceStd.
 inline SimData simulateSystem(const Poly& a, const Poly& b, const Poly& c, const Poly& d,
                               const Poly& f, Eigen::Index n, double noiseStd, unsigned seed,
-                              double gain = 0.0) {
+                              double gain = 0.0, double referenceStd = 1.0) {
   std::mt19937 rng(seed);
   SimData s;
-  s.r = whiteNoise(n, 1.0, rng);
+  s.r = whiteNoise(n, referenceStd, rng);
   s.e = whiteNoise(n, noiseStd, rng);
   const Poly af = polyMultiply(a, f), ad = polyMultiply(a, d);
   s.u = Eigen::VectorXd::Zero(n);

@@ -107,6 +107,23 @@ TEST(Spa, ClosedLoopDataCarryTheBiasWarning) {
   EXPECT_NEAR(closed.response.omega.back(), M_PI / 0.01, 1e-9);
 }
 
+TEST(Spa, NoiseDominatedClosedLoopTendsToMinusInverseController) {
+  // (4.30) with Phi_r << |F_y|^2 Phi_v: G_hat -> -1 / F_y; here F_y = 0.5, so G_hat -> -2.
+  auto s = simulateSystem(kOne, kB, kOne, kOne, kF, 20000, 1.0, 12, 0.5, 1e-3);
+  SpaOptions o;
+  o.windowWidth = 200;  // resolves the open-loop resonance near 0.45 rad
+  o.omega = logGrid(0.1, 3.0, 10);
+  const auto r = spa(s.u, s.y, 1.0, o);
+  for (const auto& g : r.response.value) EXPECT_LT(std::abs(g - std::complex<double>(-2.0, 0.0)), 0.01);
+  // With a strong reference a loop gives the system, not the controller (a gain of 0.2 keeps
+  // the closed loop well damped, so the lag window resolves its spectra).
+  auto strong = simulateSystem(kOne, kB, kOne, kOne, kF, 20000, 0.05, 12, 0.2, 1.0);
+  const auto rs = spa(strong.u, strong.y, 1.0, o);
+  const auto t = frequencyResponse(trueOe(), o.omega);
+  for (std::size_t i = 0; i < o.omega.size(); ++i)
+    EXPECT_LT(std::abs(rs.response.value[i] - t.value[i]), 0.05 * std::abs(t.value[i]) + 0.02);
+}
+
 TEST(Bands, TrueResponseLiesInsideTheBandAtThePromisedRate) {
   // OE fits over many seeds; count how often |G_true| is inside the magnitude band and the
   // true phase inside the phase band, at 99 % and at 50 % (the latter must not be too wide).

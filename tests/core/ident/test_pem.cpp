@@ -177,6 +177,34 @@ TEST(GreyBox, CancelStopsTheSearch) {
   EXPECT_EQ(calls, 2);
 }
 
+TEST(GreyBox, BandStdMatchesFiniteDifferenceLinearization) {
+  // With covariance diag(s_j^2), Var |G| = sum_j (d|G|/d theta_j)^2 s_j^2 (Gauss approximation).
+  TwoMassTestModel m;
+  const std::vector<int> free{0, 1, 3, 4};
+  Eigen::VectorXd sd(4);
+  sd << 2e-5, 0.3, 3e3, 5.0;
+  const Eigen::MatrixXd cov = sd.cwiseAbs2().asDiagonal();
+  const std::vector<double> omega{30.0, 112.0, 150.0, 400.0};
+  const auto fr = frequencyResponse(m, omega, cov, free, 0.99);
+  ASSERT_TRUE(fr.hasBands());
+  for (std::size_t i = 0; i < omega.size(); ++i) {
+    double var = 0.0;
+    for (std::size_t j = 0; j < free.size(); ++j) {
+      TwoMassTestModel mp = m, mm = m;
+      const auto& p = m.parameters()[free[j]];
+      const double h = 1e-6 * std::abs(p.value);
+      mp.setParameter(p.name, p.value + h);
+      mm.setParameter(p.name, p.value - h);
+      const double dmag = (frequencyResponse(mp, {omega[i]}).magnitude[0] -
+                           frequencyResponse(mm, {omega[i]}).magnitude[0]) / (2 * h);
+      var += dmag * dmag * sd[j] * sd[j];
+    }
+    EXPECT_NEAR(fr.magnitudeStd[i], std::sqrt(var), 1e-5 * std::sqrt(var)) << omega[i];
+    EXPECT_NEAR(fr.magnitudeUpper[i] - fr.magnitude[i], 2.5758 * fr.magnitudeStd[i],
+                1e-3 * fr.magnitudeStd[i]);
+  }
+}
+
 TEST(GreyBox, MisuseThrows) {
   TwoMassTestModel m;
   Eigen::VectorXd u = Eigen::VectorXd::Ones(100), y = Eigen::VectorXd::Ones(99);

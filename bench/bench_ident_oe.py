@@ -1,0 +1,74 @@
+#!/usr/bin/env python3
+"""Peer for bench_ident_oe: the same output-error problems solved with
+scipy.optimize.least_squares from the same data and start.
+
+Usage: bench_ident_oe.py DIR   (DIR holds data.csv and start.json written by bench_ident_oe)
+Prints one JSON line per problem: name, loss (mean squared error), seconds (the
+least_squares call only, interpreter start-up excluded), nfev."""
+import json
+import sys
+import time
+
+import numpy as np
+from scipy.linalg import expm
+from scipy.optimize import least_squares
+from scipy.signal import lfilter
+
+
+def two_mass(theta, r):
+    jm, ja, fm, k, d = theta
+    a = np.array([[0.0, r, -1.0],
+                  [-r * k / jm, -(fm + r * r * d) / jm, r * d / jm],
+                  [k / ja, r * d / ja, -d / ja]])
+    b = np.array([0.0, 1.0 / jm, 0.0])
+    return a, b
+
+
+def zoh_simulate(a, b, u, ts):
+    m = np.zeros((4, 4))
+    m[:3, :3] = a
+    m[:3, 3] = b
+    e = expm(m * ts)
+    ad, bd = e[:3, :3], e[:3, 3]
+    x = np.zeros(3)
+    y = np.empty_like(u)
+    for t, ut in enumerate(u):
+        y[t] = x[1]
+        x = ad @ x + bd * ut
+    return y
+
+
+def main():
+    folder = sys.argv[1]
+    data = np.loadtxt(folder + "/data.csv", delimiter=",", skiprows=1)
+    start = json.load(open(folder + "/start.json"))
+    u_poly, y_poly = data[:, 0], data[:, 1]
+    u_phys, y_phys = data[:, 2], data[:, 3]
+
+    # Polynomial OE: y = B/F u, B = b1 q^-1 + b2 q^-2, F = 1 + f1 q^-1 + f2 q^-2.
+    def res_poly(p):
+        return y_poly - lfilter(np.r_[0.0, p[:2]], np.r_[1.0, p[2:]], u_poly)
+
+    t0 = time.perf_counter()
+    sol = least_squares(res_poly, np.array(start["poly"]), method="lm", xtol=1e-12, ftol=1e-12)
+    sec = time.perf_counter() - t0
+    print(json.dumps({"name": "oe221", "loss": float(np.mean(sol.fun ** 2)), "seconds": sec,
+                      "nfev": int(sol.nfev)}))
+
+    # Two-mass OE with ZOH simulation, log parameters as in FlexArm.
+    r, ts = start["r"], start["ts"]
+
+    def res_phys(logp):
+        a, b = two_mass(np.exp(logp), r)
+        return y_phys - zoh_simulate(a, b, u_phys, ts)
+
+    t0 = time.perf_counter()
+    sol = least_squares(res_phys, np.log(np.array(start["two_mass"])), method="lm",
+                        xtol=1e-10, ftol=1e-10)
+    sec = time.perf_counter() - t0
+    print(json.dumps({"name": "two-mass", "loss": float(np.mean(sol.fun ** 2)),
+                      "seconds": sec, "nfev": int(sol.nfev)}))
+
+
+if __name__ == "__main__":
+    main()
