@@ -44,33 +44,37 @@ StateSpace makeSystem(Eigen::MatrixXd A, Eigen::MatrixXd B, Eigen::MatrixXd C,
 
 }  // namespace
 
-LqrResult lqr(const Eigen::MatrixXd& A, const Eigen::MatrixXd& B, const Eigen::MatrixXd& Q1,
-              const Eigen::MatrixXd& Q2, const CareOptions& options) {
-  const CareResult care = solveCare(A, B, Q1, Q2, options);
-  LqrResult r;
+namespace {
+
+// A gain result carrying the Riccati solution and its report; the caller adds the gain.
+GainResult gainFromRiccati(const CareResult& care, const char* what) {
+  GainResult r;
   r.termination = care.termination;
-  r.message = "LQR: " + care.message;
+  r.message = std::string(what) + ": " + care.message;
   r.residual = care.residual;
   r.seconds = care.seconds;
-  if (!care.ok()) return r;
   r.X = care.X;
-  r.L = Q2.llt().solve(B.transpose() * care.X);
-  r.closedLoopPoles = eigenvalues(A - B * r.L);
   return r;
 }
 
-KalmanResult kalman(const Eigen::MatrixXd& A, const Eigen::MatrixXd& C, const Eigen::MatrixXd& R1,
-                    const Eigen::MatrixXd& R2, const CareOptions& options) {
-  const CareResult care = solveCare(A.transpose(), C.transpose(), R1, R2, options);
-  KalmanResult r;
-  r.termination = care.termination;
-  r.message = "Kalman filter: " + care.message;
-  r.residual = care.residual;
-  r.seconds = care.seconds;
-  if (!care.ok()) return r;
-  r.P = care.X;
-  r.K = R2.llt().solve(C * care.X).transpose();  // P C' R2^-1 with R2, P symmetric
-  r.observerPoles = eigenvalues(A - r.K * C);
+}  // namespace
+
+GainResult lqr(const Eigen::MatrixXd& A, const Eigen::MatrixXd& B, const Eigen::MatrixXd& Q1,
+               const Eigen::MatrixXd& Q2, const CareOptions& options) {
+  GainResult r = gainFromRiccati(solveCare(A, B, Q1, Q2, options), "LQR");
+  if (!r.ok()) return r;
+  r.gain = Q2.llt().solve(B.transpose() * r.X);
+  r.poles = eigenvalues(A - B * r.gain);
+  return r;
+}
+
+GainResult kalman(const Eigen::MatrixXd& A, const Eigen::MatrixXd& C, const Eigen::MatrixXd& R1,
+                  const Eigen::MatrixXd& R2, const CareOptions& options) {
+  GainResult r =
+      gainFromRiccati(solveCare(A.transpose(), C.transpose(), R1, R2, options), "Kalman filter");
+  if (!r.ok()) return r;
+  r.gain = R2.llt().solve(C * r.X).transpose();  // P C' R2^-1 with R2 and P symmetric
+  r.poles = eigenvalues(A - r.gain * C);
   return r;
 }
 
@@ -137,27 +141,27 @@ LqgDesign designLqg(const LqgOptions& options) {
   // (8.17) on the controllable four-state arm.
   const Eigen::MatrixXd Q1 = options.q1.head(n).asDiagonal();
   const Eigen::MatrixXd Q2 = Eigen::MatrixXd::Constant(1, 1, options.q2);
-  const LqrResult state = lqr(d.plant.A, d.plant.B, Q1, Q2, options.care);
+  const GainResult state = lqr(d.plant.A, d.plant.B, Q1, Q2, options.care);
   d.lqrResidual = state.residual;
   if (!state.ok()) return finish(state.termination, state.message);
   d.L = Eigen::RowVectorXd::Zero(nm);
-  d.L.head(n) = state.L.row(0);
+  d.L.head(n) = state.gain.row(0);
   if (options.integralAction) {
     // The (1,2) block of the extended Riccati equation (see designLqg's declaration).
     const Eigen::MatrixXd X12 =
-        (d.plant.A - d.plant.B * state.L).transpose().partialPivLu().solve(-state.X * d.plant.Bv);
+        (d.plant.A - d.plant.B * state.gain).transpose().partialPivLu().solve(-state.X * d.plant.Bv);
     d.L(n) = (d.plant.B.transpose() * X12)(0, 0) / options.q2;
   }
-  d.statePoles = state.closedLoopPoles;
+  d.statePoles = state.poles;
 
   // (8.16) on the design model.
   const Eigen::MatrixXd R1 = options.r1.asDiagonal();
   const Eigen::MatrixXd R2 = options.r2.asDiagonal();
-  const KalmanResult filter = kalman(d.model.A, d.model.C, R1, R2, options.care);
+  const GainResult filter = kalman(d.model.A, d.model.C, R1, R2, options.care);
   d.kalmanResidual = filter.residual;
   if (!filter.ok()) return finish(filter.termination, filter.message);
-  d.K = filter.K;
-  d.observerPoles = filter.observerPoles;
+  d.K = filter.gain;
+  d.observerPoles = filter.poles;
 
   const StateSpace fy = regulatorFy(d);
   d.regulatorPoles = eigenvalues(fy.A);

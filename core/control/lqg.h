@@ -14,41 +14,30 @@
 
 namespace flexarm {
 
-// State feedback u = -L x minimizing (8.17) with weights Q1 (states) and Q2 (input).
-struct LqrResult {
+// A feedback or filter gain from a Riccati equation: the LQR gain L of (8.17) or the Kalman
+// gain K of (8.16).
+struct GainResult {
   Termination termination = Termination::Failed;
   std::string message;
-  Eigen::MatrixXd L;               // inputs x states
-  Eigen::MatrixXd X;               // Riccati solution
-  double residual = 0.0;           // relative Riccati residual
-  Eigen::VectorXcd closedLoopPoles;  // eigenvalues of A - B L
+  Eigen::MatrixXd gain;    // L (inputs x states) or K (states x measurements)
+  Eigen::MatrixXd X;       // Riccati solution (the error covariance P for the filter)
+  double residual = 0.0;   // relative Riccati residual
+  Eigen::VectorXcd poles;  // eigenvalues of A - B L, or of A - K C
   double seconds = 0.0;
   bool ok() const { return termination == Termination::Converged; }
 };
 
 // LQR gain of (8.17): L = Q2^-1 B' X with A'X + XA - X B Q2^-1 B' X + Q1 = 0. Throws
-// std::invalid_argument for inconsistent sizes or weights that are not symmetric, Q2 not
+// std::invalid_argument for inconsistent sizes, weights that are not symmetric, or Q2 not
 // positive definite.
-LqrResult lqr(const Eigen::MatrixXd& A, const Eigen::MatrixXd& B, const Eigen::MatrixXd& Q1,
-              const Eigen::MatrixXd& Q2, const CareOptions& options = {});
+GainResult lqr(const Eigen::MatrixXd& A, const Eigen::MatrixXd& B, const Eigen::MatrixXd& Q1,
+               const Eigen::MatrixXd& Q2, const CareOptions& options = {});
 
-// Kalman filter gain for x' = Ax + Bu + (noise with covariance R1), y = Cx + (noise with
-// covariance R2), used in (8.16).
-struct KalmanResult {
-  Termination termination = Termination::Failed;
-  std::string message;
-  Eigen::MatrixXd K;              // states x measurements
-  Eigen::MatrixXd P;              // error covariance, Riccati solution
-  double residual = 0.0;          // relative Riccati residual
-  Eigen::VectorXcd observerPoles;  // eigenvalues of A - K C
-  double seconds = 0.0;
-  bool ok() const { return termination == Termination::Converged; }
-};
-
-// Stationary Kalman gain K = P C' R2^-1 with AP + PA' - P C' R2^-1 C P + R1 = 0 (the dual of
-// lqr). Throws std::invalid_argument as lqr does.
-KalmanResult kalman(const Eigen::MatrixXd& A, const Eigen::MatrixXd& C, const Eigen::MatrixXd& R1,
-                    const Eigen::MatrixXd& R2, const CareOptions& options = {});
+// Stationary Kalman gain of (8.16) for x' = Ax + Bu + (noise of covariance R1),
+// y = Cx + (noise of covariance R2): K = P C' R2^-1 with AP + PA' - P C' R2^-1 C P + R1 = 0
+// (the dual of lqr). Throws std::invalid_argument as lqr does.
+GainResult kalman(const Eigen::MatrixXd& A, const Eigen::MatrixXd& C, const Eigen::MatrixXd& R1,
+                  const Eigen::MatrixXd& R2, const CareOptions& options = {});
 
 // Design variables of Section 8.3. Weights are diagonals over the states of the design model
 // (five with integral action, four without) and the measurements.
