@@ -9,6 +9,8 @@ const std::vector<Verb>& verbs() {
       {"info", "channels, units, sample rate, length, metadata and ranges of a log", runInfo},
       {"preprocess", "differentiate, decimate with anti-alias filter, detrend, cut; write CSV",
        runPreprocess},
+      {"lqg", "LQG design of chapter 8: gains, poles, Nyquist, max |S|, Bode integral",
+       runLqg},
   };
   return kVerbs;
 }

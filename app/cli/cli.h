@@ -64,5 +64,6 @@ class ArgParser {
 // Verbs. Each lives in its own verb_*.cpp.
 int runInfo(const std::vector<std::string>& args, std::ostream& out, std::ostream& err);
 int runPreprocess(const std::vector<std::string>& args, std::ostream& out, std::ostream& err);
+int runLqg(const std::vector<std::string>& args, std::ostream& out, std::ostream& err);
 
 }  // namespace flexarm::cli
