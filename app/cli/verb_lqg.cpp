@@ -84,9 +84,8 @@ nlohmann::json matrix(const Eigen::MatrixXd& M) {
 nlohmann::json crossings(const std::vector<DescribingFunctionCrossing>& xs) {
   nlohmann::json j = nlohmann::json::array();
   for (const auto& x : xs)
-    j.push_back({{"frequency_rad_s", x.frequency},
-                 {"real_part", x.realPart},
-                 {"amplitude", x.amplitude}});
+    j.push_back(
+        {{"frequency_rad_s", x.frequency}, {"real_part", x.realPart}, {"amplitude", x.amplitude}});
   return j;
 }
 
@@ -110,7 +109,8 @@ int runLqg(const std::vector<std::string>& argv, std::ostream& out, std::ostream
     out << kLqgHelp;
     return kExitOk;
   }
-  if (!args.positional().empty()) return usage("unexpected argument '" + args.positional()[0] + "'");
+  if (!args.positional().empty())
+    return usage("unexpected argument '" + args.positional()[0] + "'");
   if (auto m = args.value("model"); m && *m != "two-mass")
     return usage("--model must be two-mass, not '" + *m + "'");
 
@@ -136,9 +136,8 @@ int runLqg(const std::vector<std::string>& argv, std::ostream& out, std::ostream
     }
   }
   std::string why;
-  for (auto [name, target] : {std::pair<const char*, Eigen::VectorXd*>{"q1", &o.q1},
-                              {"r1", &o.r1},
-                              {"r2", &o.r2}}) {
+  for (auto [name, target] :
+       {std::pair<const char*, Eigen::VectorXd*>{"q1", &o.q1}, {"r1", &o.r1}, {"r2", &o.r2}}) {
     if (auto v = args.value(name); v && !parseList(*v, *target, why))
       return usage(std::string("--") + name + " " + why);
   }
@@ -185,11 +184,11 @@ int runLqg(const std::vector<std::string>& argv, std::ostream& out, std::ostream
                          {"without_anti_windup", response(a.saturated)},
                          {"with_anti_windup", response(a.saturatedAntiWindup)}};
     if (ao.taBandwidth > 0.0)
-      j["bandwidth_criterion"] = {{"bandwidth_rad_s", a.bandwidth.bandwidth},
-                                  {"encirclements_of_plus_one", a.bandwidth.curve.encirclements},
-                                  {"rhp_zeros", a.bandwidth.rhpZeros},
-                                  {"unstable_regulator_needed",
-                                   a.bandwidth.unstableRegulatorNeeded()}};
+      j["bandwidth_criterion"] = {
+          {"bandwidth_rad_s", a.bandwidth.bandwidth},
+          {"encirclements_of_plus_one", a.bandwidth.curve.encirclements},
+          {"rhp_zeros", a.bandwidth.rhpZeros},
+          {"unstable_regulator_needed", a.bandwidth.unstableRegulatorNeeded()}};
     out << j.dump(2) << "\n";
     return kExitOk;
   }
@@ -199,8 +198,8 @@ int runLqg(const std::vector<std::string>& argv, std::ostream& out, std::ostream
   out << "  Riccati residuals: LQR " << d.lqrResidual << ", Kalman " << d.kalmanResidual << "\n";
   out << "  " << d.regulatorStability() << "; closed loop "
       << (d.rhpClosedLoopPoles == 0 ? "stable" : "UNSTABLE") << "\n";
-  out << "  F_y G encircles -1 " << a.loop.encirclements << " times counter-clockwise (poles predict "
-      << a.expectedEncirclements << ")\n";
+  out << "  F_y G encircles -1 " << a.loop.encirclements
+      << " times counter-clockwise (poles predict " << a.expectedEncirclements << ")\n";
   out << "  max |S| = " << a.maxSensitivity << " at " << a.maxSensitivityFrequency
       << " rad/s (min distance to -1: " << a.minDistanceToMinusOne << ")\n";
   out << "  Bode integral (8.37): " << a.bodeIntegral << ", pi * sum Re(p_i) = " << a.bodePrediction

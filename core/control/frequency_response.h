@@ -24,8 +24,10 @@ class TransferEvaluator {
   int outputs() const { return static_cast<int>(Ct_.rows()); }
 
  private:
-  // Solves (sI - H) X = Bt for the Hessenberg H by elimination with adjacent-row pivoting.
-  Eigen::MatrixXcd solve(std::complex<double> s, int columns) const;
+  // Solves (sI - H) X = Bt for the Hessenberg H by elimination with adjacent-row pivoting;
+  // M (n x n) and X (n x columns) are row-major work arrays, X returns the solution.
+  void solve(std::complex<double> s, int columns, std::complex<double>* M,
+             std::complex<double>* X) const;
 
   Eigen::MatrixXd H_, Bt_, Ct_, D_;
 };

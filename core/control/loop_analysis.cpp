@@ -84,7 +84,8 @@ NyquistCurve nyquist(const ComplexFunction& f, std::complex<double> point,
     if (std::isfinite(w)) largest = std::max(largest, std::abs(w));
   double smallest = largest;
   for (double w : characteristicFrequencies)
-    if (std::isfinite(w) && std::abs(w) > 1e-9 * largest) smallest = std::min(smallest, std::abs(w));
+    if (std::isfinite(w) && std::abs(w) > 1e-9 * largest)
+      smallest = std::min(smallest, std::abs(w));
   if (!(largest > 0.0) && (options.minFrequency == 0.0 || options.maxFrequency == 0.0))
     throw std::invalid_argument("nyquist: no positive characteristic frequency to set the range");
   const double lo = options.minFrequency > 0.0 ? options.minFrequency : 1e-3 * smallest;
@@ -102,8 +103,7 @@ NyquistCurve nyquist(const ComplexFunction& f, std::complex<double> point,
   for (double w : characteristicFrequencies)
     if (std::abs(w) > eps && std::abs(w) < hi) c.frequencies.push_back(std::abs(w));
   std::sort(c.frequencies.begin(), c.frequencies.end());
-  c.frequencies.erase(std::unique(c.frequencies.begin(), c.frequencies.end()),
-                      c.frequencies.end());
+  c.frequencies.erase(std::unique(c.frequencies.begin(), c.frequencies.end()), c.frequencies.end());
   c.values.reserve(c.frequencies.size());
   for (double w : c.frequencies) c.values.push_back(onAxis(w));
   c.gridLimitReached = !refine(c.frequencies, c.values, onAxis, point, options, true);
@@ -130,9 +130,7 @@ NyquistCurve nyquist(const ComplexFunction& f, std::complex<double> point,
 
 double bodeSensitivityIntegral(const ComplexFunction& loopGain, const std::vector<double>& grid) {
   if (grid.size() < 2) throw std::invalid_argument("bodeSensitivityIntegral: grid too short");
-  auto logS = [&loopGain](double w) {
-    return -std::log(std::abs(1.0 + loopGain({0.0, w})));
-  };
+  auto logS = [&loopGain](double w) { return -std::log(std::abs(1.0 + loopGain({0.0, w}))); };
   // 4-point Gauss-Legendre in t = log w on each panel: integrand log|S(e^t)| e^t.
   static const double node[4] = {-0.8611363115940526, -0.3399810435848563, 0.3399810435848563,
                                  0.8611363115940526};

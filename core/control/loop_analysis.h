@@ -13,9 +13,9 @@ namespace flexarm {
 using ComplexFunction = std::function<std::complex<double>(std::complex<double>)>;
 
 struct NyquistOptions {
-  int initialPoints = 300;     // log-spaced points before refinement
-  int maxPoints = 6000;        // refinement stops here (gridLimitReached)
-  double maxAngleStep = 0.2;   // rad: largest turn of f - point between neighbours
+  int initialPoints = 300;      // log-spaced points before refinement
+  int maxPoints = 6000;         // refinement stops here (gridLimitReached)
+  double maxAngleStep = 0.2;    // rad: largest turn of f - point between neighbours
   double maxChordRatio = 0.25;  // largest |f_i+1 - f_i| / min(|f_i - point|, |f_i+1 - point|)
   // Frequency range in rad/s; 0 picks it from the characteristic frequencies.
   double minFrequency = 0.0, maxFrequency = 0.0;
@@ -24,14 +24,14 @@ struct NyquistOptions {
 
 // A Nyquist curve on positive frequencies and its encirclements of a point.
 struct NyquistCurve {
-  std::vector<double> frequencies;            // rad/s, increasing
-  std::vector<std::complex<double>> values;   // f(i w)
+  std::vector<double> frequencies;           // rad/s, increasing
+  std::vector<std::complex<double>> values;  // f(i w)
   // Net counter-clockwise encirclements of the point by f over the whole Nyquist contour
   // (-i inf to +i inf, a small indentation right of the origin, closed through the right
   // half plane). By the argument principle this equals P - Z for f = L, point = -1 (P, Z:
   // right-half-plane poles of L and of the closed loop).
   int encirclements = 0;
-  double windingError = 0.0;  // distance of the measured winding from the integer, in turns
+  double windingError = 0.0;       // distance of the measured winding from the integer, in turns
   double indentationRadius = 0.0;  // rad/s
   bool gridLimitReached = false;
 };

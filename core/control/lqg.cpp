@@ -26,14 +26,13 @@ bool diagonalIsValid(const Eigen::VectorXd& v, int size, bool positive, const ch
   for (Eigen::Index i = 0; i < v.size(); ++i) {
     if (!std::isfinite(v(i))) return fail(std::string(name) + " has a non-finite entry");
     if (positive ? !(v(i) > 0.0) : v(i) < 0.0)
-      return fail(std::string(name) + (positive ? " entries must be positive"
-                                                : " entries must not be negative"));
+      return fail(std::string(name) +
+                  (positive ? " entries must be positive" : " entries must not be negative"));
   }
   return true;
 }
 
-StateSpace makeSystem(Eigen::MatrixXd A, Eigen::MatrixXd B, Eigen::MatrixXd C,
-                      Eigen::MatrixXd D) {
+StateSpace makeSystem(Eigen::MatrixXd A, Eigen::MatrixXd B, Eigen::MatrixXd C, Eigen::MatrixXd D) {
   StateSpace s;
   s.A = std::move(A);
   s.B = std::move(B);
@@ -105,13 +104,28 @@ bool LqgOptions::isValid(std::string* why) const {
   return care.isValid(why);
 }
 
-int countRightHalfPlane(const Eigen::VectorXcd& poles, double relativeTolerance) {
+namespace {
+
+// Real parts above this lie in the open right half plane.
+double rightHalfPlaneThreshold(const Eigen::VectorXcd& poles, double relativeTolerance) {
   double radius = 1.0;
   for (Eigen::Index i = 0; i < poles.size(); ++i) radius = std::max(radius, std::abs(poles(i)));
-  int count = 0;
+  return relativeTolerance * radius;
+}
+
+}  // namespace
+
+int countRightHalfPlane(const Eigen::VectorXcd& poles, double relativeTolerance) {
+  const double threshold = rightHalfPlaneThreshold(poles, relativeTolerance);
+  return static_cast<int>((poles.real().array() > threshold).count());
+}
+
+double rightHalfPlaneRealSum(const Eigen::VectorXcd& poles, double relativeTolerance) {
+  const double threshold = rightHalfPlaneThreshold(poles, relativeTolerance);
+  double sum = 0.0;
   for (Eigen::Index i = 0; i < poles.size(); ++i)
-    if (poles(i).real() > relativeTolerance * radius) ++count;
-  return count;
+    if (poles(i).real() > threshold) sum += poles(i).real();
+  return sum;
 }
 
 std::string LqgDesign::regulatorStability() const {
@@ -148,8 +162,10 @@ LqgDesign designLqg(const LqgOptions& options) {
   d.L.head(n) = state.gain.row(0);
   if (options.integralAction) {
     // The (1,2) block of the extended Riccati equation (see designLqg's declaration).
-    const Eigen::MatrixXd X12 =
-        (d.plant.A - d.plant.B * state.gain).transpose().partialPivLu().solve(-state.X * d.plant.Bv);
+    const Eigen::MatrixXd X12 = (d.plant.A - d.plant.B * state.gain)
+                                    .transpose()
+                                    .partialPivLu()
+                                    .solve(-state.X * d.plant.Bv);
     d.L(n) = (d.plant.B.transpose() * X12)(0, 0) / options.q2;
   }
   d.statePoles = state.poles;
@@ -170,14 +186,13 @@ LqgDesign designLqg(const LqgOptions& options) {
   d.rhpClosedLoopPoles = countRightHalfPlane(d.closedLoopPoles);
   std::ostringstream s;
   s << (d.rhpClosedLoopPoles == 0 ? "stable closed loop; " : "UNSTABLE closed loop; ")
-    << d.regulatorStability() << " (Riccati residuals " << d.lqrResidual << ", "
-    << d.kalmanResidual << ")";
+    << d.regulatorStability() << " (Riccati residuals " << d.lqrResidual << ", " << d.kalmanResidual
+    << ")";
   return finish(Termination::Converged, s.str());
 }
 
 StateSpace plantTransfer(const LqgDesign& d) {
-  return makeSystem(d.plant.A, d.plant.B, d.plant.C,
-                    Eigen::MatrixXd::Zero(d.plant.C.rows(), 1));
+  return makeSystem(d.plant.A, d.plant.B, d.plant.C, Eigen::MatrixXd::Zero(d.plant.C.rows(), 1));
 }
 
 StateSpace regulatorFy(const LqgDesign& d) {
@@ -207,8 +222,8 @@ StateSpace disturbanceClosedLoop(const LqgDesign& d) {
   Eigen::MatrixXd A(n + nm, n + nm), B(n + nm, 2), C = Eigen::MatrixXd::Zero(3, n + nm);
   A << g.A, -g.B * d.L, d.K * g.C, m.A - m.B * d.L - d.K * m.C;
   B << g.Bw, g.Bv, Eigen::MatrixXd::Zero(nm, 1), d.K * g.Dv;
-  C(0, 2) = 1.0;  // phi_a
-  C(1, 0) = 1.0;  // phi_m
+  C(0, 2) = 1.0;                // phi_a
+  C(1, 0) = 1.0;                // phi_m
   C.block(2, n, 1, nm) = -d.L;  // u = -L x_hat
   return makeSystem(A, B, C, Eigen::MatrixXd::Zero(3, 2));
 }

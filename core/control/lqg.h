@@ -44,7 +44,7 @@ GainResult kalman(const Eigen::MatrixXd& A, const Eigen::MatrixXd& C, const Eige
 struct LqgOptions {
   TwoMassLqgParameters parameters;  // Table 8.1 by default
   LqgMeasurement measurement = LqgMeasurement::MotorAngle;
-  bool integralAction = true;       // extend with x5, a constant load on the arm
+  bool integralAction = true;  // extend with x5, a constant load on the arm
   Eigen::VectorXd q1 = (Eigen::VectorXd(5) << 100, 1, 0, 0, 0).finished();
   double q2 = 1.0;
   Eigen::VectorXd r1 = (Eigen::VectorXd(5) << 0, 0, 0, 0, 1).finished();
@@ -100,12 +100,14 @@ LqgDesign designLqg(const LqgOptions& options);
 // Numbers of eigenvalues with real part above tol * max(1, spectral radius), i.e. in the open
 // right half plane; eigenvalues within the tolerance of the axis are not counted.
 int countRightHalfPlane(const Eigen::VectorXcd& poles, double relativeTolerance = 1e-9);
+// Sum of the real parts of the eigenvalues that countRightHalfPlane counts.
+double rightHalfPlaneRealSum(const Eigen::VectorXcd& poles, double relativeTolerance = 1e-9);
 
 // Transfer functions of a design (all continuous-time state space).
-StateSpace plantTransfer(const LqgDesign& d);  // G: u -> y, C (sI - A)^-1 B
-StateSpace regulatorFy(const LqgDesign& d);    // (8.20) L (sI - A + BL + KC)^-1 K
-StateSpace regulatorFr(const LqgDesign& d);    // (8.19) 1 - L (sI - A + BL + KC)^-1 B
-StateSpace closedLoopGc(const LqgDesign& d);   // (8.21) C (sI - A + BL)^-1 B
+StateSpace plantTransfer(const LqgDesign& d);    // G: u -> y, C (sI - A)^-1 B
+StateSpace regulatorFy(const LqgDesign& d);      // (8.20) L (sI - A + BL + KC)^-1 K
+StateSpace regulatorFr(const LqgDesign& d);      // (8.19) 1 - L (sI - A + BL + KC)^-1 B
+StateSpace closedLoopGc(const LqgDesign& d);     // (8.21) C (sI - A + BL)^-1 B
 StateSpace stateFeedbackG0(const LqgDesign& d);  // (8.35) L (sI - A)^-1 B
 // The closed loop with inputs (w, v) and outputs (phi_a, phi_m, u), states (x, x_hat).
 StateSpace disturbanceClosedLoop(const LqgDesign& d);

@@ -1,12 +1,12 @@
 #include "core/control/lqg_analysis.h"
 
 #include <Eigen/Eigenvalues>
-#include <unsupported/Eigen/MatrixFunctions>
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <sstream>
 #include <stdexcept>
+#include <unsupported/Eigen/MatrixFunctions>
 
 #include "core/control/frequency_response.h"
 
@@ -97,31 +97,54 @@ DisturbanceResponse disturbanceSteps(const LqgDesign& d, const DisturbanceStepOp
   }
   const auto [Phi, Gamma] = discretize(A, B, h);
   DisturbanceResponse r;
-  Eigen::VectorXd xi = Eigen::VectorXd::Zero(n + nm);
-  Eigen::VectorXd in = Eigen::VectorXd::Zero(B.cols());
+  // The loop below runs tens of thousands of times per call: column-wise updates on plain
+  // arrays keep the small products free of temporaries and of serial dependencies.
+  const int ns = n + nm, ni = static_cast<int>(B.cols());
+  std::vector<double> xi(ns, 0.0), next(ns), in(ni, 0.0);
+  for (auto* v : {&r.time, &r.armAngle, &r.motorAngle, &r.torque, &r.computedTorque})
+    v->reserve(static_cast<std::size_t>(samples));
+  const std::vector<double> gain(d.L.data(), d.L.data() + nm);
   for (long k = 0; k < samples; ++k) {
     const double t = k * o.sampleTime;
     const double w = t >= o.wStepTime - 1e-9 * o.sampleTime ? o.wAmplitude : 0.0;
     const double v = t >= o.vStepTime - 1e-9 * o.sampleTime ? o.vAmplitude : 0.0;
     for (int s = 0; s < sub; ++s) {
-      const double ubar = -(d.L * xi.tail(nm))(0);
-      const double u =
-          saturated ? std::clamp(ubar, -o.saturationLimit, o.saturationLimit) : ubar;
+      double ubar = 0.0;
+      for (int i = 0; i < nm; ++i) ubar -= gain[i] * xi[n + i];
+      const double u = saturated ? std::clamp(ubar, -o.saturationLimit, o.saturationLimit) : ubar;
       if (s == 0) {
         r.time.push_back(t);
-        r.armAngle.push_back(xi(2));
-        r.motorAngle.push_back(xi(0));
+        r.armAngle.push_back(xi[2]);
+        r.motorAngle.push_back(xi[0]);
         r.torque.push_back(u);
         r.computedTorque.push_back(ubar);
-        r.peakArmDeviation = std::max(r.peakArmDeviation, std::abs(xi(2)));
+        r.peakArmDeviation = std::max(r.peakArmDeviation, std::abs(xi[2]));
       }
-      if (saturated)
-        in << u, (o.antiWindup ? u : ubar), w, v;
-      else
-        in << w, v;
-      xi = Phi * xi + Gamma * in;
+      if (saturated) {
+        in[0] = u;
+        in[1] = o.antiWindup ? u : ubar;
+        in[2] = w;
+        in[3] = v;
+      } else {
+        in[0] = w;
+        in[1] = v;
+      }
+      std::fill(next.begin(), next.end(), 0.0);
+      for (int j = 0; j < ns; ++j) {
+        const double* col = Phi.data() + static_cast<std::ptrdiff_t>(j) * ns;
+        const double xj = xi[j];
+        for (int i = 0; i < ns; ++i) next[i] += col[i] * xj;
+      }
+      for (int j = 0; j < ni; ++j) {
+        const double* col = Gamma.data() + static_cast<std::ptrdiff_t>(j) * ns;
+        const double uj = in[j];
+        for (int i = 0; i < ns; ++i) next[i] += col[i] * uj;
+      }
+      xi.swap(next);
     }
-    if (!(xi.norm() < 1e6)) {
+    double norm2 = 0.0;
+    for (double x : xi) norm2 += x * x;
+    if (!(norm2 < 1e12)) {
       r.diverged = true;
       break;
     }
@@ -149,8 +172,8 @@ BandwidthCriterion bandwidthCriterion(const TwoMassLqgParameters& p, double band
   c.curve = nyquist(tm, 1.0, freqs, options);
   // Numerator of 1 - T_m: (1 + s/w0)^3 (k + d s) - (k + (d + f_a) s + J_a s^2); its constant
   // term vanishes (T_m(0) = 1), so divide by s.
-  const std::vector<double> lead = multiply(
-      multiply(multiply({1.0, 1.0 / w0}, {1.0, 1.0 / w0}), {1.0, 1.0 / w0}), {p.k, p.d});
+  const std::vector<double> lead =
+      multiply(multiply(multiply({1.0, 1.0 / w0}, {1.0, 1.0 / w0}), {1.0, 1.0 / w0}), {p.k, p.d});
   std::vector<double> num = lead;
   num[0] -= p.k;
   num[1] -= p.d + p.fa;
@@ -193,8 +216,8 @@ LqgAnalysis analyzeLqg(const LqgOptions& designOptions, const LqgAnalysisOptions
     return siso ? Fy.scalar(s) * G.scalar(s) : (Fy(s) * G(s))(0, 0);
   };
   const ComplexFunction g0 = [&G0](std::complex<double> s) { return G0.scalar(s); };
-  const Eigen::VectorXcd plantPoles = Eigen::EigenSolver<Eigen::MatrixXd>(d.plant.A, false)
-                                          .eigenvalues();
+  const Eigen::VectorXcd plantPoles =
+      Eigen::EigenSolver<Eigen::MatrixXd>(d.plant.A, false).eigenvalues();
   std::vector<double> freqs;
   appendMagnitudes(plantPoles, freqs);
   appendMagnitudes(d.regulatorPoles, freqs);
@@ -210,7 +233,9 @@ LqgAnalysis analyzeLqg(const LqgOptions& designOptions, const LqgAnalysisOptions
     if (a.sensitivity[i] > a.sensitivity[peak]) peak = i;
   }
   // Golden-section search of the peak between the neighbours of the best grid point.
-  auto sens = [&loopGain](double lw) { return 1.0 / std::abs(1.0 + loopGain({0.0, std::exp(lw)})); };
+  auto sens = [&loopGain](double lw) {
+    return 1.0 / std::abs(1.0 + loopGain({0.0, std::exp(lw)}));
+  };
   const auto& wf = a.loop.frequencies;
   double lo = std::log(wf[peak > 0 ? peak - 1 : 0]);
   double hi = std::log(wf[std::min(peak + 1, wf.size() - 1)]);
@@ -231,13 +256,7 @@ LqgAnalysis analyzeLqg(const LqgOptions& designOptions, const LqgAnalysisOptions
   a.openLoopRhpPoles = d.rhpRegulatorPoles + countRightHalfPlane(plantPoles);
   a.expectedEncirclements = a.openLoopRhpPoles - d.rhpClosedLoopPoles;
   a.bodeIntegral = bodeSensitivityIntegral(loopGain, a.loop.frequencies);
-  double sumRe = 0.0;
-  for (const Eigen::VectorXcd* poles : {&d.regulatorPoles, &plantPoles}) {
-    double radius = 1.0;
-    for (Eigen::Index i = 0; i < poles->size(); ++i) radius = std::max(radius, std::abs((*poles)(i)));
-    for (Eigen::Index i = 0; i < poles->size(); ++i)
-      if ((*poles)(i).real() > 1e-9 * radius) sumRe += (*poles)(i).real();
-  }
+  const double sumRe = rightHalfPlaneRealSum(d.regulatorPoles) + rightHalfPlaneRealSum(plantPoles);
   a.bodePrediction = kPi * sumRe;
 
   // Describing function (Section 8.5) on F_y G and on G_0 (8.35).
@@ -257,8 +276,8 @@ LqgAnalysis analyzeLqg(const LqgOptions& designOptions, const LqgAnalysisOptions
     a.saturatedAntiWindup = disturbanceSteps(d, steps);
   }
   if (options.taBandwidth > 0.0)
-    a.bandwidth = bandwidthCriterion(designOptions.parameters, options.taBandwidth,
-                                     options.nyquist);
+    a.bandwidth =
+        bandwidthCriterion(designOptions.parameters, options.taBandwidth, options.nyquist);
 
   std::ostringstream s;
   s << d.regulatorStability() << "; max |S| = " << a.maxSensitivity << " at "

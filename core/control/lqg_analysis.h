@@ -17,9 +17,9 @@ namespace flexarm {
 // Unit step disturbances: w at wStepTime, v at vStepTime (Figure 8.3), optionally through an
 // input saturation |u| <= saturationLimit.
 struct DisturbanceStepOptions {
-  double horizon = 3.0;       // s
-  double sampleTime = 1e-3;   // s, output spacing
-  double wStepTime = 0.0, vStepTime = 1.0;  // s
+  double horizon = 3.0;                       // s
+  double sampleTime = 1e-3;                   // s, output spacing
+  double wStepTime = 0.0, vStepTime = 1.0;    // s
   double wAmplitude = 1.0, vAmplitude = 1.0;  // N m
   // 0: linear loop, simulated exactly. > 0: the applied torque is limited to this level and
   // the regulator runs on a sub-step of sampleTime / subSteps holding u constant.
@@ -72,22 +72,22 @@ struct LqgAnalysis {
   double seconds = 0.0;
   LqgDesign design;
 
-  NyquistCurve loop;  // F_y(iw) G(iw), encirclements of -1 (counter-clockwise)
+  NyquistCurve loop;                  // F_y(iw) G(iw), encirclements of -1 (counter-clockwise)
   std::vector<double> sensitivity;    // |S(iw)| on loop.frequencies (8.36)
   std::vector<double> complementary;  // |T(iw)| = |L / (1 + L)|
   double maxSensitivity = 0.0, maxSensitivityFrequency = 0.0;
   double minDistanceToMinusOne = 0.0;  // min |1 + L| = 1 / max |S| (8.38)
-  int openLoopRhpPoles = 0;           // of F_y G: the regulator's (the arm has none)
-  int expectedEncirclements = 0;      // P - Z from the poles, for comparison with loop's
-  double bodeIntegral = 0.0;          // left side of (8.37)
-  double bodePrediction = 0.0;        // pi * sum of Re(p_i) over right-half-plane poles of F_y G
+  int openLoopRhpPoles = 0;            // of F_y G: the regulator's (the arm has none)
+  int expectedEncirclements = 0;       // P - Z from the poles, for comparison with loop's
+  double bodeIntegral = 0.0;           // left side of (8.37)
+  double bodePrediction = 0.0;         // pi * sum of Re(p_i) over right-half-plane poles of F_y G
 
   NyquistCurve g0;  // G_0(iw) of (8.35) on its own grid, encirclements of -1
   std::vector<DescribingFunctionCrossing> loopCrossings, g0Crossings;
 
-  DisturbanceResponse steps;  // linear loop, Figure 8.3
+  DisturbanceResponse steps;                           // linear loop, Figure 8.3
   DisturbanceResponse saturated, saturatedAntiWindup;  // empty without a saturation limit
-  BandwidthCriterion bandwidth;  // empty when taBandwidth is 0
+  BandwidthCriterion bandwidth;                        // empty when taBandwidth is 0
 
   bool ok() const { return termination == Termination::Converged; }
 };

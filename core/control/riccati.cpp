@@ -94,8 +94,7 @@ bool CareOptions::isValid(std::string* why) const {
 
 Eigen::MatrixXd solveSylvester(const Eigen::MatrixXd& A, const Eigen::MatrixXd& B,
                                const Eigen::MatrixXd& C) {
-  if (A.rows() != A.cols() || B.rows() != B.cols() || C.rows() != A.rows() ||
-      C.cols() != B.rows())
+  if (A.rows() != A.cols() || B.rows() != B.cols() || C.rows() != A.rows() || C.cols() != B.rows())
     throw std::invalid_argument("Sylvester equation: matrix sizes do not agree");
   Eigen::ComplexSchur<CMatrix> sa(A.cast<Complex>()), sb(B.cast<Complex>());
   const CMatrix& Ta = sa.matrixT();
@@ -170,8 +169,7 @@ CareResult solveCare(const Eigen::MatrixXd& A, const Eigen::MatrixXd& B, const E
   // Newton refinement: (A - G X)' E + E (A - G X) = -Res(X), X <- X + E.
   for (int step = 0; step < options.maxRefinementSteps && result.residual > 1e-15; ++step) {
     const Eigen::MatrixXd Acl = A - G * X;
-    const Eigen::MatrixXd E =
-        solveSylvester(Acl.transpose(), Acl, -residualMatrix(A, G, Q, X));
+    const Eigen::MatrixXd E = solveSylvester(Acl.transpose(), Acl, -residualMatrix(A, G, Q, X));
     Eigen::MatrixXd Xn = X + E;
     Xn = 0.5 * (Xn + Xn.transpose()).eval();
     const double r = relativeResidual(A, G, Q, Xn);

@@ -59,8 +59,10 @@ bool TwoMassLqgParameters::isValid(std::string* why) const {
 
 const char* toString(LqgMeasurement m) {
   switch (m) {
-    case LqgMeasurement::MotorAngle: return "motor-angle";
-    case LqgMeasurement::MotorAngleAndArmAcceleration: return "motor-angle+arm-acceleration";
+    case LqgMeasurement::MotorAngle:
+      return "motor-angle";
+    case LqgMeasurement::MotorAngleAndArmAcceleration:
+      return "motor-angle+arm-acceleration";
   }
   return "?";
 }
@@ -75,7 +77,8 @@ TwoMassLqgPlant twoMassLqgPlant(const TwoMassLqgParameters& p, LqgMeasurement m)
   std::string why;
   if (!p.isValid(&why)) throw std::invalid_argument("two-mass model: " + why);
   TwoMassLqgPlant g;
-  g.A.resize(4, 4);  // (8.4)
+  // (8.4)
+  g.A.resize(4, 4);
   g.A << 0, 1, 0, 0,                                              //
       -p.k / p.Jm, -(p.d + p.fm) / p.Jm, p.k / p.Jm, p.d / p.Jm,  //
       0, 0, 0, 1,                                                 //

@@ -39,8 +39,8 @@ TEST(Lqg, IntegralActionRemovesSteadyMotorErrorForConstantLoads) {
     const StateSpace cl = disturbanceClosedLoop(d);
     // Static gain -C A^-1 B from (w, v) to (phi_a, phi_m, u).
     const Eigen::MatrixXd dc = -cl.C * cl.A.partialPivLu().solve(cl.B);
-    EXPECT_NEAR(dc(1, 0), 0.0, 1e-9);  // phi_m after a constant w
-    EXPECT_NEAR(dc(1, 1), 0.0, 1e-9);  // phi_m after a constant v
+    EXPECT_NEAR(dc(1, 0), 0.0, 1e-9);   // phi_m after a constant w
+    EXPECT_NEAR(dc(1, 1), 0.0, 1e-9);   // phi_m after a constant v
     EXPECT_NEAR(dc(2, 0), -1.0, 1e-9);  // the torque cancels w
     EXPECT_NEAR(dc(2, 1), -1.0, 1e-9);  // and v
   }

@@ -11,10 +11,9 @@ namespace {
 TEST(Care, ScalarEquationMatchesClosedForm) {
   // 2 a x - x^2 b^2 / r + q = 0 has the stabilizing root x = r (a + sqrt(a^2 + b^2 q / r)) / b^2.
   const double a = 0.7, b = 2.0, q = 3.0, r = 0.5;
-  const CareResult res = solveCare(Eigen::MatrixXd::Constant(1, 1, a),
-                                   Eigen::MatrixXd::Constant(1, 1, b),
-                                   Eigen::MatrixXd::Constant(1, 1, q),
-                                   Eigen::MatrixXd::Constant(1, 1, r));
+  const CareResult res =
+      solveCare(Eigen::MatrixXd::Constant(1, 1, a), Eigen::MatrixXd::Constant(1, 1, b),
+                Eigen::MatrixXd::Constant(1, 1, q), Eigen::MatrixXd::Constant(1, 1, r));
   ASSERT_TRUE(res.ok()) << res.message;
   EXPECT_NEAR(res.X(0, 0), r * (a + std::sqrt(a * a + b * b * q / r)) / (b * b), 1e-12);
 }
@@ -31,9 +30,9 @@ TEST(Care, DoubleIntegratorMatchesClosedForm) {
   expected << std::sqrt(3.0), 1, 1, std::sqrt(3.0);
   EXPECT_LT((res.X - expected).norm(), 1e-12);
   EXPECT_LT(res.residual, 1e-14);
-  EXPECT_LT(careResidual(A, B, Eigen::MatrixXd::Identity(2, 2), Eigen::MatrixXd::Identity(1, 1),
-                         res.X),
-            1e-14);
+  EXPECT_LT(
+      careResidual(A, B, Eigen::MatrixXd::Identity(2, 2), Eigen::MatrixXd::Identity(1, 1), res.X),
+      1e-14);
 }
 
 TEST(Care, UnstabilizableSystemIsReportedNotThrown) {

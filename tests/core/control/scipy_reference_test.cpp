@@ -1,12 +1,12 @@
 // LQR and Kalman gains of the seed's three designs against an independent reference:
 // SciPy's scipy.linalg.solve_continuous_are, run by /usr/bin/python3 on the same matrices.
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <cstdio>
 #include <fstream>
 #include <sstream>
 #include <string>
-#include <unistd.h>
 
 #include "core/control/lqg.h"
 
@@ -109,7 +109,8 @@ TEST(ScipyReference, SeedDesignsAgreeWithSolveContinuousAre) {
     const Eigen::RowVectorXd L = X[2 * i].row(1) / designs[i].q2;  // Q2^-1 B' X, B = e2 / J_m
     const Eigen::RowVectorXd Lref = L / designs[i].parameters.Jm;
     EXPECT_LT((d.L.head(4) - Lref).norm(), 1e-8 * Lref.norm()) << "design " << i << "\n"
-                                                                 << d.L << "\n" << Lref;
+                                                               << d.L << "\n"
+                                                               << Lref;
     const Eigen::MatrixXd R2 = designs[i].r2.asDiagonal();
     const Eigen::MatrixXd Kref = X[2 * i + 1] * d.model.C.transpose() * R2.inverse();
     EXPECT_LT((d.K - Kref).norm(), 1e-7 * Kref.norm()) << "design " << i << "\n"
