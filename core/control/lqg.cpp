@@ -168,6 +168,7 @@ LqgDesign designLqg(const LqgOptions& options) {
                                     .solve(-state.X * d.plant.Bv);
     d.L(n) = (d.plant.B.transpose() * X12)(0, 0) / options.q2;
   }
+  d.plantPoles = eigenvalues(d.plant.A);
   d.statePoles = state.poles;
 
   // (8.16) on the design model.

@@ -74,6 +74,7 @@ struct LqgDesign {
   Eigen::MatrixXd K;      // (8.16) Kalman gain, model states x measurements
   double lqrResidual = 0.0, kalmanResidual = 0.0;
 
+  Eigen::VectorXcd plantPoles;       // eig(A) of the arm (8.4)
   Eigen::VectorXcd statePoles;       // eig(A - B L) of the controllable part
   Eigen::VectorXcd observerPoles;    // eig(A_bar - K C_bar)
   Eigen::VectorXcd regulatorPoles;   // poles of F_y: eig(A_bar - B_bar L - K C_bar)

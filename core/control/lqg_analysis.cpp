@@ -216,8 +216,7 @@ LqgAnalysis analyzeLqg(const LqgOptions& designOptions, const LqgAnalysisOptions
     return siso ? Fy.scalar(s) * G.scalar(s) : (Fy(s) * G(s))(0, 0);
   };
   const ComplexFunction g0 = [&G0](std::complex<double> s) { return G0.scalar(s); };
-  const Eigen::VectorXcd plantPoles =
-      Eigen::EigenSolver<Eigen::MatrixXd>(d.plant.A, false).eigenvalues();
+  const Eigen::VectorXcd& plantPoles = d.plantPoles;
   std::vector<double> freqs;
   appendMagnitudes(plantPoles, freqs);
   appendMagnitudes(d.regulatorPoles, freqs);
