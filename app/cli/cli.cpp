@@ -15,6 +15,8 @@ const std::vector<Verb>& verbs() {
       {"fit", "estimate ARX/ARMAX/OE/BJ or physical models with std, fit %, notches, peaks",
        runFit},
       {"bode", "frequency response of a fitted model or SPA/ETFE with bands, to CSV", runBode},
+      {"lqg", "LQG design of chapter 8: gains, poles, Nyquist, max |S|, Bode integral",
+       runLqg},
   };
   return kVerbs;
 }

@@ -68,5 +68,6 @@ int runModel(const std::vector<std::string>& args, std::ostream& out, std::ostre
 int runSimulate(const std::vector<std::string>& args, std::ostream& out, std::ostream& err);
 int runFit(const std::vector<std::string>& args, std::ostream& out, std::ostream& err);
 int runBode(const std::vector<std::string>& args, std::ostream& out, std::ostream& err);
+int runLqg(const std::vector<std::string>& args, std::ostream& out, std::ostream& err);
 
 }  // namespace flexarm::cli
