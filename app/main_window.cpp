@@ -96,30 +96,22 @@ bool askTableMapping(QWidget* parent, const QString& path, LogReadOptions& o) {
 
 MainWindow::MainWindow(QWidget* parent)
     : QMainWindow(parent), workspace_(new Workspace(this)),
-      logPanel_(new LogPanel(workspace_, this)),
-      preprocessPanel_(new PreprocessPanel(workspace_, this)),
-      armPanel_(new ArmPanel(workspace_, this)),
-      modelPanel_(new ModelPanel(workspace_, this)),
-      preprocessDock_(new QDockWidget(tr("Preprocess"), this)),
-      armDock_(new QDockWidget(tr("Arm"), this)),
-      modelDock_(new QDockWidget(tr("Model"), this)) {
+      logPanel_(new LogPanel(workspace_, this)) {
   setObjectName("mainWindow");
   setWindowTitle("FlexArm");
   setAcceptDrops(true);
   setCentralWidget(logPanel_);
-  preprocessDock_->setObjectName("preprocessDock");
-  preprocessDock_->setWidget(preprocessPanel_);
-  armDock_->setObjectName("armDock");
-  armDock_->setWidget(armPanel_);
-  addDockWidget(Qt::RightDockWidgetArea, preprocessDock_);
-  addDockWidget(Qt::RightDockWidgetArea, armDock_);
-  modelDock_->setObjectName("modelDock");
-  modelDock_->setWidget(modelPanel_);
-  addDockWidget(Qt::RightDockWidgetArea, modelDock_);
-  tabifyDockWidget(preprocessDock_, modelDock_);
+  createMenus();
+  // Panels: each a dock on the right, tabbed with the Preprocess panel unless it has its own
+  // place, with a View menu entry and shortcut.
+  preprocessDock_ = addPanel(preprocessPanel_ = new PreprocessPanel(workspace_, this),
+                             tr("Preprocess"), "preprocessDock", "Ctrl+Shift+P", nullptr);
+  armDock_ = addPanel(armPanel_ = new ArmPanel(workspace_, this), tr("Arm"), "armDock",
+                      "Ctrl+Shift+A", nullptr);
+  modelDock_ = addPanel(modelPanel_ = new ModelPanel(workspace_, this), tr("Model"),
+                        "modelDock", "Ctrl+Shift+M", preprocessDock_);
   preprocessDock_->raise();
   resize(1280, 860);
-  createMenus();
 
   QSettings settings;
   restoreGeometry(settings.value("window/geometry").toByteArray());
@@ -172,21 +164,11 @@ void MainWindow::createMenus() {
   data->addSeparator();
   QAction* all = data->addAction(tr("&Show whole log"), logPanel_, &LogPanel::showAll);
   all->setShortcut(QKeySequence("Ctrl+0"));
-  QAction* apply = data->addAction(tr("&Apply preprocessing"), preprocessPanel_, &PreprocessPanel::apply);
+  QAction* apply = data->addAction(tr("&Apply preprocessing"), this, [this] { preprocessPanel_->apply(); });
   apply->setShortcut(QKeySequence("Ctrl+Return"));
-  data->addAction(tr("&Undo preprocessing"), preprocessPanel_, &PreprocessPanel::reset);
+  data->addAction(tr("&Undo preprocessing"), this, [this] { preprocessPanel_->reset(); });
 
-  QMenu* view = menuBar()->addMenu(tr("&View"));
-  QAction* pre = preprocessDock_->toggleViewAction();
-  pre->setShortcut(QKeySequence("Ctrl+Shift+P"));
-  view->addAction(pre);
-  QAction* arm = armDock_->toggleViewAction();
-  arm->setShortcut(QKeySequence("Ctrl+Shift+A"));
-  view->addAction(arm);
-
-  QAction* model = modelDock_->toggleViewAction();
-  model->setShortcut(QKeySequence("Ctrl+Shift+M"));
-  view->addAction(model);
+  viewMenu_ = menuBar()->addMenu(tr("&View"));
 
   QMenu* edit = menuBar()->addMenu(tr("&Edit"));
   QAction* undo = workspace_->undoStack()->createUndoAction(this, tr("&Undo"));
@@ -211,6 +193,19 @@ void MainWindow::createMenus() {
                        tr("<b>FlexArm %1</b><p>Identification, diagnosis and control of "
                           "flexible robot arms.</p>").arg(FLEXARM_VERSION));
   });
+}
+
+QDockWidget* MainWindow::addPanel(QWidget* panel, const QString& title, const char* objectName,
+                                  const QString& shortcut, QDockWidget* tabWith) {
+  auto* dock = new QDockWidget(title, this);
+  dock->setObjectName(objectName);
+  dock->setWidget(panel);
+  addDockWidget(Qt::RightDockWidgetArea, dock);
+  if (tabWith) tabifyDockWidget(tabWith, dock);
+  QAction* toggle = dock->toggleViewAction();
+  toggle->setShortcut(QKeySequence(shortcut));
+  viewMenu_->addAction(toggle);
+  return dock;
 }
 
 void MainWindow::openDialog() {

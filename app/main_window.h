@@ -50,6 +50,10 @@ class MainWindow : public QMainWindow {
 
  private:
   void createMenus();
+  // Puts a panel in a dock on the right (tabbed with tabWith when given) and adds its View
+  // menu entry with the shortcut.
+  QDockWidget* addPanel(QWidget* panel, const QString& title, const char* objectName,
+                        const QString& shortcut, QDockWidget* tabWith);
   void openDialog();
   void exportData();
   void addRecent(const QString& path);
@@ -59,13 +63,14 @@ class MainWindow : public QMainWindow {
 
   Workspace* workspace_;
   LogPanel* logPanel_;
-  PreprocessPanel* preprocessPanel_;
-  ArmPanel* armPanel_;
-  ModelPanel* modelPanel_;
-  QDockWidget* preprocessDock_;
-  QDockWidget* armDock_;
-  QDockWidget* modelDock_;
+  PreprocessPanel* preprocessPanel_ = nullptr;
+  ArmPanel* armPanel_ = nullptr;
+  ModelPanel* modelPanel_ = nullptr;
+  QDockWidget* preprocessDock_ = nullptr;
+  QDockWidget* armDock_ = nullptr;
+  QDockWidget* modelDock_ = nullptr;
   QMenu* recentMenu_ = nullptr;
+  QMenu* viewMenu_ = nullptr;
   QFutureWatcher<LogReadResult> reader_;
   QProgressDialog* progress_ = nullptr;
   QString readingPath_;
