@@ -60,11 +60,14 @@ ModelPanel::ModelPanel(Workspace* workspace, QWidget* parent)
   params_->setObjectName("parameterTable");
   params_->setHorizontalHeaderLabels({tr("Parameter"), tr("Value"), tr("Unit"), tr("Free")});
   params_->verticalHeader()->hide();
-  params_->horizontalHeader()->setSectionResizeMode(QHeaderView::Stretch);
+  params_->horizontalHeader()->setSectionResizeMode(QHeaderView::ResizeToContents);
+  params_->horizontalHeader()->setSectionResizeMode(1, QHeaderView::Stretch);
+  params_->verticalHeader()->setDefaultSectionSize(22);
   effects_->setObjectName("effectTable");
   effects_->setHorizontalHeaderLabels({tr("Effect"), tr("On"), tr("Value 1"), tr("Value 2")});
   effects_->verticalHeader()->hide();
-  effects_->horizontalHeader()->setSectionResizeMode(QHeaderView::Stretch);
+  effects_->horizontalHeader()->setSectionResizeMode(QHeaderView::ResizeToContents);
+  effects_->verticalHeader()->setDefaultSectionSize(22);
   effects_->setRowCount(static_cast<int>(allEffectKinds().size()));
   for (int r = 0; r < effects_->rowCount(); ++r) {
     const EffectKind k = allEffectKinds()[static_cast<std::size_t>(r)];
@@ -113,7 +116,8 @@ ModelPanel::ModelPanel(Workspace* workspace, QWidget* parent)
   auto* split = new QSplitter(Qt::Horizontal, this);
   split->addWidget(left);
   split->addWidget(right);
-  split->setStretchFactor(1, 2);
+  split->setStretchFactor(0, 1);
+  split->setStretchFactor(1, 1);
   auto* simRow = new QHBoxLayout;
   simRow->addWidget(simulate_);
   simRow->addWidget(fit_, 1);

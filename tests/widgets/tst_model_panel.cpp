@@ -1,0 +1,160 @@
+// The Model panel: new model from the list, parameter edits in the table that move the notch
+// and can be undone, effects switched on, and a simulation against a sample log whose truth
+// is the panel's default three-mass model.
+#include <QApplication>
+#include <QRegularExpression>
+#include <QSignalSpy>
+#include <QTableWidget>
+#include <QUndoStack>
+#include <QtTest>
+#include <qcustomplot.h>
+
+#include "app/main_window.h"
+#include "core/io/log_io.h"
+#include "widget_test_support.h"
+#include "widgets/arm/vtk_view.h"
+#include "widgets/model_panel.h"
+#include "widgets/plots/bode_plot.h"
+#include "widgets/plots/pole_zero_plot.h"
+#include "widgets/workspace.h"
+
+using namespace flexarm;
+
+namespace {
+
+// First notch frequency in the panel's "Notches a, b rad/s; ..." text.
+double firstNotch(const QString& text) {
+  const QRegularExpressionMatch m = QRegularExpression("Notches ([0-9.]+)").match(text);
+  return m.hasMatch() ? m.captured(1).toDouble() : -1.0;
+}
+
+int rowOf(QTableWidget* t, const QString& name) {
+  for (int r = 0; r < t->rowCount(); ++r)
+    if (t->item(r, 0)->text() == name) return r;
+  return -1;
+}
+
+}  // namespace
+
+class ModelPanelTest : public QObject {
+  Q_OBJECT
+ private:
+  MainWindow* window_ = nullptr;
+  ModelPanel* panel_ = nullptr;
+  QTableWidget* params_ = nullptr;
+
+ private slots:
+  void initTestCase() {
+    window_ = new MainWindow;
+    window_->resize(1600, 1000);
+    window_->show();
+    QVERIFY(QTest::qWaitForWindowExposed(window_));
+    panel_ = window_->modelPanel();
+    params_ = panel_->findChild<QTableWidget*>("parameterTable");
+    QVERIFY(params_);
+  }
+
+  void newTwoMassModelShowsTable52Notch() {
+    const int i = panel_->newModel("two-mass");
+    QCOMPARE(i, 0);
+    QCOMPARE(static_cast<int>(window_->workspace()->models().size()), 1);
+    QVERIFY(rowOf(params_, "J_a") >= 0);
+    QCOMPARE(params_->item(rowOf(params_, "J_a"), 2)->text(), QString("kg m^2"));
+    // Table 5.2 puts the notch at sqrt(k/J_a) = 112 rad/s (5.4).
+    QVERIFY2(std::abs(firstNotch(panel_->frequencyText()) - 111.8) < 0.5, qPrintable(panel_->frequencyText()));
+    QCOMPARE(panel_->bode()->curveCount(), 1);
+    QCOMPARE(panel_->poleZero()->pointCount(), 3 + 2);  // three poles, two zeros
+  }
+
+  void editingTheTableMovesTheNotchAndUndoRestoresIt() {
+    const int row = rowOf(params_, "k_a");
+    QVERIFY(row >= 0);
+    // Typing into the value cell, as a user would: k_a x 4 doubles the notch frequency.
+    params_->item(row, 1)->setText("600000");
+    QVERIFY2(std::abs(firstNotch(panel_->frequencyText()) - 2 * 111.8) < 1.0, qPrintable(panel_->frequencyText()));
+    QCOMPARE(window_->workspace()->models()[0].model->value("k_a"), 6e5);
+    window_->workspace()->undoStack()->undo();
+    QCOMPARE(window_->workspace()->models()[0].model->value("k_a"), 1.5e5);
+    QVERIFY(std::abs(firstNotch(panel_->frequencyText()) - 111.8) < 0.5);
+    QCOMPARE(params_->item(row, 1)->text(), QString("150000"));
+    window_->workspace()->undoStack()->redo();
+    QCOMPARE(window_->workspace()->models()[0].model->value("k_a"), 6e5);
+    window_->workspace()->undoStack()->undo();
+  }
+
+  void badValuesAreRefused() {
+    const int row = rowOf(params_, "J_m");
+    params_->item(row, 1)->setText("-3");  // below the lower bound
+    QCOMPARE(window_->workspace()->models()[0].model->value("J_m"), 9e-4);
+    params_->item(row, 1)->setText("abc");
+    QCOMPARE(window_->workspace()->models()[0].model->value("J_m"), 9e-4);
+    QVERIFY(params_->toolTip().contains("number"));
+  }
+
+  void freeFlagAndEffectsAreUndoable() {
+    const int row = rowOf(params_, "f_m");
+    const bool before = window_->workspace()->models()[0].model->parameters()[static_cast<std::size_t>(
+        window_->workspace()->models()[0].model->indexOf("f_m"))].free;
+    params_->item(row, 3)->setCheckState(before ? Qt::Unchecked : Qt::Checked);
+    auto freeNow = [&] {
+      const auto& m = *window_->workspace()->models()[0].model;
+      return m.parameters()[static_cast<std::size_t>(m.indexOf("f_m"))].free;
+    };
+    QCOMPARE(freeNow(), !before);
+    window_->workspace()->undoStack()->undo();
+    QCOMPARE(freeNow(), before);
+    auto* effects = panel_->findChild<QTableWidget*>("effectTable");
+    const int backlash = rowOf(effects, "backlash");
+    effects->item(backlash, 1)->setCheckState(Qt::Checked);
+    QCOMPARE(window_->workspace()->models()[0].effects.size(), std::size_t{1});
+    QCOMPARE(window_->workspace()->models()[0].effects[0].kind, EffectKind::Backlash);
+    window_->workspace()->undoStack()->undo();
+    QVERIFY(window_->workspace()->models()[0].effects.empty());
+  }
+
+  void extraMassAddsAResonance() {
+    const int peaksBefore = panel_->frequencyText().section("peaks", 1).count(',') + 1;
+    QVERIFY(panel_->setEffect(EffectKind::ExtraMass, true));
+    const int peaksAfter = panel_->frequencyText().section("peaks", 1).count(',') + 1;
+    QCOMPARE(peaksAfter, peaksBefore + 1);
+    window_->workspace()->undoStack()->undo();
+  }
+
+  void simulatesTheTrueModelAgainstItsLog() {
+    // The chirp sample log was made from the default three-mass model (its truth sidecar).
+    QSignalSpy opened(window_, &MainWindow::logOpened);
+    window_->openFile(QString(FLEXARM_SAMPLE_DIR) + "/three_mass_estimation_chirp.csv");
+    QVERIFY(opened.wait(20000));
+    panel_->newModel("three-mass");
+    QSignalSpy done(panel_, &ModelPanel::simulationFinished);
+    panel_->findChild<QPushButton*>("simulateButton")->click();
+    QVERIFY(done.wait(30000));
+    const double trueFit = done.takeFirst().at(0).toDouble();
+    QVERIFY2(trueFit > 50.0, qPrintable(QString::number(trueFit)));
+    QVERIFY(panel_->findChild<QLabel*>("fitLabel")->text().contains(QString::number(trueFit, 'f', 1)));
+    auto* compare = panel_->findChild<QCustomPlot*>("comparePlot");
+    QCOMPARE(compare->graph(0)->dataCount(), 36000);
+    window_->findChild<QDockWidget*>("modelDock")->raise();
+    QTest::qWait(200);
+    test::saveShot(panel_->grab().toImage(), "model_panel");
+    test::saveShot(window_->grab().toImage(), "main_window_model");
+    // A wrong model (arm inertia four times too large) fits the same log worse.
+    QVERIFY(panel_->setParameter("J_a", 4 * 1.72));
+    panel_->simulateAgainstLog();
+    QVERIFY(done.wait(30000));
+    const double wrongFit = done.takeFirst().at(0).toDouble();
+    QVERIFY2(wrongFit < trueFit - 5.0, qPrintable(QString("%1 vs %2").arg(wrongFit).arg(trueFit)));
+  }
+
+  void cleanupTestCase() { delete window_; }
+};
+
+int main(int argc, char** argv) {
+  VtkView::installDefaultSurfaceFormat();
+  QApplication app(argc, argv);
+  QApplication::setOrganizationName("FlexArmTests");
+  ModelPanelTest t;
+  return QTest::qExec(&t, argc, argv);
+}
+
+#include "tst_model_panel.moc"
