@@ -1,6 +1,8 @@
 // Opens a sample log in the main window, selects ranges by dragging, preprocesses, and
 // checks what the panels show, with screenshots of the window and the Arm dock.
 #include <QApplication>
+#include <QDir>
+#include <QMimeData>
 #include <QSignalSpy>
 #include <QStandardPaths>
 #include <QTableWidget>
@@ -186,6 +188,39 @@ class MainWindowTest : public QObject {
     const QString msg = failed.takeFirst().at(0).toString();
     QVERIFY2(msg.contains("non_numeric.csv:") && msg.contains("column"), qPrintable(msg));
     QCOMPARE(window_->workspace()->current()->samples(), before);
+  }
+
+  void everySampleLogOpens() {
+    const QStringList logs = QDir(FLEXARM_SAMPLE_DIR).entryList({"*.csv"}, QDir::Files);
+    QVERIFY(logs.size() >= 12);
+    for (const QString& name : logs) {
+      QSignalSpy opened(window_, &MainWindow::logOpened);
+      window_->openFile(QString(FLEXARM_SAMPLE_DIR) + "/" + name);
+      QVERIFY2(opened.wait(20000), qPrintable(name));
+      QVERIFY2(window_->logPanel()->channelCount() >= 3, qPrintable(name));
+      QVERIFY(window_->workspace()->current()->input() != nullptr);
+    }
+    // The real DaISy table, with its column mapping given.
+    LogReadOptions table;
+    table.format = LogFormat::Table;
+    QSignalSpy opened(window_, &MainWindow::logOpened);
+    window_->openFile(QString(FLEXARM_SAMPLE_DIR) + "/daisy_robot_arm.dat", table);
+    QVERIFY(opened.wait(20000));
+    QCOMPARE(window_->logPanel()->channelCount(), 2);
+    QCOMPARE(window_->workspace()->current()->samples(), std::size_t{1024});
+  }
+
+  void dropOpensAFile() {
+    QMimeData mime;
+    mime.setUrls({QUrl::fromLocalFile(QString(FLEXARM_SAMPLE_DIR) + "/effect_backlash.csv")});
+    QSignalSpy opened(window_, &MainWindow::logOpened);
+    QDragEnterEvent enter(QPoint(100, 100), Qt::CopyAction, &mime, Qt::LeftButton, Qt::NoModifier);
+    QApplication::sendEvent(window_, &enter);
+    QVERIFY(enter.isAccepted());
+    QDropEvent drop(QPointF(100, 100), Qt::CopyAction, &mime, Qt::LeftButton, Qt::NoModifier);
+    QApplication::sendEvent(window_, &drop);
+    QVERIFY(opened.wait(20000));
+    QVERIFY(opened.takeFirst().at(0).toString().endsWith("effect_backlash.csv"));
   }
 
   void cleanupTestCase() { delete window_; }
