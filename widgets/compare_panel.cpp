@@ -118,7 +118,6 @@ void ComparePanel::refresh() {
     return;
   }
   const bool noValidation = kind == RangeKind::Validation && base->validation.empty();
-  addGraph(*base, base->y, tr("measured"), QPen(QColor(60, 60, 60), 1.0));
   QStringList lines;
   int colour = 0;
   for (std::size_t i = 0; i < list.size(); ++i) {
@@ -149,6 +148,7 @@ void ComparePanel::refresh() {
     lines << tr("%1: fit %2 %%3").arg(list[i].name).arg(fit, 0, 'f', 1)
                  .arg(factor > 1 ? tr(" (at %1 Hz)").arg(1.0 / data->sampleTime, 0, 'g', 4) : QString());
   }
+  addGraph(*base, base->y, tr("measured"), QPen(QColor(20, 20, 20), 1.0));  // on top
   lines.prepend(tr("Fit (5.2) of the simulated output on the %1 data (%2):")
                     .arg(noValidation ? tr("estimation (no validation range set)")
                                       : kind == RangeKind::Validation ? tr("validation") : tr("estimation"),

@@ -122,6 +122,8 @@ FitPanel::FitPanel(Workspace* workspace, QWidget* parent)
   table_->setEditTriggers(QAbstractItemView::NoEditTriggers);
   summary_->setObjectName("fitSummary");
   summary_->setWordWrap(true);
+  summary_->setMinimumHeight(6 * summary_->fontMetrics().lineSpacing());
+  summary_->setAlignment(Qt::AlignLeft | Qt::AlignTop);
   summary_->setTextInteractionFlags(Qt::TextSelectableByMouse);
 
   auto* studyBox = new QGroupBox(tr("Sensitivity study (Section 5.3.3)"), this);
@@ -196,7 +198,9 @@ void FitPanel::refillModels() {
   const int k = model_->findData(keep);
   model_->setCurrentIndex(k >= 0 ? k : 2);
   model_->blockSignals(false);
+  const QStringList ticked = freeParameters();  // the user's choice survives a list change
   refillParameters();
+  if (k >= 0 && !ticked.isEmpty()) setFreeParameters(ticked);
   updateControls();
 }
 

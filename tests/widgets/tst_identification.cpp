@@ -148,11 +148,28 @@ class IdentificationTest : public QObject {
       filled += bode->plot()->plot()->graph(i)->channelFillGraph() != nullptr;
     QVERIFY(filled >= 4);  // magnitude and phase bands of two models
     test::saveShot(bode->grab().toImage(), "bode_panel");
-    // A narrower level gives a narrower band: hide all but the physical estimate.
+    // Only the physical estimate: a lower level gives a narrower band.
     for (int i = 0; i < n; ++i) bode->setModelShown(i, i == physical);
     bode->setNonparametricShown(false, false);
     QCOMPARE(bode->curveNames().size(), 1);
     test::saveShot(bode->grab().toImage(), "bode_panel_three_mass_99");
+    auto bandArea = [bode] {
+      double area = 0.0;
+      QCustomPlot* p = bode->plot()->plot();
+      for (int g = 0; g < p->graphCount(); ++g) {
+        QCPGraph* hi = p->graph(g);
+        if (!hi->channelFillGraph()) continue;
+        for (int i = 0; i < hi->dataCount(); ++i)
+          area += hi->data()->at(i)->value - hi->channelFillGraph()->data()->at(i)->value;
+      }
+      return area;
+    };
+    const double area99 = bandArea();
+    bode->setLevel(0.5);
+    const double area50 = bandArea();
+    QVERIFY2(area99 > 0.0 && area50 < 0.5 * area99,
+             qPrintable(QString("band area %1 at 99 %, %2 at 50 %").arg(area99).arg(area50)));
+    bode->setLevel(0.99);
     QTemporaryDir dir;
     for (const char* ext : {"png", "pdf", "svg"}) {
       const QString path = dir.filePath(QString("bode.%1").arg(ext));
@@ -219,6 +236,7 @@ class IdentificationTest : public QObject {
     fit->setFreeParameters({"J_m", "k_g"});
     fit->setDecimation(10);
     QVERIFY2(clickEstimate(fit), qPrintable(fit->summaryText()));
+    QCOMPARE(fit->freeParameters(), QStringList({"J_m", "k_g"}));  // kept as the list grew
     fit->setStudyRuns(24);
     QSignalSpy done(fit, &FitPanel::studyFinished);
     QTest::mouseClick(fit->findChild<QPushButton*>("studyButton"), Qt::LeftButton);
