@@ -72,6 +72,8 @@ BodePanel::BodePanel(Workspace* workspace, QWidget* parent)
   export_->setObjectName("bodeExportButton");
   note_->setObjectName("bodeNote");
   note_->setWordWrap(true);
+  note_->setMinimumHeight(4 * note_->fontMetrics().lineSpacing());
+  note_->setAlignment(Qt::AlignLeft | Qt::AlignTop);
 
   auto* controls = new QHBoxLayout;
   controls->addWidget(new QLabel(tr("Band level"), this));

@@ -20,6 +20,7 @@
 #include "widgets/bode_panel.h"
 #include "widgets/compare_panel.h"
 #include "widgets/fit_panel.h"
+#include "widgets/model_panel.h"
 #include "widgets/plots/bode_plot.h"
 #include "widgets/residuals_panel.h"
 #include "widgets/workspace.h"
@@ -127,6 +128,12 @@ class IdentificationTest : public QObject {
     QVERIFY(fit->resultsTable()->item(0, 2)->text().toDouble() > 0.0);
     QVERIFY2(fit->summaryText().contains("oe[4 4 1]"), qPrintable(fit->summaryText()));
     test::saveShot(fit->grab().toImage(), "fit_panel_oe");
+    // The Model panel shows a black-box entry without offering physical edits.
+    ModelPanel* mp = window_->modelPanel();
+    mp->selectModel(static_cast<int>(window_->workspace()->models().size()) - 1);
+    QCOMPARE(mp->findChild<QTableWidget*>("parameterTable")->rowCount(), 0);
+    QVERIFY(!mp->findChild<QPushButton*>("simulateButton")->isEnabled());
+    QVERIFY(!mp->setParameter("J_m", 1.0));
   }
 
   void bodeShowsBandsAndNonparametricPoints() {
