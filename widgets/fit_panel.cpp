@@ -510,7 +510,7 @@ void FitPanel::onFinished() {
   out.entry.name = name;
   lines << tr("Added to the model list as \"%1\".").arg(name);
   summary_->setText(lines.join("\n"));
-  last_ = out;
+  if (out.estimate) last_ = out;  // the study runs on the latest physical estimate
   lastIndex_ = workspace_->addModel(out.entry);
   updateControls();
   emit estimated(true);

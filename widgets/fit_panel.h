@@ -123,7 +123,7 @@ class FitPanel : public QWidget {
   QFutureWatcher<StudyOutcome> study_;
   std::shared_ptr<std::atomic<int>> permille_;
   std::shared_ptr<std::atomic<bool>> abort_;
-  Outcome last_;
+  Outcome last_;  // the latest physical estimate (for the study)
   int lastIndex_ = -1;
   int fits_ = 0;
 };

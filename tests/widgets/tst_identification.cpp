@@ -127,6 +127,8 @@ class IdentificationTest : public QObject {
     QCOMPARE(fit->resultsTable()->rowCount(), 8);
     QVERIFY(fit->resultsTable()->item(0, 2)->text().toDouble() > 0.0);
     QVERIFY2(fit->summaryText().contains("oe[4 4 1]"), qPrintable(fit->summaryText()));
+    // The study still has the physical estimate to work on.
+    QVERIFY(fit->findChild<QPushButton*>("studyButton")->isEnabled());
     test::saveShot(fit->grab().toImage(), "fit_panel_oe");
     // The Model panel shows a black-box entry without offering physical edits.
     ModelPanel* mp = window_->modelPanel();
