@@ -29,9 +29,13 @@
 #include "app/cli/cli.h"
 #include "core/io/ranges.h"
 #include "widgets/arm_panel.h"
+#include "widgets/bode_panel.h"
+#include "widgets/compare_panel.h"
+#include "widgets/fit_panel.h"
 #include "widgets/log_panel.h"
 #include "widgets/model_panel.h"
 #include "widgets/preprocess_panel.h"
+#include "widgets/residuals_panel.h"
 #include "widgets/workspace.h"
 
 namespace flexarm {
@@ -110,6 +114,14 @@ MainWindow::MainWindow(QWidget* parent)
                       "Ctrl+Shift+A", nullptr);
   modelDock_ = addPanel(modelPanel_ = new ModelPanel(workspace_, this), tr("Model"),
                         "modelDock", "Ctrl+Shift+M", preprocessDock_);
+  fitDock_ = addPanel(fitPanel_ = new FitPanel(workspace_, this), tr("Fit"), "fitDock",
+                      "Ctrl+Shift+F", preprocessDock_);
+  bodeDock_ = addPanel(bodePanel_ = new BodePanel(workspace_, this), tr("Bode"), "bodeDock",
+                       "Ctrl+Shift+B", preprocessDock_);
+  compareDock_ = addPanel(comparePanel_ = new ComparePanel(workspace_, this), tr("Compare"),
+                          "compareDock", "Ctrl+Shift+C", preprocessDock_);
+  residualsDock_ = addPanel(residualsPanel_ = new ResidualsPanel(workspace_, this),
+                            tr("Residuals"), "residualsDock", "Ctrl+Shift+R", preprocessDock_);
   preprocessDock_->raise();
   resize(1280, 860);
 

@@ -15,9 +15,13 @@ class QProgressDialog;
 namespace flexarm {
 
 class ArmPanel;
+class BodePanel;
+class ComparePanel;
+class FitPanel;
 class LogPanel;
 class ModelPanel;
 class PreprocessPanel;
+class ResidualsPanel;
 class Workspace;
 
 class MainWindow : public QMainWindow {
@@ -37,6 +41,10 @@ class MainWindow : public QMainWindow {
   PreprocessPanel* preprocessPanel() const { return preprocessPanel_; }
   ArmPanel* armPanel() const { return armPanel_; }
   ModelPanel* modelPanel() const { return modelPanel_; }
+  FitPanel* fitPanel() const { return fitPanel_; }
+  BodePanel* bodePanel() const { return bodePanel_; }
+  ComparePanel* comparePanel() const { return comparePanel_; }
+  ResidualsPanel* residualsPanel() const { return residualsPanel_; }
   QStringList recentFiles() const;
 
  signals:
@@ -69,6 +77,14 @@ class MainWindow : public QMainWindow {
   QDockWidget* preprocessDock_ = nullptr;
   QDockWidget* armDock_ = nullptr;
   QDockWidget* modelDock_ = nullptr;
+  FitPanel* fitPanel_ = nullptr;
+  BodePanel* bodePanel_ = nullptr;
+  ComparePanel* comparePanel_ = nullptr;
+  ResidualsPanel* residualsPanel_ = nullptr;
+  QDockWidget* fitDock_ = nullptr;
+  QDockWidget* bodeDock_ = nullptr;
+  QDockWidget* compareDock_ = nullptr;
+  QDockWidget* residualsDock_ = nullptr;
   QMenu* recentMenu_ = nullptr;
   QMenu* viewMenu_ = nullptr;
   QFutureWatcher<LogReadResult> reader_;

@@ -1,6 +1,9 @@
 // Output-error fitting speed: FlexArm against scipy.optimize.least_squares on the same
-// simulated data and start, in one run. Two problems: a polynomial OE [2 2 1] (4.8) and the
-// two-mass physical model (3.13) with ZOH simulation. Prints the time ratio and both losses.
+// simulated data and start, in one run. Three problems: a polynomial OE [2 2 1] (4.8), the
+// two-mass physical model (3.13) and the three-mass model (3.21) with ZOH simulation, the
+// last on closed-loop simulator data (Table 5.7 p6 truth, the chirp of Section 5.1, motor
+// velocity by central differences, decimated to the seed's 200 Hz). Prints the time ratio and
+// both losses.
 //
 //   cmake --build BUILD --target bench && BUILD/bench/bench_ident_oe
 #include <algorithm>
@@ -19,6 +22,10 @@
 #include "core/ident/blackbox.h"
 #include "core/ident/pem.h"
 #include "core/ident/sensitivity.h"
+#include "core/ident/nonparametric.h"
+#include "core/models/physical_models.h"
+#include "core/signal/preprocess.h"
+#include "core/sim/closed_loop.h"
 #include "tests/core/ident/sim_helpers.h"
 #include "tests/core/ident/two_mass_test_model.h"
 
@@ -68,6 +75,28 @@ int main() {
   const char* names[] = {"J_m", "J_a", "f_m", "k", "d"};
   for (int i = 0; i < 5; ++i) m0.setParameter(names[i], s2[i]);
 
+  // Three-mass data: the closed loop of Figure 5.1 around the p6 truth, decimated by ten.
+  SimulationOptions so;
+  so.durationS = 18.0;
+  so.seed = 1;
+  const auto sim = simulateClosedLoop(*makeModel("three-mass"), {}, so);
+  DecimateOptions dec;
+  dec.factor = 10;
+  const IdData d3 = decimate(addDerivative(sim.data), dec);
+  Eigen::VectorXd u3, y3;
+  inputOutput(d3, u3, y3);
+  u3.array() -= u3.mean();
+  y3.array() -= y3.mean();
+  const double ts3 = d3.sampleTime;
+  auto m3 = makeModel("three-mass");
+  const char* names3[] = {"J_m", "J_g", "J_a", "f_m", "k_g", "k_a", "d_g", "d_a"};
+  const double factors3[] = {1.2, 0.8, 1.15, 1.3, 0.85, 1.1, 0.8, 1.25};
+  std::vector<double> s3;
+  for (int i = 0; i < 8; ++i) {
+    s3.push_back(m3->value(names3[i]) * factors3[i]);
+    m3->setParameter(names3[i], s3.back());
+  }
+
   const auto dir = std::filesystem::temp_directory_path() / "flexarm_bench_ident_oe";
   std::filesystem::create_directories(dir);
   {
@@ -80,7 +109,13 @@ int main() {
     s.precision(17);
     s << "{\"poly\": [0.8, 0.3, -1.2, 0.5], \"two_mass\": [" << s2[0] << ", " << s2[1] << ", "
       << s2[2] << ", " << s2[3] << ", " << s2[4] << "], \"r\": " << 1.0 / 120.0
-      << ", \"ts\": " << ts << "}\n";
+      << ", \"ts\": " << ts << ", \"three_mass\": [";
+    for (std::size_t i = 0; i < s3.size(); ++i) s << (i ? ", " : "") << s3[i];
+    s << "], \"r3\": " << m3->value("r") << ", \"ts3\": " << ts3 << "}\n";
+    std::ofstream d3f(dir / "three_mass.csv");
+    d3f.precision(17);
+    d3f << "u,y\n";
+    for (Eigen::Index t = 0; t < u3.size(); ++t) d3f << u3[t] << "," << y3[t] << "\n";
   }
 
   PolyEstimate rp;
@@ -91,6 +126,8 @@ int main() {
   PemOptions pe;
   pe.relativeTolerance = 1e-12;
   const double tPhys = secondsOf([&] { r2 = pem(m0, u2, y2, ts, pe); }, 5);
+  PemResult r3;
+  const double tThree = secondsOf([&] { r3 = pem(*m3, u3, y3, ts3, pe); }, 3);
   // The loss as SciPy computes it: mean squared error over all samples.
   const double lossPoly = predictionErrors(rp.model, poly.u, poly.y).squaredNorm() / n;
   const double lossPhys = r2.summary.loss;
@@ -103,16 +140,21 @@ int main() {
     return 1;
   }
   std::ifstream in(dir / "scipy.txt");
-  std::string line1, line2;
+  std::string line1, line2, line3;
   std::getline(in, line1);
   std::getline(in, line2);
+  std::getline(in, line3);
   const double spPolyT = std::stod(field(line1, "seconds")), spPolyL = std::stod(field(line1, "loss"));
   const double spPhysT = std::stod(field(line2, "seconds")), spPhysL = std::stod(field(line2, "loss"));
+  const double spThreeT = std::stod(field(line3, "seconds")), spThreeL = std::stod(field(line3, "loss"));
   std::printf("problem    samples  flexarm_s   scipy_s    ratio  flexarm_loss   scipy_loss  iters\n");
   std::printf("oe[2 2 1]  %7ld  %9.5f  %8.5f  %7.1f  %12.6g  %11.6g  %5d\n", static_cast<long>(n),
               tPoly, spPolyT, spPolyT / tPoly, lossPoly, spPolyL, rp.summary.iterations);
   std::printf("two-mass   %7ld  %9.5f  %8.5f  %7.1f  %12.6g  %11.6g  %5d\n", static_cast<long>(n),
               tPhys, spPhysT, spPhysT / tPhys, lossPhys, spPhysL, r2.summary.iterations);
+  std::printf("three-mass %7ld  %9.5f  %8.5f  %7.1f  %12.6g  %11.6g  %5d\n",
+              static_cast<long>(u3.size()), tThree, spThreeT, spThreeT / tThree,
+              r3.summary.loss, spThreeL, r3.summary.iterations);
   std::printf("(ratio = SciPy seconds / FlexArm seconds; medians of FlexArm repeats; SciPy times\n"
               " the least_squares call only, with finite-difference Jacobians, method 'lm')\n");
 

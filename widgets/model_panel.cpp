@@ -18,16 +18,12 @@
 #include "core/models/analysis.h"
 #include "core/models/nonlinear_plant.h"
 #include "core/signal/preprocess.h"
+#include "widgets/ident_data.h"
 #include "widgets/plots/bode_plot.h"
 #include "widgets/plots/pole_zero_plot.h"
 
 namespace flexarm {
 namespace {
-
-std::shared_ptr<PhysicalModel> cloneModel(const PhysicalModel& m) {
-  std::unique_ptr<ParametricModel> c = m.clone();
-  return std::shared_ptr<PhysicalModel>(static_cast<PhysicalModel*>(c.release()));
-}
 
 QString modesText(const std::vector<Mode>& modes) {
   QStringList parts;
@@ -192,6 +188,14 @@ void ModelPanel::refreshModel() {
     return;
   }
   const ModelEntry& entry = workspace_->models()[static_cast<std::size_t>(current_)];
+  if (!entry.model) {  // a black-box estimate: nothing physical to edit here
+    simulate_->setEnabled(false);
+    description_->setText(tr("%1 is a black-box estimate: the Bode, Compare and Residuals "
+                             "panels show it.").arg(entry.name));
+    frequencies_->clear();
+    filling_ = false;
+    return;
+  }
   const PhysicalModel& m = *entry.model;
   description_->setText(QString::fromStdString(m.description()));
   const auto& ps = m.parameters();
@@ -236,7 +240,7 @@ void ModelPanel::refreshModel() {
   // Linear analysis of the model with the velocity output (structural effects applied).
   try {
     ModelOptions velocity;
-    std::shared_ptr<PhysicalModel> linear = cloneModel(m);
+    std::shared_ptr<PhysicalModel> linear = clonePhysical(m);
     linear->setOptions(velocity);
     StateSpace sys = linear->stateSpace();
     for (const auto& e : entry.effects)
@@ -262,7 +266,8 @@ QString ModelPanel::frequencyText() const { return frequencies_->text(); }
 bool ModelPanel::setParameter(const QString& name, double value, QString* why) {
   if (current_ < 0) return false;
   ModelEntry entry = workspace_->models()[static_cast<std::size_t>(current_)];
-  auto copy = cloneModel(*entry.model);
+  if (!entry.model) return false;
+  auto copy = clonePhysical(*entry.model);
   try {
     copy->setParameter(name.toStdString(), value);
   } catch (const std::exception& e) {
@@ -271,6 +276,8 @@ bool ModelPanel::setParameter(const QString& name, double value, QString* why) {
     return false;
   }
   entry.model = copy;
+  entry.covariance.resize(0, 0);  // the estimate's covariance no longer describes it
+  entry.covarianceIndices.clear();
   workspace_->replaceModel(current_, entry, tr("set %1 = %2").arg(name).arg(value));
   return true;
 }
@@ -278,6 +285,7 @@ bool ModelPanel::setParameter(const QString& name, double value, QString* why) {
 bool ModelPanel::setEffect(EffectKind kind, bool on, double firstValue) {
   if (current_ < 0) return false;
   ModelEntry entry = workspace_->models()[static_cast<std::size_t>(current_)];
+  if (!entry.model) return false;
   std::vector<Effect> effects;
   for (const auto& e : entry.effects)
     if (e.kind != kind) effects.push_back(e);
@@ -300,7 +308,8 @@ bool ModelPanel::setEffect(EffectKind kind, bool on, double firstValue) {
 }
 
 void ModelPanel::onParameterEdited(int row, int column) {
-  if (filling_ || current_ < 0) return;
+  if (filling_ || current_ < 0 || !workspace_->models()[static_cast<std::size_t>(current_)].model)
+    return;
   const auto& ps = workspace_->models()[static_cast<std::size_t>(current_)].model->parameters();
   const QString name = QString::fromStdString(ps[static_cast<std::size_t>(row)].name);
   if (column == 1) {
@@ -315,7 +324,7 @@ void ModelPanel::onParameterEdited(int row, int column) {
     }
   } else if (column == 3) {
     ModelEntry entry = workspace_->models()[static_cast<std::size_t>(current_)];
-    auto copy = cloneModel(*entry.model);
+    auto copy = clonePhysical(*entry.model);
     const bool free = params_->item(row, 3)->checkState() == Qt::Checked;
     copy->setFree(name.toStdString(), free);
     entry.model = copy;
@@ -339,6 +348,7 @@ void ModelPanel::onEffectEdited(int row, int column) {
 void ModelPanel::simulateAgainstLog() {
   const IdData* data = workspace_->current();
   if (current_ < 0 || !data || isSimulating()) return;
+  if (!workspace_->models()[static_cast<std::size_t>(current_)].model) return;
   const Channel* torque = data->channel(columns::kTorqueRef);
   if (!torque && data->input()) torque = data->input();
   const Channel* velocity = data->channel(columns::kMotorVelocity);

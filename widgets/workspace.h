@@ -7,6 +7,7 @@
 #include <memory>
 #include <optional>
 
+#include "core/ident/blackbox.h"
 #include "core/models/effects.h"
 #include "core/models/physical_models.h"
 #include "core/signal/id_data.h"
@@ -24,11 +25,18 @@ struct TimeRange {
 };
 
 // A model in the shared model list: a physical model (its parameters, free/fixed flags and
-// output options) and the nonlinear effects switched on for it.
+// output options) and the nonlinear effects switched on for it, or a black-box estimate.
 struct ModelEntry {
   QString name;
-  std::shared_ptr<const PhysicalModel> model;
+  std::shared_ptr<const PhysicalModel> model;  // null for a black-box estimate
   std::vector<Effect> effects;
+  // A black-box estimate (4.8) with its covariance; set exactly when model is null.
+  std::shared_ptr<const PolynomialModel> polynomial;
+  // For a physical estimate: covariance of the free parameters (indices into
+  // model->parameters()) that gives its confidence bands. Empty for a hand-made model; an
+  // edit of the parameters clears it.
+  Eigen::MatrixXd covariance;
+  std::vector<int> covarianceIndices;
 };
 
 class Workspace : public QObject {

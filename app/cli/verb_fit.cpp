@@ -294,6 +294,11 @@ int prepareAndFit(ArgParser& args, const std::string& verb, FitOutcome& out, std
   }
   out.uVal.array() -= uMean;
   out.yVal.array() -= yMean;
+  if (!out.spec.nonparametric && (out.uEst.array() - out.uEst.mean()).abs().maxCoeff() == 0.0) {
+    err << pre << "the fit failed: the input is constant over the estimation range, so the "
+                  "data say nothing about the system\n";
+    return kExitNumerical;
+  }
 
   if (out.spec.nonparametric) {
     if (out.spec.spa) {

@@ -75,8 +75,14 @@ double fitLoss(const ParametricModel& start, const Eigen::VectorXd& u, const Eig
   o.randomStarts = 0;
   o.notchPeakStarts = 0;
   o.userStarts.clear();
-  const PemResult r = pem(start, u, y, T, o);
-  return r.summary.ok() ? r.summary.loss : INFINITY;
+  // A search that steps outside a parameter's bounds throws; from a random start that is a
+  // failed fit, and it must not leave a worker thread through an exception.
+  try {
+    const PemResult r = pem(start, u, y, T, o);
+    return r.summary.ok() ? r.summary.loss : INFINITY;
+  } catch (const std::invalid_argument&) {
+    return INFINITY;
+  }
 }
 
 }  // namespace

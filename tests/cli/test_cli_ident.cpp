@@ -1,0 +1,190 @@
+// The identification verbs fit and bode, end to end through the executable: black-box fits of
+// the real DaISy arm, physical fits of a simulator log against its truth sidecar, the Bode CSV
+// with its band columns, and the exit codes of bad requests.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+#include "cli_test_support.h"
+
+using flexarm::test::readAll;
+using flexarm::test::runFlexarm;
+using flexarm::test::scratchDir;
+using nlohmann::json;
+
+namespace {
+
+const std::string kDaisy = std::string(FLEXARM_SAMPLE_DIR) + "/daisy_robot_arm.dat";
+const std::string kChirp = std::string(FLEXARM_SAMPLE_DIR) + "/three_mass_estimation_chirp.csv";
+const std::vector<std::string> kDaisyColumns = {"--input-column", "1", "--output-column", "2"};
+
+std::vector<std::string> daisy(std::vector<std::string> args) {
+  args.insert(args.begin() + 1, kDaisy);
+  args.insert(args.end(), kDaisyColumns.begin(), kDaisyColumns.end());
+  return args;
+}
+
+// The chirp log with the motor velocity (central differences) as output, made once.
+const std::string& velocityLog() {
+  static const std::string path = [] {
+    const std::string p = (scratchDir() / "chirp_velocity.csv").string();
+    const auto r = runFlexarm({"preprocess", kChirp, "--differentiate", "--out", p});
+    EXPECT_EQ(r.code, 0) << r.err;
+    return p;
+  }();
+  return path;
+}
+
+// Truth values of the sidecar's parameters by name.
+std::map<std::string, double> truth() {
+  const json j = json::parse(readAll(std::string(FLEXARM_SAMPLE_DIR) +
+                                     "/three_mass_estimation_chirp.truth.json"));
+  std::map<std::string, double> t;
+  for (const auto& p : j["model"]["parameters"]) t[p["name"]] = p["value"].get<double>();
+  return t;
+}
+
+}  // namespace
+
+TEST(CliIdent, FitBlackBoxOnTheDaisyArmReportsParametersStdAndFit) {
+  // Estimation on samples 0..699 (time = sample index), validation on the rest.
+  const auto r = runFlexarm(daisy({"fit", "--model", "oe:6,6,1", "--range", "0:699",
+                                   "--validation-range", "700:1023", "--json"}));
+  ASSERT_EQ(r.code, 0) << r.err;
+  const json j = json::parse(r.out);
+  EXPECT_EQ(j["model"], "oe[6 6 1]");
+  EXPECT_EQ(j["parameters"].size(), 12u);
+  for (auto it = j["std"].begin(); it != j["std"].end(); ++it) {
+    ASSERT_TRUE(it.value().is_number()) << it.key();
+    EXPECT_GT(it.value().get<double>(), 0.0) << it.key();
+  }
+  EXPECT_GT(j["fit_percent"].get<double>(), 90.0);
+  EXPECT_GT(j["fit_percent_validation"].get<double>(), 90.0);
+  EXPECT_GT(j["loss"].get<double>(), 0.0);
+  EXPECT_GE(j["peaks_rad_s"].size(), 1u);  // a flexible arm
+  EXPECT_EQ(j["samples_estimation"].get<int>(), 700);
+  EXPECT_FALSE(j["closed_loop"].get<bool>());
+
+  // ARX and BJ of the same data: a higher-order structure with a noise model fits at least as
+  // well on the estimation data as the plain equation-error ARX of the same B and A/F orders.
+  const auto a = runFlexarm(daisy({"fit", "--model", "arx:6,6,1", "--range", "0:699", "--json"}));
+  const auto b = runFlexarm(daisy({"fit", "--model", "bj:6,2,2,6,1", "--range", "0:699",
+                                   "--json"}));
+  ASSERT_EQ(a.code, 0) << a.err;
+  ASSERT_EQ(b.code, 0) << b.err;
+  EXPECT_GT(json::parse(b.out)["fit_percent"].get<double>(), 90.0);
+  EXPECT_EQ(json::parse(a.out)["termination"], "converged");
+}
+
+TEST(CliIdent, FitPhysicalWithFreeAndFixedParametersOnTheSampleLog) {
+  const auto t = truth();
+  // Estimate the three inertias and the two springs; hold friction and damping at the truth
+  // (d_g given explicitly by --fix, as the seed's p1 holds d = 0).
+  const std::string fixDg = "d_g=" + std::to_string(t.at("d_g"));
+  const auto r = runFlexarm({"fit", velocityLog(), "--model", "three-mass", "--free",
+                             "J_m,J_g,J_a,k_g,k_a", "--fix", fixDg, "--json"});
+  ASSERT_EQ(r.code, 0) << r.err;
+  const json j = json::parse(r.out);
+  EXPECT_EQ(j["model"], "three-mass (K = 0)");
+  for (const char* p : {"J_m", "J_g", "J_a", "k_g", "k_a"}) {
+    const double v = j["parameters"][p].get<double>(), s = j["std"][p].get<double>();
+    EXPECT_GT(s, 0.0) << p;
+    // Within 10 % of the truth: the log is closed loop, so output error is biased by the
+    // noise fed back into the input (4.43); on this log the bias is 1-8 %, far beyond the
+    // 99 % intervals (tests/core/ident/test_three_mass_fit.cpp measures it).
+    EXPECT_NEAR(v / t.at(p), 1.0, 0.10) << p << " = " << v << " +- " << s << ", truth " << t.at(p);
+  }
+  EXPECT_DOUBLE_EQ(j["parameters"]["d_g"].get<double>(), t.at("d_g"));
+  EXPECT_EQ(j["std"]["d_g"].get<double>(), 0.0);
+  EXPECT_EQ(j["std"]["f_m"].get<double>(), 0.0);  // not in --free: held at the nominal value
+  EXPECT_GT(j["fit_percent"].get<double>(), 80.0);
+  EXPECT_EQ(j["notches_rad_s"].size(), 2u);  // three masses: two resonances
+  EXPECT_EQ(j["peaks_rad_s"].size(), 2u);
+  EXPECT_TRUE(j["closed_loop"].get<bool>());
+}
+
+TEST(CliIdent, BodeWritesMagnitudePhaseAndBandLimits) {
+  const std::string out = (scratchDir() / "bode_oe.csv").string();
+  const auto r = runFlexarm(daisy({"bode", "--model", "oe:6,6,1", "--range", "0:699", "--out",
+                                   out, "--points", "200", "--level", "0.95", "--json"}));
+  ASSERT_EQ(r.code, 0) << r.err;
+  const json j = json::parse(r.out);
+  EXPECT_TRUE(j["bands"].get<bool>());
+  EXPECT_EQ(j["points"].get<int>(), 200);
+  std::istringstream csv(readAll(out));
+  std::string line;
+  std::getline(csv, line);
+  EXPECT_EQ(line, "omega_rad_s,frequency_hz,magnitude,magnitude_db,phase_deg,magnitude_lower,"
+                  "magnitude_upper,phase_lower_deg,phase_upper_deg");
+  int rows = 0;
+  double lastW = 0.0;
+  while (std::getline(csv, line)) {
+    std::vector<double> v;
+    std::stringstream ss(line);
+    std::string cell;
+    while (std::getline(ss, cell, ',')) v.push_back(std::stod(cell));
+    ASSERT_EQ(v.size(), 9u) << line;
+    EXPECT_GT(v[0], lastW);
+    lastW = v[0];
+    EXPECT_NEAR(v[1], v[0] / (2 * M_PI), 1e-9 * v[0]);
+    EXPECT_NEAR(v[3], 20 * std::log10(v[2]), 1e-6);
+    EXPECT_LE(v[5], v[2]);
+    EXPECT_GE(v[6], v[2]);
+    EXPECT_LE(v[7], v[4]);
+    EXPECT_GE(v[8], v[4]);
+    ++rows;
+  }
+  EXPECT_EQ(rows, 200);
+  EXPECT_NEAR(lastW, M_PI, 1e-6);  // up to the Nyquist frequency (T = 1)
+
+  // ETFE has no confidence region: the band columns stay empty.
+  const std::string outE = (scratchDir() / "bode_etfe.csv").string();
+  const auto e = runFlexarm(daisy({"bode", "--model", "etfe:8", "--out", outE, "--points", "50"}));
+  ASSERT_EQ(e.code, 0) << e.err;
+  std::istringstream csvE(readAll(outE));
+  std::getline(csvE, line);
+  std::getline(csvE, line);
+  EXPECT_EQ(line.substr(line.size() - 4), ",,,,");
+}
+
+TEST(CliIdent, BadRequestsExitWithUsageBadInputOrNumericalCodes) {
+  // 2: usage.
+  auto r = runFlexarm(daisy({"fit", "--model", "oe:6,6"}));
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("needs 3 comma-separated integers"), std::string::npos) << r.err;
+  r = runFlexarm(daisy({"fit", "--model", "arx:2,2,1", "--free", "k_g"}));
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("physical models only"), std::string::npos) << r.err;
+  r = runFlexarm({"fit", kChirp, "--model", "three-mass", "--free", "J_x"});
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("no parameter 'J_x'"), std::string::npos) << r.err;
+  r = runFlexarm({"fit", kChirp, "--model", "three-mass", "--fix", "k_g"});
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("NAME=VALUE"), std::string::npos) << r.err;
+  EXPECT_EQ(runFlexarm(daisy({"bode", "--model", "arx:2,2,1"})).code, 2) << "--out missing";
+  EXPECT_EQ(runFlexarm(daisy({"bode", "--model", "arx:2,2,1", "--out", "/tmp/x.csv", "--level",
+                              "1.5"})).code, 2);
+
+  // 3: bad input (a missing log, an unwritable output file).
+  r = runFlexarm({"fit", "/no/such/log.csv", "--model", "arx:2,2,1"});
+  EXPECT_EQ(r.code, 3);
+  EXPECT_NE(r.err.find("/no/such/log.csv"), std::string::npos) << r.err;
+  r = runFlexarm(daisy({"bode", "--model", "arx:2,2,1", "--out", "/no/such/dir/b.csv"}));
+  EXPECT_EQ(r.code, 3);
+
+  // 4: numerical failure. A log whose input is constant zero carries no information.
+  const std::string flat = (scratchDir() / "flat.dat").string();
+  {
+    std::ofstream f(flat);
+    for (int i = 0; i < 400; ++i) f << 0.0 << " " << std::sin(0.1 * i) << "\n";
+  }
+  r = runFlexarm({"fit", flat, "--input-column", "1", "--output-column", "2", "--model",
+                  "oe:2,2,1"});
+  EXPECT_EQ(r.code, 4) << r.out << r.err;
+  EXPECT_NE(r.err.find("fit failed"), std::string::npos) << r.err;
+}

@@ -1,0 +1,272 @@
+// The identification panels in the main window: opens the chirp sample log (three-mass truth,
+// closed loop), sets estimation and validation ranges, clicks Estimate for a physical and a
+// black-box model, and checks the results table, the shared model list, the Bode bands, the
+// Compare fits, the residual tests, Cancel and the sensitivity study; screenshots of every
+// panel.
+#include <QApplication>
+#include <QDockWidget>
+#include <QListWidget>
+#include <QPushButton>
+#include <QSignalSpy>
+#include <QTableWidget>
+#include <QTemporaryDir>
+#include <QtTest>
+#include <qcustomplot.h>
+
+#include "app/main_window.h"
+#include "core/models/physical_models.h"
+#include "widget_test_support.h"
+#include "widgets/arm/vtk_view.h"
+#include "widgets/bode_panel.h"
+#include "widgets/compare_panel.h"
+#include "widgets/fit_panel.h"
+#include "widgets/model_panel.h"
+#include "widgets/plots/bode_plot.h"
+#include "widgets/residuals_panel.h"
+#include "widgets/workspace.h"
+
+using namespace flexarm;
+
+namespace {
+const QString kSampleLog = QString(FLEXARM_SAMPLE_DIR) + "/three_mass_estimation_chirp.csv";
+
+// Waits until the panel's Estimate has finished and returns whether it succeeded.
+bool clickEstimate(FitPanel* fit) {
+  QSignalSpy done(fit, &FitPanel::estimated);
+  QTest::mouseClick(fit->findChild<QPushButton*>("estimateButton"), Qt::LeftButton);
+  if (!done.wait(120000)) return false;
+  return done.takeFirst().at(0).toBool();
+}
+}  // namespace
+
+class IdentificationTest : public QObject {
+  Q_OBJECT
+ private:
+  MainWindow* window_ = nullptr;
+
+  void showDock(const char* name) {
+    auto* dock = window_->findChild<QDockWidget*>(name);
+    QVERIFY(dock);
+    dock->show();
+    dock->raise();
+    QTest::qWait(150);
+  }
+
+ private slots:
+  void initTestCase() {
+    window_ = new MainWindow;
+    window_->resize(1500, 1000);
+    window_->show();
+    QVERIFY(QTest::qWaitForWindowExposed(window_));
+    QSignalSpy opened(window_, &MainWindow::logOpened);
+    window_->openFile(kSampleLog);
+    QVERIFY(opened.wait(30000));
+    // Estimation on the chirp's first 9 s, validation on the rest (a different part of the
+    // sweep: lower frequencies).
+    window_->workspace()->setRange(RangeKind::Estimation, {0.5, 9.0});
+    window_->workspace()->setRange(RangeKind::Validation, {9.0, 17.5});
+  }
+
+  void physicalFitFillsTheTableAndJoinsTheList() {
+    FitPanel* fit = window_->fitPanel();
+    showDock("fitDock");
+    QVERIFY(fit->setModelChoice("three-mass"));
+    fit->setFreeParameters({"J_m", "J_a", "k_g", "k_a", "d_a"});
+    fit->setDecimation(10);
+    const std::size_t before = window_->workspace()->models().size();
+    QVERIFY2(clickEstimate(fit), qPrintable(fit->summaryText()));
+    QCOMPARE(window_->workspace()->models().size(), before + 1);
+    QCOMPARE(fit->lastModelIndex(), static_cast<int>(before));
+    const ModelEntry& e = window_->workspace()->models().back();
+    QVERIFY(e.model != nullptr);
+    QCOMPARE(e.covariance.rows(), 5);
+
+    QTableWidget* t = fit->resultsTable();
+    QCOMPARE(t->rowCount(), static_cast<int>(makeModel("three-mass")->parameters().size()));
+    int freeRows = 0;
+    for (int r = 0; r < t->rowCount(); ++r) {
+      if (t->item(r, 2)->text() == "fixed") continue;
+      ++freeRows;
+      bool ok = false;
+      const double v = t->item(r, 1)->text().toDouble(&ok);
+      QVERIFY(ok);
+      const double s = t->item(r, 2)->text().toDouble(&ok);
+      QVERIFY2(ok && s > 0.0, qPrintable(t->item(r, 0)->text() + " std " + t->item(r, 2)->text()));
+      const double lo = t->item(r, 3)->text().toDouble(), hi = t->item(r, 4)->text().toDouble();
+      QVERIFY(lo < v && v < hi);
+      QVERIFY(std::abs((hi - lo) / 2 - 2.576 * s) < 0.01 * s + 1e-12 * std::abs(v));
+      // The inertias and springs stay within a factor of two of the truth (Table 5.7 p6).
+      const std::string name = t->item(r, 0)->text().toStdString();
+      if (name != "d_a") {
+        const double truth = makeModel("three-mass")->value(name);
+        QVERIFY2(v > 0.5 * truth && v < 2.0 * truth, qPrintable(QString::fromStdString(name)));
+      }
+    }
+    QCOMPARE(freeRows, 5);
+    const QString s = fit->summaryText();
+    QVERIFY2(s.contains("% on the estimation data") && s.contains("% on the validation data"),
+             qPrintable(s));
+    QVERIFY2(s.contains("Notches: ") && s.contains("rad/s"), qPrintable(s));
+    test::saveShot(fit->grab().toImage(), "fit_panel_three_mass");
+  }
+
+  void blackBoxFitJoinsTheListToo() {
+    FitPanel* fit = window_->fitPanel();
+    QVERIFY(fit->setModelChoice("oe"));
+    PolyOrders o;
+    o.nb = 4;
+    o.nf = 4;
+    o.nk = 1;
+    fit->setOrders(o);
+    fit->setDecimation(10);
+    QVERIFY2(clickEstimate(fit), qPrintable(fit->summaryText()));
+    const ModelEntry& e = window_->workspace()->models().back();
+    QVERIFY(e.model == nullptr);
+    QVERIFY(e.polynomial != nullptr);
+    QCOMPARE(e.polynomial->sampleTime, 0.005);
+    QCOMPARE(fit->resultsTable()->rowCount(), 8);
+    QVERIFY(fit->resultsTable()->item(0, 2)->text().toDouble() > 0.0);
+    QVERIFY2(fit->summaryText().contains("oe[4 4 1]"), qPrintable(fit->summaryText()));
+    // The study still has the physical estimate to work on.
+    QVERIFY(fit->findChild<QPushButton*>("studyButton")->isEnabled());
+    test::saveShot(fit->grab().toImage(), "fit_panel_oe");
+    // The Model panel shows a black-box entry without offering physical edits.
+    ModelPanel* mp = window_->modelPanel();
+    mp->selectModel(static_cast<int>(window_->workspace()->models().size()) - 1);
+    QCOMPARE(mp->findChild<QTableWidget*>("parameterTable")->rowCount(), 0);
+    QVERIFY(!mp->findChild<QPushButton*>("simulateButton")->isEnabled());
+    QVERIFY(!mp->setParameter("J_m", 1.0));
+  }
+
+  void bodeShowsBandsAndNonparametricPoints() {
+    BodePanel* bode = window_->bodePanel();
+    showDock("bodeDock");
+    bode->setNonparametricShown(true, false);
+    const QStringList names = bode->curveNames();
+    const int n = static_cast<int>(window_->workspace()->models().size());
+    QCOMPARE(names.size(), n + 1);  // every model and SPA
+    const int physical = n - 2;      // the three-mass estimate
+    QVERIFY2(names[physical].contains("three-mass"), qPrintable(names.join(", ")));
+    QVERIFY(bode->curveHasBand(physical));
+    QVERIFY(bode->curveHasBand(n - 1));  // OE with its covariance
+    QVERIFY(!bode->curveHasBand(n));     // SPA drawn as points
+    QVERIFY2(bode->noteText().contains("closed loop"), qPrintable(bode->noteText()));
+    // A band is drawn: some graph of the plot has a filled channel.
+    int filled = 0;
+    for (int i = 0; i < bode->plot()->plot()->graphCount(); ++i)
+      filled += bode->plot()->plot()->graph(i)->channelFillGraph() != nullptr;
+    QVERIFY(filled >= 4);  // magnitude and phase bands of two models
+    test::saveShot(bode->grab().toImage(), "bode_panel");
+    // Only the physical estimate: a lower level gives a narrower band.
+    for (int i = 0; i < n; ++i) bode->setModelShown(i, i == physical);
+    bode->setNonparametricShown(false, false);
+    QCOMPARE(bode->curveNames().size(), 1);
+    test::saveShot(bode->grab().toImage(), "bode_panel_three_mass_99");
+    auto bandArea = [bode] {
+      double area = 0.0;
+      QCustomPlot* p = bode->plot()->plot();
+      for (int g = 0; g < p->graphCount(); ++g) {
+        QCPGraph* hi = p->graph(g);
+        if (!hi->channelFillGraph()) continue;
+        for (int i = 0; i < hi->dataCount(); ++i)
+          area += hi->data()->at(i)->value - hi->channelFillGraph()->data()->at(i)->value;
+      }
+      return area;
+    };
+    const double area99 = bandArea();
+    bode->setLevel(0.5);
+    const double area50 = bandArea();
+    QVERIFY2(area99 > 0.0 && area50 < 0.5 * area99,
+             qPrintable(QString("band area %1 at 99 %, %2 at 50 %").arg(area99).arg(area50)));
+    bode->setLevel(0.99);
+    QTemporaryDir dir;
+    for (const char* ext : {"png", "pdf", "svg"}) {
+      const QString path = dir.filePath(QString("bode.%1").arg(ext));
+      QString why;
+      QVERIFY2(bode->exportTo(path, &why), qPrintable(why));
+      QVERIFY(QFileInfo(path).size() > 1000);
+    }
+    for (int i = 0; i < n; ++i) bode->setModelShown(i, true);
+  }
+
+  void compareShowsFitOfEveryModel() {
+    ComparePanel* cmp = window_->comparePanel();
+    showDock("compareDock");
+    cmp->setRangeKind(RangeKind::Validation);
+    const auto fits = cmp->fits();
+    QCOMPARE(static_cast<int>(fits.size()), static_cast<int>(window_->workspace()->models().size()));
+    // The physical estimate simulates the validation part of the sweep well.
+    QVERIFY2(fits[fits.size() - 2] > 60.0, qPrintable(cmp->fitText()));
+    // The OE model is simulated at its own 200 Hz.
+    QVERIFY2(fits.back() > 30.0, qPrintable(cmp->fitText()));
+    QVERIFY2(cmp->fitText().contains("(at 200 Hz)"), qPrintable(cmp->fitText()));
+    QVERIFY2(cmp->fitText().contains("validation"), qPrintable(cmp->fitText()));
+    QCOMPARE(cmp->plot()->graphCount(), static_cast<int>(fits.size()) + 1);
+    test::saveShot(cmp->grab().toImage(), "compare_panel");
+  }
+
+  void residualsShowCorrelationsWithBounds() {
+    ResidualsPanel* res = window_->residualsPanel();
+    showDock("residualsDock");
+    res->setRangeKind(RangeKind::Validation);
+    res->setMaxLag(30);
+    res->selectModel(static_cast<int>(window_->workspace()->models().size()) - 1);
+    const ResidualAnalysis& a = res->analysis();
+    QCOMPARE(static_cast<int>(a.lags.size()), 31);
+    QCOMPARE(static_cast<int>(a.crossLags.size()), 61);
+    QVERIFY(a.autocorrelationBound > 0.0);
+    QCOMPARE(a.autocorrelation[0], 1.0);
+    QVERIFY2(res->verdictText().contains("Whiteness"), qPrintable(res->verdictText()));
+    test::saveShot(res->grab().toImage(), "residuals_panel");
+  }
+
+  void cancelStopsAnEstimate() {
+    FitPanel* fit = window_->fitPanel();
+    QVERIFY(fit->setModelChoice("three-mass"));
+    fit->setFreeParameters({"J_m", "J_g", "J_a", "f_m", "k_g", "k_a", "d_g", "d_a"});
+    fit->setDecimation(1);
+    fit->setStarts(50);
+    const std::size_t before = window_->workspace()->models().size();
+    QSignalSpy done(fit, &FitPanel::estimated);
+    QTest::mouseClick(fit->findChild<QPushButton*>("estimateButton"), Qt::LeftButton);
+    QVERIFY(fit->isBusy());
+    QVERIFY(fit->findChild<QPushButton*>("fitCancelButton")->isEnabled());
+    QTest::mouseClick(fit->findChild<QPushButton*>("fitCancelButton"), Qt::LeftButton);
+    QVERIFY(done.wait(60000));
+    QCOMPARE(done.takeFirst().at(0).toBool(), false);
+    QVERIFY2(fit->summaryText().startsWith("Cancelled"), qPrintable(fit->summaryText()));
+    QCOMPARE(window_->workspace()->models().size(), before);
+    fit->setStarts(0);
+  }
+
+  void sensitivityStudyReportsLimitsAndSuccessRate() {
+    FitPanel* fit = window_->fitPanel();
+    QVERIFY(fit->setModelChoice("three-mass"));
+    fit->setFreeParameters({"J_m", "k_g"});
+    fit->setDecimation(10);
+    QVERIFY2(clickEstimate(fit), qPrintable(fit->summaryText()));
+    QCOMPARE(fit->freeParameters(), QStringList({"J_m", "k_g"}));  // kept as the list grew
+    fit->setStudyRuns(24);
+    QSignalSpy done(fit, &FitPanel::studyFinished);
+    QTest::mouseClick(fit->findChild<QPushButton*>("studyButton"), Qt::LeftButton);
+    QVERIFY(done.wait(120000));
+    QVERIFY2(done.takeFirst().at(0).toBool(), qPrintable(fit->studyText()));
+    QCOMPARE(fit->studyTable()->rowCount(), 2);
+    QVERIFY2(fit->studyText().contains("of 24 runs succeeded"), qPrintable(fit->studyText()));
+    showDock("fitDock");
+    test::saveShot(fit->grab().toImage(), "fit_panel_study");
+    test::saveShot(window_->grab().toImage(), "main_window_identification");
+  }
+
+  void cleanupTestCase() { delete window_; }
+};
+
+int main(int argc, char** argv) {
+  VtkView::installDefaultSurfaceFormat();
+  QApplication app(argc, argv);
+  QApplication::setOrganizationName("FlexArmTests");
+  IdentificationTest t;
+  return QTest::qExec(&t, argc, argv);
+}
+
+#include "tst_identification.moc"

@@ -1,0 +1,217 @@
+#include "widgets/bode_panel.h"
+
+#include <QCheckBox>
+#include <QDoubleSpinBox>
+#include <QFileDialog>
+#include <QHBoxLayout>
+#include <QLabel>
+#include <QListWidget>
+#include <QPushButton>
+#include <QSpinBox>
+#include <QSplitter>
+#include <QVBoxLayout>
+#include <cmath>
+
+#include "core/ident/nonparametric.h"
+#include "widgets/ident_data.h"
+#include "widgets/plots/bode_plot.h"
+
+namespace flexarm {
+namespace {
+
+const QColor kPalette[] = {QColor(31, 119, 180), QColor(214, 39, 40), QColor(44, 160, 44),
+                           QColor(148, 103, 189), QColor(255, 127, 14), QColor(23, 190, 207),
+                           QColor(140, 86, 75), QColor(227, 119, 194)};
+
+BodeCurve toCurve(const QString& name, const QColor& color, const FrequencyResponse& fr) {
+  BodeCurve c;
+  c.name = name;
+  c.color = color;
+  c.frequency = fr.omega;
+  c.response = fr.value;
+  if (fr.hasBands()) {
+    c.magnitudeLow = fr.magnitudeLower;
+    c.magnitudeHigh = fr.magnitudeUpper;
+    for (std::size_t i = 0; i < fr.omega.size(); ++i) {
+      // Bands around the wrapped phase of the value, as BodePlot expects.
+      const double offset = std::arg(fr.value[i]) - fr.phase[i];
+      c.phaseLowDeg.push_back((fr.phaseLower[i] + offset) * 180.0 / M_PI);
+      c.phaseHighDeg.push_back((fr.phaseUpper[i] + offset) * 180.0 / M_PI);
+    }
+  }
+  return c;
+}
+
+}  // namespace
+
+BodePanel::BodePanel(Workspace* workspace, QWidget* parent)
+    : QWidget(parent), workspace_(workspace), models_(new QListWidget(this)),
+      level_(new QDoubleSpinBox(this)), spa_(new QCheckBox(tr("SPA"), this)),
+      etfe_(new QCheckBox(tr("ETFE"), this)), window_(new QSpinBox(this)),
+      export_(new QPushButton(tr("Export..."), this)), plot_(new BodePlot(this)),
+      note_(new QLabel(this)) {
+  setObjectName("bodePanel");
+  models_->setObjectName("bodeModelList");
+  models_->setMaximumWidth(220);
+  models_->setToolTip(tr("Checked models of the shared list are drawn"));
+  level_->setObjectName("bodeLevelSpin");
+  level_->setRange(0.5, 0.9999);
+  level_->setDecimals(4);
+  level_->setSingleStep(0.01);
+  level_->setValue(0.99);
+  level_->setToolTip(tr("Confidence level of the shaded bands"));
+  spa_->setObjectName("bodeSpaCheck");
+  spa_->setToolTip(tr("Spectral analysis (4.28) of the estimation data"));
+  etfe_->setObjectName("bodeEtfeCheck");
+  etfe_->setToolTip(tr("Empirical transfer function estimate (4.24), smoothed (4.25)"));
+  window_->setObjectName("bodeWindowSpin");
+  window_->setRange(0, 20000);
+  window_->setValue(400);
+  window_->setToolTip(tr("SPA lag window width M in samples (0: min(N/10, 30)); ETFE uses "
+                         "M/50 bins of smoothing"));
+  export_->setObjectName("bodeExportButton");
+  note_->setObjectName("bodeNote");
+  note_->setWordWrap(true);
+  note_->setMinimumHeight(4 * note_->fontMetrics().lineSpacing());
+  note_->setAlignment(Qt::AlignLeft | Qt::AlignTop);
+
+  auto* controls = new QHBoxLayout;
+  controls->addWidget(new QLabel(tr("Band level"), this));
+  controls->addWidget(level_);
+  controls->addWidget(spa_);
+  controls->addWidget(etfe_);
+  controls->addWidget(new QLabel(tr("Window"), this));
+  controls->addWidget(window_);
+  controls->addStretch(1);
+  controls->addWidget(export_);
+  auto* split = new QSplitter(Qt::Horizontal, this);
+  split->addWidget(models_);
+  split->addWidget(plot_);
+  split->setStretchFactor(1, 4);
+  auto* layout = new QVBoxLayout(this);
+  layout->addLayout(controls);
+  layout->addWidget(split, 1);
+  layout->addWidget(note_);
+
+  connect(models_, &QListWidget::itemChanged, this, &BodePanel::refresh);
+  connect(level_, QOverload<double>::of(&QDoubleSpinBox::valueChanged), this, &BodePanel::refresh);
+  connect(window_, QOverload<int>::of(&QSpinBox::valueChanged), this, &BodePanel::refresh);
+  for (QCheckBox* c : {spa_, etfe_}) connect(c, &QCheckBox::toggled, this, &BodePanel::refresh);
+  connect(export_, &QPushButton::clicked, this, &BodePanel::exportDialog);
+  connect(workspace_, &Workspace::modelsChanged, this, [this](int) { refillList(); });
+  for (auto sig : {&Workspace::currentChanged, &Workspace::rangesChanged})
+    connect(workspace_, sig, this, &BodePanel::refresh);
+  refillList();
+}
+
+void BodePanel::refillList() {
+  fillModelChecklist(models_, workspace_->models());
+  refresh();
+}
+
+void BodePanel::setModelShown(int index, bool shown) {
+  if (index < 0 || index >= models_->count()) return;
+  models_->item(index)->setCheckState(shown ? Qt::Checked : Qt::Unchecked);
+}
+
+void BodePanel::setLevel(double level) { level_->setValue(level); }
+
+void BodePanel::setNonparametricShown(bool spa, bool etfe) {
+  filling_ = true;
+  spa_->setChecked(spa);
+  filling_ = false;
+  etfe_->setChecked(etfe);
+  refresh();
+}
+
+bool BodePanel::curveHasBand(int curve) const {
+  return curve >= 0 && curve < static_cast<int>(bands_.size()) && bands_[static_cast<std::size_t>(curve)];
+}
+
+QString BodePanel::noteText() const { return note_->text(); }
+
+void BodePanel::refresh() {
+  if (filling_) return;
+  plot_->clear();
+  names_.clear();
+  bands_.clear();
+  QStringList notes;
+  QString why;
+  const auto data = identSignals(*workspace_, 1, true, &why);
+  double wmin = 1.0, wmax = 2000.0;
+  if (data) {
+    wmin = std::max(2.0 * M_PI / (static_cast<double>(data->estimation.size()) * data->sampleTime), 0.5);
+    wmax = M_PI / data->sampleTime;
+  }
+  const auto grid = logGrid(wmin, wmax, 800);
+  const double level = level_->value();
+  int colour = 0;
+  auto add = [&](const BodeCurve& c) {
+    plot_->addCurve(c);
+    names_ << c.name;
+    bands_.push_back(!c.magnitudeLow.empty());
+  };
+  const auto& list = workspace_->models();
+  for (std::size_t i = 0; i < list.size(); ++i) {
+    const QColor color = kPalette[colour++ % 8];
+    if (!isModelChecked(models_, i)) continue;
+    try {
+      const FrequencyResponse fr = responseOf(list[i], grid, level);
+      if (!fr.omega.empty()) add(toCurve(list[i].name, color, fr));
+    } catch (const std::exception& e) {
+      notes << tr("%1: %2").arg(list[i].name, QString::fromStdString(e.what()));
+    }
+  }
+  if ((spa_->isChecked() || etfe_->isChecked()) && !data) notes << why;
+  if (data && (spa_->isChecked() || etfe_->isChecked())) {
+    const auto b = static_cast<Eigen::Index>(data->estimation.begin);
+    const auto n = static_cast<Eigen::Index>(data->estimation.size());
+    const Eigen::VectorXd u = data->u.segment(b, n), y = data->y.segment(b, n);
+    const auto pointsGrid = logGrid(wmin, wmax, 250);
+    auto addPoints = [&](const QString& name, const QColor& color, const NonparametricEstimate& e) {
+      if (e.termination != Termination::Converged) {
+        notes << tr("%1: %2").arg(name, QString::fromStdString(e.message));
+        return;
+      }
+      BodeCurve c = toCurve(name, color, e.response);
+      c.points = true;
+      c.magnitudeLow.clear();  // points only: the SPA region is drawn for models
+      c.magnitudeHigh.clear();
+      c.phaseLowDeg.clear();
+      c.phaseHighDeg.clear();
+      add(c);
+    };
+    if (spa_->isChecked()) {
+      SpaOptions so;
+      so.windowWidth = window_->value();
+      so.omega = pointsGrid;
+      so.level = level;
+      addPoints(tr("SPA (M = %1)").arg(window_->value()), QColor(90, 90, 90), spa(u, y, data->sampleTime, so));
+    }
+    if (etfe_->isChecked()) {
+      EtfeOptions eo;
+      eo.smoothingWidth = std::max(1, window_->value() / 50);
+      eo.omega = pointsGrid;
+      addPoints(tr("ETFE"), QColor(180, 140, 20), etfe(u, y, data->sampleTime, eo));
+    }
+    if (data->closedLoop) notes << QString::fromUtf8(kClosedLoopBiasWarning);
+  }
+  if (names_.isEmpty())
+    notes.prepend(tr("No curve: add a model (Model or Fit panel) or tick SPA/ETFE with a log open."));
+  else
+    notes.prepend(tr("Bands: %1 % confidence (Gauss approximation).").arg(100.0 * level, 0, 'g', 4));
+  note_->setText(notes.join("\n"));
+  plot_->rescale();
+}
+
+bool BodePanel::exportTo(const QString& path, QString* why) const { return plot_->exportTo(path, why); }
+
+void BodePanel::exportDialog() {
+  const QString path = QFileDialog::getSaveFileName(this, tr("Export Bode plot"), "bode.png",
+                                                    tr("Images (*.png *.pdf *.svg)"));
+  if (path.isEmpty()) return;
+  QString why;
+  if (!exportTo(path, &why)) note_->setText(tr("Export failed: %1").arg(why));
+}
+
+}  // namespace flexarm

@@ -1,0 +1,44 @@
+#pragma once
+// Compare panel: the measured output against the output simulated by several models of the
+// shared list on the validation range (or the estimation range), each with its fit % (5.2),
+// as the seed's Figure 5.11. Simulation starts at the log's first sample, so no start-up
+// transient enters the fit.
+#include <QWidget>
+#include <vector>
+
+#include "widgets/workspace.h"
+
+class QComboBox;
+class QCustomPlot;
+class QLabel;
+class QListWidget;
+
+namespace flexarm {
+
+class ComparePanel : public QWidget {
+  Q_OBJECT
+ public:
+  explicit ComparePanel(Workspace* workspace, QWidget* parent = nullptr);
+
+  void setModelShown(int index, bool shown);
+  void setRangeKind(RangeKind kind);
+  // Fit % of each checked model in list order (NaN where it could not be simulated).
+  std::vector<double> fits() const { return fits_; }
+  QString fitText() const;
+  QCustomPlot* plot() const { return plot_; }
+
+ public slots:
+  void refresh();
+
+ private:
+  void refillList();
+
+  Workspace* workspace_;
+  QListWidget* models_;
+  QComboBox* range_;
+  QCustomPlot* plot_;
+  QLabel* fit_;
+  std::vector<double> fits_;
+};
+
+}  // namespace flexarm

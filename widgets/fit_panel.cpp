@@ -1,0 +1,595 @@
+#include "widgets/fit_panel.h"
+
+#include <QComboBox>
+#include <QFormLayout>
+#include <QGroupBox>
+#include <QHBoxLayout>
+#include <QHeaderView>
+#include <QLabel>
+#include <QListWidget>
+#include <QProgressBar>
+#include <QPushButton>
+#include <QSpinBox>
+#include <QTableWidget>
+#include <QTimer>
+#include <QVBoxLayout>
+#include <QtConcurrent>
+#include <algorithm>
+#include <cmath>
+
+#include "core/ident/blackbox.h"
+#include "core/ident/nonparametric.h"
+#include "core/models/physical_models.h"
+#include "widgets/ident_data.h"
+
+namespace flexarm {
+namespace {
+
+QString joined(const std::vector<double>& w) {
+  QStringList parts;
+  for (double x : w) parts << QString::number(x, 'f', 1);
+  return parts.isEmpty() ? QObject::tr("none") : parts.join(", ") + " rad/s";
+}
+
+QString number(double v) { return QString::number(v, 'g', 5); }
+
+// What the worker needs, copied on the GUI thread.
+struct Request {
+  bool physical = false;
+  PolyStructure structure = PolyStructure::Oe;
+  PolyOrders orders;
+  std::shared_ptr<PhysicalModel> model;  // a private copy with the free flags applied
+  QString name;
+  PemOptions pem;
+  int maxIterations = 100;
+};
+
+}  // namespace
+
+FitPanel::FitPanel(Workspace* workspace, QWidget* parent)
+    : QWidget(parent), workspace_(workspace), model_(new QComboBox(this)),
+      na_(new QSpinBox(this)), nb_(new QSpinBox(this)), nc_(new QSpinBox(this)),
+      nd_(new QSpinBox(this)), nf_(new QSpinBox(this)), nk_(new QSpinBox(this)),
+      free_(new QListWidget(this)), ranges_(new QLabel(this)), decimation_(new QSpinBox(this)),
+      noise_(new QComboBox(this)), starts_(new QSpinBox(this)), iterations_(new QSpinBox(this)),
+      estimate_(new QPushButton(tr("Estimate"), this)),
+      cancel_(new QPushButton(tr("Cancel"), this)), progress_(new QProgressBar(this)),
+      table_(new QTableWidget(0, 6, this)), summary_(new QLabel(this)),
+      studyRuns_(new QSpinBox(this)), study_button_(new QPushButton(tr("Run study"), this)),
+      studyTable_(new QTableWidget(0, 3, this)), studySummary_(new QLabel(this)),
+      poll_(new QTimer(this)), permille_(std::make_shared<std::atomic<int>>(0)),
+      abort_(std::make_shared<std::atomic<bool>>(false)) {
+  setObjectName("fitPanel");
+  model_->setObjectName("fitModelCombo");
+  const char* orderNames[] = {"na", "nb", "nc", "nd", "nf", "nk"};
+  QSpinBox* orders[] = {na_, nb_, nc_, nd_, nf_, nk_};
+  const int defaults[] = {2, 4, 2, 2, 4, 1};
+  auto* orderRow = new QHBoxLayout;
+  for (int i = 0; i < 6; ++i) {
+    orders[i]->setRange(0, 60);
+    orders[i]->setValue(defaults[i]);
+    orders[i]->setObjectName(QString("%1Spin").arg(orderNames[i]));
+    orders[i]->setToolTip(tr("Order %1 of (4.8)").arg(orderNames[i]));
+    orderRow->addWidget(new QLabel(orderNames[i], this));
+    orderRow->addWidget(orders[i]);
+  }
+  free_->setObjectName("freeParameterList");
+  free_->setMaximumHeight(90);
+  free_->setToolTip(tr("Checked parameters are estimated; the others keep their values"));
+  ranges_->setObjectName("fitRangesLabel");
+  ranges_->setWordWrap(true);
+  decimation_->setRange(1, 100);
+  decimation_->setObjectName("fitDecimationSpin");
+  decimation_->setToolTip(tr("Decimate behind the anti-alias FIR before fitting (the seed: "
+                             "10); 1 fits at the data's own rate, where the zero-order hold "
+                             "the physical models assume is what the controller does"));
+  noise_->setObjectName("noiseModelCombo");
+  noise_->addItem(tr("Output error (K = 0)"), "output-error");
+  noise_->addItem(tr("Innovations form (K estimated)"), "innovations");
+  starts_->setRange(0, 200);
+  starts_->setObjectName("startsSpin");
+  starts_->setToolTip(tr("Random starts besides the model's own values, plus two whose "
+                         "notches and peaks match the SPA estimate"));
+  iterations_->setRange(1, 1000);
+  iterations_->setValue(100);
+
+  auto* form = new QFormLayout;
+  form->addRow(tr("Model"), model_);
+  form->addRow(tr("Orders"), orderRow);
+  form->addRow(tr("Free parameters"), free_);
+  form->addRow(tr("Ranges"), ranges_);
+  form->addRow(tr("Decimation"), decimation_);
+  form->addRow(tr("Noise model"), noise_);
+  form->addRow(tr("Extra starts"), starts_);
+  form->addRow(tr("Max iterations"), iterations_);
+
+  estimate_->setObjectName("estimateButton");
+  cancel_->setObjectName("fitCancelButton");
+  cancel_->setEnabled(false);
+  progress_->setObjectName("fitProgress");
+  progress_->setRange(0, 1000);
+  progress_->setValue(0);
+  auto* buttons = new QHBoxLayout;
+  buttons->addWidget(estimate_);
+  buttons->addWidget(cancel_);
+  buttons->addWidget(progress_, 1);
+
+  table_->setObjectName("fitResultsTable");
+  table_->setHorizontalHeaderLabels(
+      {tr("Parameter"), tr("Value"), tr("Std"), tr("99 % low"), tr("99 % high"), tr("Unit")});
+  table_->horizontalHeader()->setSectionResizeMode(QHeaderView::ResizeToContents);
+  table_->verticalHeader()->setVisible(false);
+  table_->setEditTriggers(QAbstractItemView::NoEditTriggers);
+  summary_->setObjectName("fitSummary");
+  summary_->setWordWrap(true);
+  summary_->setMinimumHeight(6 * summary_->fontMetrics().lineSpacing());
+  summary_->setAlignment(Qt::AlignLeft | Qt::AlignTop);
+  summary_->setTextInteractionFlags(Qt::TextSelectableByMouse);
+
+  auto* studyBox = new QGroupBox(tr("Sensitivity study (Section 5.3.3)"), this);
+  studyRuns_->setRange(1, 100000);
+  studyRuns_->setValue(1000);
+  studyRuns_->setObjectName("studyRunsSpin");
+  study_button_->setObjectName("studyButton");
+  study_button_->setEnabled(false);
+  study_button_->setToolTip(tr("Domain of attraction of every free parameter by interval "
+                               "halving (Table 5.8), then Monte-Carlo fits from random starts "
+                               "inside it; on the latest physical estimate"));
+  studyTable_->setObjectName("studyTable");
+  studyTable_->setHorizontalHeaderLabels({tr("Parameter"), tr("Lower limit"), tr("Upper limit")});
+  studyTable_->horizontalHeader()->setSectionResizeMode(QHeaderView::Stretch);
+  studyTable_->verticalHeader()->setVisible(false);
+  studyTable_->setEditTriggers(QAbstractItemView::NoEditTriggers);
+  studyTable_->setMaximumHeight(90);
+  studySummary_->setObjectName("studySummary");
+  studySummary_->setWordWrap(true);
+  auto* studyRow = new QHBoxLayout;
+  studyRow->addWidget(new QLabel(tr("Monte-Carlo runs"), this));
+  studyRow->addWidget(studyRuns_);
+  studyRow->addWidget(study_button_);
+  studyRow->addStretch(1);
+  auto* studyLayout = new QVBoxLayout(studyBox);
+  studyLayout->addLayout(studyRow);
+  studyLayout->addWidget(studyTable_);
+  studyLayout->addWidget(studySummary_);
+
+  auto* layout = new QVBoxLayout(this);
+  layout->addLayout(form);
+  layout->addLayout(buttons);
+  layout->addWidget(table_, 3);
+  layout->addWidget(summary_);
+  layout->addWidget(studyBox);
+
+  poll_->setInterval(100);
+  connect(poll_, &QTimer::timeout, this, [this] { progress_->setValue(permille_->load()); });
+  connect(model_, QOverload<int>::of(&QComboBox::currentIndexChanged), this, [this] {
+    refillParameters();
+    updateControls();
+  });
+  connect(estimate_, &QPushButton::clicked, this, &FitPanel::estimate);
+  connect(cancel_, &QPushButton::clicked, this, &FitPanel::cancel);
+  connect(study_button_, &QPushButton::clicked, this, &FitPanel::runStudy);
+  connect(&watcher_, &QFutureWatcher<Outcome>::finished, this, &FitPanel::onFinished);
+  connect(&study_, &QFutureWatcher<StudyOutcome>::finished, this, &FitPanel::onStudyFinished);
+  connect(workspace_, &Workspace::modelsChanged, this, [this](int index) {
+    if (index < 0) refillModels();
+  });
+  for (auto signal : {&Workspace::currentChanged, &Workspace::rangesChanged})
+    connect(workspace_, signal, this, &FitPanel::showRanges);
+  refillModels();
+  showRanges();
+}
+
+void FitPanel::refillModels() {
+  const QString keep = modelChoice();
+  model_->blockSignals(true);
+  model_->clear();
+  model_->addItem(tr("ARX (least squares)"), "arx");
+  model_->addItem(tr("ARMAX"), "armax");
+  model_->addItem(tr("OE"), "oe");
+  model_->addItem(tr("Box-Jenkins"), "bj");
+  const auto& list = workspace_->models();
+  for (std::size_t i = 0; i < list.size(); ++i)
+    if (list[i].model)
+      model_->addItem(tr("%1 (model list)").arg(list[i].name), QString("list:%1").arg(i));
+  for (const auto& s : modelStructureNames())
+    model_->addItem(tr("%1, nominal values").arg(QString::fromStdString(s)),
+                    QString::fromStdString(s));
+  const int k = model_->findData(keep);
+  model_->setCurrentIndex(k >= 0 ? k : 2);
+  model_->blockSignals(false);
+  const QStringList ticked = freeParameters();  // the user's choice survives a list change
+  refillParameters();
+  if (k >= 0 && !ticked.isEmpty()) setFreeParameters(ticked);
+  updateControls();
+}
+
+bool FitPanel::setModelChoice(const QString& key) {
+  const int k = model_->findData(key);
+  if (k < 0) return false;
+  model_->setCurrentIndex(k);
+  return true;
+}
+
+QString FitPanel::modelChoice() const { return model_->currentData().toString(); }
+
+void FitPanel::setOrders(const PolyOrders& o) {
+  na_->setValue(o.na);
+  nb_->setValue(o.nb);
+  nc_->setValue(o.nc);
+  nd_->setValue(o.nd);
+  nf_->setValue(o.nf);
+  nk_->setValue(o.nk);
+}
+
+void FitPanel::setFreeParameters(const QStringList& names) {
+  for (int i = 0; i < free_->count(); ++i)
+    free_->item(i)->setCheckState(names.contains(free_->item(i)->text()) ? Qt::Checked
+                                                                       : Qt::Unchecked);
+}
+
+QStringList FitPanel::freeParameters() const {
+  QStringList names;
+  for (int i = 0; i < free_->count(); ++i)
+    if (free_->item(i)->checkState() == Qt::Checked) names << free_->item(i)->text();
+  return names;
+}
+
+void FitPanel::setDecimation(int factor) { decimation_->setValue(factor); }
+void FitPanel::setNoiseModel(NoiseModel m) { noise_->setCurrentIndex(m == NoiseModel::Innovations); }
+void FitPanel::setStarts(int randomStarts) { starts_->setValue(randomStarts); }
+void FitPanel::setStudyRuns(int runs) { studyRuns_->setValue(runs); }
+
+void FitPanel::refillParameters() {
+  free_->clear();
+  const QString key = modelChoice();
+  std::shared_ptr<const PhysicalModel> m;
+  if (key.startsWith("list:")) {
+    const auto i = key.mid(5).toUInt();
+    if (i < workspace_->models().size()) m = workspace_->models()[i].model;
+  } else if (!polyStructureFromString(key.toStdString())) {
+    m = makeModel(key.toStdString());
+  }
+  if (!m) return;
+  for (const auto& p : m->parameters()) {
+    auto* item = new QListWidgetItem(QString::fromStdString(p.name), free_);
+    item->setFlags(Qt::ItemIsEnabled | Qt::ItemIsUserCheckable);
+    item->setCheckState(p.free ? Qt::Checked : Qt::Unchecked);
+    item->setToolTip(tr("%1 %2, start value").arg(p.value).arg(QString::fromStdString(p.unit)));
+  }
+}
+
+void FitPanel::updateControls() {
+  const auto s = polyStructureFromString(modelChoice().toStdString());
+  const bool busy = isBusy();
+  const bool used[4][5] = {{true, true, false, false, false},    // arx: na nb
+                           {true, true, true, false, false},     // armax: na nb nc
+                           {false, true, false, false, true},    // oe: nb nf
+                           {false, true, true, true, true}};     // bj: nb nc nd nf
+  QSpinBox* orders[] = {na_, nb_, nc_, nd_, nf_};
+  for (int i = 0; i < 5; ++i) orders[i]->setEnabled(s && used[static_cast<int>(*s)][i] && !busy);
+  nk_->setEnabled(s.has_value() && !busy);
+  free_->setEnabled(!s && !busy);
+  noise_->setEnabled(!s && !busy);
+  starts_->setEnabled(!s && !busy);
+  estimate_->setEnabled(!busy && workspace_->hasLog());
+  cancel_->setEnabled(busy);
+  study_button_->setEnabled(!busy && last_.estimate != nullptr);
+  model_->setEnabled(!busy);
+}
+
+void FitPanel::showRanges() {
+  auto text = [this](RangeKind k) {
+    const auto r = workspace_->range(k);
+    if (!r) return k == RangeKind::Estimation ? tr("estimation: all data") : tr("validation: none");
+    return tr("%1: %2-%3 s (%4 samples)")
+        .arg(toString(k))
+        .arg(r->start, 0, 'f', 2)
+        .arg(r->end, 0, 'f', 2)
+        .arg(workspace_->samples(k).size());
+  };
+  ranges_->setText(text(RangeKind::Estimation) + "; " + text(RangeKind::Validation));
+  updateControls();
+}
+
+ProgressCallback FitPanel::progressCallback() const {
+  auto permille = permille_;
+  auto abort = abort_;
+  return [permille, abort](double fraction, const std::string&) {
+    permille->store(static_cast<int>(1000.0 * std::clamp(fraction, 0.0, 1.0)));
+    return abort->load() ? ProgressAction::Abort : ProgressAction::Continue;
+  };
+}
+
+void FitPanel::startProgress() {
+  permille_->store(0);
+  abort_->store(false);
+  progress_->setValue(0);
+  poll_->start();
+  updateControls();
+}
+
+void FitPanel::cancel() {
+  abort_->store(true);
+  summary_->setText(tr("Cancelling..."));
+}
+
+void FitPanel::estimate() {
+  if (isBusy()) return;
+  Request req;
+  const QString key = modelChoice();
+  req.maxIterations = iterations_->value();
+  if (auto s = polyStructureFromString(key.toStdString())) {
+    req.structure = *s;
+    PolyOrders& o = req.orders;
+    const bool used[4][5] = {{true, true, false, false, false},
+                             {true, true, true, false, false},
+                             {false, true, false, false, true},
+                             {false, true, true, true, true}};
+    QSpinBox* spins[] = {na_, nb_, nc_, nd_, nf_};
+    int* fields[] = {&o.na, &o.nb, &o.nc, &o.nd, &o.nf};
+    for (int i = 0; i < 5; ++i) *fields[i] = used[static_cast<int>(*s)][i] ? spins[i]->value() : 0;
+    o.nk = nk_->value();
+    std::string why;
+    if (!o.isValid(&why)) {
+      summary_->setText(tr("Orders: %1").arg(QString::fromStdString(why)));
+      return;
+    }
+  } else {
+    req.physical = true;
+    std::shared_ptr<const PhysicalModel> base;
+    if (key.startsWith("list:")) {
+      const auto i = key.mid(5).toUInt();
+      if (i < workspace_->models().size()) {
+        base = workspace_->models()[i].model;
+        req.name = workspace_->models()[i].name;
+      }
+    } else {
+      base = makeModel(key.toStdString());
+      req.name = key;
+    }
+    if (!base) return;
+    req.model = clonePhysical(*base);
+    const QStringList names = freeParameters();
+    if (names.isEmpty()) {
+      summary_->setText(tr("Check at least one parameter to estimate."));
+      return;
+    }
+    for (const auto& p : base->parameters())
+      req.model->setFree(p.name, names.contains(QString::fromStdString(p.name)));
+    req.pem.maxIterations = req.maxIterations;
+    req.pem.noiseModel = noise_->currentIndex() == 1 ? NoiseModel::Innovations
+                                                     : NoiseModel::OutputError;
+    req.pem.randomStarts = starts_->value();
+    req.pem.seed = static_cast<unsigned>(++fits_);
+  }
+  QString why;
+  ModelEntry probe;
+  probe.model = req.model;
+  auto data = identSignals(*workspace_, decimation_->value(), wantsVelocity(probe), &why);
+  if (!data) {
+    summary_->setText(why);
+    return;
+  }
+  table_->setRowCount(0);
+  summary_->setText(tr("Estimating on %1 samples (%2)...")
+                        .arg(data->estimation.size())
+                        .arg(data->note));
+  startProgress();
+  const auto progress = progressCallback();
+  watcher_.setFuture(QtConcurrent::run([req, sig = std::move(*data), progress]() {
+    Outcome out;
+    out.note = sig.note;
+    const auto b = static_cast<Eigen::Index>(sig.estimation.begin);
+    const auto n = static_cast<Eigen::Index>(sig.estimation.size());
+    const Eigen::VectorXd u = sig.u.segment(b, n), y = sig.y.segment(b, n);
+    const double T = sig.sampleTime;
+    try {
+      if (req.physical) {
+        PemOptions po = req.pem;
+        if (po.randomStarts > 0) {  // two more starts matching the SPA notches and peaks
+          const NonparametricEstimate sp = spa(u, y, T);
+          const auto np = notchesAndPeaks(sp.response, 3.0);
+          po.targetNotches = np.notches;
+          po.targetPeaks = np.peaks;
+          if (!np.notches.empty() || !np.peaks.empty()) po.notchPeakStarts = 2;
+        }
+        PemResult r = pem(*req.model, u, y, T, po, progress);
+        out.summary = r.summary;
+        for (const auto& p : r.parameters)
+          out.rows.push_back({QString::fromStdString(p.name), QString::fromStdString(p.unit),
+                              p.value, p.std, p.lower, p.upper, p.free});
+        auto estimated = clonePhysical(*r.model);
+        out.entry.model = estimated;
+        const int pf = static_cast<int>(r.freeIndices.size());
+        if (r.covariance.rows() >= pf && pf > 0) {
+          out.entry.covariance = r.covariance.topLeftCorner(pf, pf);
+          out.entry.covarianceIndices = r.freeIndices;
+        }
+        out.entry.name = req.name;
+        out.estimate = estimated;
+        out.u = u;
+        out.y = y;
+        out.sampleTime = T;
+      } else {
+        PolyEstimateOptions po;
+        po.maxIterations = req.maxIterations;
+        PolyEstimate r = estimatePolynomial(u, y, req.structure, req.orders, T, po, progress);
+        out.summary = r.summary;
+        const auto names = r.model.parameterNames();
+        const Eigen::VectorXd th = r.model.parameterVector(), sd = r.model.standardDeviations();
+        const double z = twoSidedNormalQuantile(0.99);
+        for (std::size_t i = 0; i < names.size(); ++i) {
+          const double s = sd.size() ? sd[static_cast<Eigen::Index>(i)] : 0.0;
+          const double v = th[static_cast<Eigen::Index>(i)];
+          out.rows.push_back({QString::fromStdString(names[i]), QString(), v, s, v - z * s,
+                              v + z * s, true});
+        }
+        out.entry.polynomial = std::make_shared<PolynomialModel>(r.model);
+        out.entry.name = QString::fromStdString(r.model.name());
+      }
+    } catch (const std::exception& e) {
+      out.error = QString::fromStdString(e.what());
+      return out;
+    }
+    if (out.summary.termination == Termination::Cancelled ||
+        out.summary.termination == Termination::Failed)
+      return out;
+    QString reason;
+    if (auto sim = simulateEntry(out.entry, u, T, &reason))
+      out.fitEstimation = fitPercent(y, *sim);
+    if (!sig.validation.empty()) {  // simulated from the log's first sample (no transient)
+      if (auto sim = simulateEntry(out.entry, sig.u, T, &reason)) {
+        out.hasValidation = true;
+        out.fitValidation = fitPercent(sig.y, *sim, static_cast<Eigen::Index>(sig.validation.begin),
+                                       static_cast<Eigen::Index>(sig.validation.end));
+      }
+    }
+    const double wmin = 2.0 * M_PI / (static_cast<double>(n) * T);
+    const auto fr = responseOf(out.entry, logGrid(wmin, M_PI / T, 2000), 0.99);
+    const auto np = notchesAndPeaks(fr, 1.0);
+    out.notches = np.notches;
+    out.peaks = np.peaks;
+    return out;
+  }));
+  updateControls();  // Cancel on, Estimate off while the future runs
+}
+
+void FitPanel::onFinished() {
+  poll_->stop();
+  Outcome out = watcher_.result();
+  progress_->setValue(out.error.isEmpty() && out.summary.ok() ? 1000 : 0);
+  if (!out.error.isEmpty() || !out.summary.ok()) {
+    const QString reason = !out.error.isEmpty() ? out.error
+                                                : QString::fromStdString(out.summary.message);
+    summary_->setText(out.summary.termination == Termination::Cancelled
+                          ? tr("Cancelled: %1").arg(reason)
+                          : tr("The fit failed: %1").arg(reason));
+    updateControls();
+    emit estimated(false);
+    return;
+  }
+  table_->setRowCount(static_cast<int>(out.rows.size()));
+  for (int r = 0; r < static_cast<int>(out.rows.size()); ++r) {
+    const Row& row = out.rows[static_cast<std::size_t>(r)];
+    const QStringList cells = {row.name,
+                               number(row.value),
+                               row.free ? number(row.std) : tr("fixed"),
+                               row.free ? number(row.lower) : QString(),
+                               row.free ? number(row.upper) : QString(),
+                               row.unit};
+    for (int c = 0; c < cells.size(); ++c) {
+      auto* item = new QTableWidgetItem(cells[c]);
+      if (!row.free) item->setForeground(QColor(130, 130, 130));
+      table_->setItem(r, c, item);
+    }
+  }
+  const auto& s = out.summary;
+  QStringList lines;
+  lines << tr("%1: %2 after %3 iterations in %4 s (%5).")
+               .arg(out.entry.name)
+               .arg(toString(s.termination))
+               .arg(s.iterations)
+               .arg(s.seconds, 0, 'f', 2)
+               .arg(out.note);
+  lines << tr("Loss %1, FPE %2, AIC %3.").arg(number(s.loss), number(s.fpe), number(s.aic));
+  QString fits = tr("Fit %1 % on the estimation data").arg(out.fitEstimation, 0, 'f', 1);
+  fits += out.hasValidation ? tr(", %1 % on the validation data.").arg(out.fitValidation, 0, 'f', 1)
+                            : tr("; no validation range set.");
+  lines << fits;
+  lines << tr("Notches: %1. Peaks: %2.").arg(joined(out.notches), joined(out.peaks));
+  // The estimate joins the shared list under a name not yet used.
+  QString name = out.entry.name + tr(" estimate");
+  int k = 1;
+  auto taken = [this](const QString& n) {
+    for (const auto& m : workspace_->models())
+      if (m.name == n) return true;
+    return false;
+  };
+  while (taken(name)) name = out.entry.name + tr(" estimate %1").arg(++k);
+  out.entry.name = name;
+  lines << tr("Added to the model list as \"%1\".").arg(name);
+  summary_->setText(lines.join("\n"));
+  if (out.estimate) last_ = out;  // the study runs on the latest physical estimate
+  lastIndex_ = workspace_->addModel(out.entry);
+  updateControls();
+  emit estimated(true);
+}
+
+QString FitPanel::summaryText() const { return summary_->text(); }
+QString FitPanel::studyText() const { return studySummary_->text(); }
+
+void FitPanel::runStudy() {
+  if (isBusy() || !last_.estimate) return;
+  const auto model = last_.estimate;
+  const Eigen::VectorXd u = last_.u, y = last_.y;
+  const double T = last_.sampleTime;
+  const int runs = studyRuns_->value();
+  studyTable_->setRowCount(0);
+  studySummary_->setText(tr("Searching the domain of attraction, then %1 Monte-Carlo fits...")
+                             .arg(runs));
+  startProgress();
+  const auto progress = progressCallback();
+  study_.setFuture(QtConcurrent::run([model, u, y, T, runs, progress]() {
+    StudyOutcome out;
+    auto half = [progress](double offset) {
+      return [progress, offset](double f, const std::string& stage) {
+        return progress(offset + 0.5 * f, stage);
+      };
+    };
+    try {
+      out.attraction = domainOfAttraction(*model, u, y, T, AttractionOptions{}, half(0.0));
+      if (out.attraction.termination == Termination::Converged) {
+        MonteCarloOptions mc;
+        mc.runs = runs;
+        out.monteCarlo = monteCarloStarts(*model, u, y, T, out.attraction, mc, half(0.5));
+      }
+    } catch (const std::exception& e) {
+      out.error = QString::fromStdString(e.what());
+    }
+    return out;
+  }));
+  updateControls();  // Cancel on, Estimate off while the future runs
+}
+
+void FitPanel::onStudyFinished() {
+  poll_->stop();
+  const StudyOutcome out = study_.result();
+  updateControls();
+  if (!out.error.isEmpty()) {
+    studySummary_->setText(tr("The study failed: %1").arg(out.error));
+    emit studyFinished(false);
+    return;
+  }
+  const auto& a = out.attraction;
+  auto limit = [](double f, bool open) {
+    return QString("%1%2 %").arg(open ? "beyond " : "").arg(100.0 * f, 0, 'g', 4);
+  };
+  studyTable_->setRowCount(static_cast<int>(a.parameters.size()));
+  for (int r = 0; r < static_cast<int>(a.parameters.size()); ++r) {
+    const auto& p = a.parameters[static_cast<std::size_t>(r)];
+    studyTable_->setItem(r, 0, new QTableWidgetItem(QString::fromStdString(p.name)));
+    studyTable_->setItem(r, 1, new QTableWidgetItem(limit(p.lowerFactor, p.lowerOpen)));
+    studyTable_->setItem(r, 2, new QTableWidgetItem(limit(p.upperFactor, p.upperOpen)));
+  }
+  const bool ok = a.termination == Termination::Converged &&
+                  out.monteCarlo.termination == Termination::Converged;
+  QString text = tr("Domain of attraction: %1 fits in %2 s (%3).")
+                     .arg(a.fits)
+                     .arg(a.seconds, 0, 'f', 1)
+                     .arg(QString::fromStdString(a.message));
+  if (a.termination == Termination::Converged)
+    text += tr(" Monte-Carlo: %1 of %2 runs succeeded (%3 %) in %4 s.")
+                .arg(out.monteCarlo.successes)
+                .arg(out.monteCarlo.completed)
+                .arg(100.0 * out.monteCarlo.successRate(), 0, 'f', 1)
+                .arg(out.monteCarlo.seconds, 0, 'f', 1);
+  if (!ok && (a.termination == Termination::Cancelled ||
+              out.monteCarlo.termination == Termination::Cancelled))
+    text += tr(" Cancelled.");
+  studySummary_->setText(text);
+  progress_->setValue(ok ? 1000 : 0);
+  emit studyFinished(ok);
+}
+
+}  // namespace flexarm

@@ -1,0 +1,131 @@
+#pragma once
+// Fit panel: a black-box structure with its orders (4.8) or a physical model (from the shared
+// model list or a fresh structure) with its free parameters; the workspace's estimation and
+// validation ranges; options (decimation, noise model, starts, iterations). Estimate runs the
+// prediction-error fit off the GUI thread with progress and Cancel and shows the results as
+// the seed's Tables 5.1 and 5.3-5.7: value +- std and the 99 % interval of every parameter,
+// loss, FPE, fit % (5.2) on the estimation and validation data, notch and peak frequencies.
+// The estimate joins the shared model list. The sensitivity study of Section 5.3.3 (domain
+// of attraction, Table 5.8, then Monte-Carlo starts) runs on the latest physical estimate.
+#include <QFutureWatcher>
+#include <QWidget>
+#include <atomic>
+#include <memory>
+
+#include "core/ident/pem.h"
+#include "core/ident/sensitivity.h"
+#include "widgets/workspace.h"
+
+class QComboBox;
+class QLabel;
+class QListWidget;
+class QProgressBar;
+class QPushButton;
+class QSpinBox;
+class QTableWidget;
+class QTimer;
+
+namespace flexarm {
+
+class FitPanel : public QWidget {
+  Q_OBJECT
+ public:
+  explicit FitPanel(Workspace* workspace, QWidget* parent = nullptr);
+
+  // The model to fit: "arx", "armax", "oe", "bj", a physical structure name ("three-mass")
+  // or "list:N" for entry N of the shared model list. False when there is no such choice.
+  bool setModelChoice(const QString& key);
+  QString modelChoice() const;
+  void setOrders(const PolyOrders& orders);
+  // Physical models: exactly these parameters are estimated.
+  void setFreeParameters(const QStringList& names);
+  QStringList freeParameters() const;
+  void setDecimation(int factor);
+  void setNoiseModel(NoiseModel m);
+  void setStarts(int randomStarts);
+
+  bool isBusy() const { return watcher_.isRunning() || study_.isRunning(); }
+  QTableWidget* resultsTable() const { return table_; }
+  QString summaryText() const;
+  // Index in the shared model list of the latest estimate (-1 before the first).
+  int lastModelIndex() const { return lastIndex_; }
+  QTableWidget* studyTable() const { return studyTable_; }
+  QString studyText() const;
+  void setStudyRuns(int runs);
+
+ public slots:
+  void estimate();
+  void runStudy();
+  void cancel();
+
+ signals:
+  void estimated(bool ok);
+  void studyFinished(bool ok);
+
+ private:
+  struct Row {
+    QString name, unit;
+    double value = 0, std = 0, lower = 0, upper = 0;
+    bool free = false;
+  };
+  struct Outcome {
+    QString error, note;
+    ModelEntry entry;
+    std::vector<Row> rows;
+    EstimateSummary summary;
+    double fitEstimation = 0, fitValidation = 0;
+    bool hasValidation = false;
+    std::vector<double> notches, peaks;
+    // What the sensitivity study needs (physical estimates only).
+    std::shared_ptr<const ParametricModel> estimate;
+    Eigen::VectorXd u, y;
+    double sampleTime = 0;
+  };
+  struct StudyOutcome {
+    AttractionResult attraction;
+    MonteCarloResult monteCarlo;
+    QString error;
+  };
+  void refillModels();
+  void refillParameters();
+  void updateControls();
+  void onFinished();
+  void onStudyFinished();
+  void showRanges();
+  void startProgress();
+  ProgressCallback progressCallback() const;
+
+  Workspace* workspace_;
+  QComboBox* model_;
+  QSpinBox* na_;
+  QSpinBox* nb_;
+  QSpinBox* nc_;
+  QSpinBox* nd_;
+  QSpinBox* nf_;
+  QSpinBox* nk_;
+  QListWidget* free_;
+  QLabel* ranges_;
+  QSpinBox* decimation_;
+  QComboBox* noise_;
+  QSpinBox* starts_;
+  QSpinBox* iterations_;
+  QPushButton* estimate_;
+  QPushButton* cancel_;
+  QProgressBar* progress_;
+  QTableWidget* table_;
+  QLabel* summary_;
+  QSpinBox* studyRuns_;
+  QPushButton* study_button_;
+  QTableWidget* studyTable_;
+  QLabel* studySummary_;
+  QTimer* poll_;
+  QFutureWatcher<Outcome> watcher_;
+  QFutureWatcher<StudyOutcome> study_;
+  std::shared_ptr<std::atomic<int>> permille_;
+  std::shared_ptr<std::atomic<bool>> abort_;
+  Outcome last_;  // the latest physical estimate (for the study)
+  int lastIndex_ = -1;
+  int fits_ = 0;
+};
+
+}  // namespace flexarm

@@ -1,0 +1,71 @@
+#pragma once
+// What the identification panels (Fit, Bode, Compare, Residuals) share: the workspace's data
+// as input and output vectors with their estimation and validation ranges, and the models of
+// the shared list (physical or black-box) simulated, predicted and as frequency responses.
+#include <QString>
+#include <optional>
+#include <vector>
+
+#include <Eigen/Dense>
+
+#include "core/ident/evaluation.h"
+#include "widgets/workspace.h"
+
+class QListWidget;
+
+namespace flexarm {
+
+// A copy of a physical model that can be edited (the list shares const models).
+std::shared_ptr<PhysicalModel> clonePhysical(const ParametricModel& model);
+
+// Fills a list widget with the shared list's model names as check boxes; a name that was
+// unchecked before stays unchecked, new ones are checked.
+void fillModelChecklist(QListWidget* list, const std::vector<ModelEntry>& models);
+bool isModelChecked(const QListWidget* list, std::size_t index);
+
+// Input u and output y of the whole log with the estimation data's means removed (as the seed
+// does, Section 5.2), and the sample ranges the workspace's ranges cover.
+struct IdentSignals {
+  Eigen::VectorXd u, y;
+  SampleRange estimation;  // the estimation range, or every sample when none is set
+  SampleRange validation;  // empty when no validation range is set
+  double sampleTime = 1.0;
+  double startTime = 0.0;
+  bool closedLoop = false;
+  QString note;  // how the data were prepared, for the user
+};
+
+// Builds the signals from the workspace's current data. decimation > 1 decimates behind the
+// anti-alias FIR; velocityOutput forms the motor velocity from the motor angle (central
+// differences) when the output is the angle, because the physical models' output is the
+// motor velocity. Returns nullopt with a sentence in why when there are no usable data.
+std::optional<IdentSignals> identSignals(const Workspace& workspace, int decimation,
+                                         bool velocityOutput, QString* why);
+
+// The decimation that brings data sampled at dataSampleTime to the rate the entry works at:
+// 1 for physical (continuous-time) models, T_model / T_data for black-box estimates, 0 when
+// that is not a whole number.
+int decimationFor(const ModelEntry& entry, double dataSampleTime);
+
+// True when the entry's output is the motor velocity (every physical model of the list with
+// the default output; black-box estimates say nothing and count as such).
+bool wantsVelocity(const ModelEntry& entry);
+
+// Output simulated from zero initial state: the ZOH simulation of a physical model (5.3), or
+// B/(A F) u of a black-box one. nullopt with a reason when a black-box model was estimated at
+// another sample time than the data's.
+std::optional<Eigen::VectorXd> simulateEntry(const ModelEntry& entry, const Eigen::VectorXd& u,
+                                             double sampleTime, QString* why);
+
+// Residuals for the correlation tests: one-step prediction errors of a black-box model (4.5),
+// output errors y - G u of a physical one (K = 0).
+std::optional<Eigen::VectorXd> residualsOf(const ModelEntry& entry, const Eigen::VectorXd& u,
+                                           const Eigen::VectorXd& y, double sampleTime,
+                                           QString* why);
+
+// Frequency response at omega (rad/s) with bands at `level` where the entry has a covariance.
+// Black-box responses stop at their Nyquist frequency.
+FrequencyResponse responseOf(const ModelEntry& entry, const std::vector<double>& omega,
+                             double level);
+
+}  // namespace flexarm

@@ -1,0 +1,182 @@
+#include "widgets/residuals_panel.h"
+
+#include <QComboBox>
+#include <QHBoxLayout>
+#include <QLabel>
+#include <QSpinBox>
+#include <QVBoxLayout>
+#include <qcustomplot.h>
+
+#include "widgets/ident_data.h"
+
+namespace flexarm {
+namespace {
+
+void setupPlot(QCustomPlot* p, const QString& title, const QString& xLabel) {
+  p->setMinimumSize(300, 160);
+  p->plotLayout()->insertRow(0);
+  p->plotLayout()->addElement(0, 0, new QCPTextElement(p, title, QFont("sans", 9, QFont::Bold)));
+  p->xAxis->setLabel(xLabel);
+}
+
+// Correlations as bars with the +-bound band drawn as dashed lines.
+void showCorrelation(QCustomPlot* p, const std::vector<int>& lags, const std::vector<double>& r,
+          double bound, int firstTested) {
+  p->clearPlottables();
+  p->clearItems();
+  auto* inside = new QCPBars(p->xAxis, p->yAxis);
+  auto* outside = new QCPBars(p->xAxis, p->yAxis);
+  inside->setBrush(QColor(31, 119, 180));
+  inside->setPen(Qt::NoPen);
+  outside->setBrush(QColor(214, 39, 40));
+  outside->setPen(Qt::NoPen);
+  for (std::size_t i = 0; i < lags.size(); ++i) {
+    const bool out = lags[i] >= firstTested && std::abs(r[i]) > bound;
+    (out ? outside : inside)->addData(lags[i], r[i]);
+  }
+  for (QCPBars* b : {inside, outside}) b->setWidth(0.6);
+  for (double level : {bound, -bound}) {
+    auto* line = new QCPItemStraightLine(p);
+    line->point1->setCoords(0, level);
+    line->point2->setCoords(1, level);
+    line->setPen(QPen(QColor(200, 40, 40), 1, Qt::DashLine));
+  }
+  p->rescaleAxes();
+  const double top = std::max(1.2 * bound, p->yAxis->range().upper);
+  const double bottom = std::min(-1.2 * bound, p->yAxis->range().lower);
+  p->yAxis->setRange(bottom, top);
+  p->xAxis->setRange(lags.front() - 1, lags.back() + 1);
+  p->replot();
+}
+
+}  // namespace
+
+ResidualsPanel::ResidualsPanel(Workspace* workspace, QWidget* parent)
+    : QWidget(parent), workspace_(workspace), model_(new QComboBox(this)),
+      range_(new QComboBox(this)), lags_(new QSpinBox(this)), auto_(new QCustomPlot(this)),
+      cross_(new QCustomPlot(this)), verdict_(new QLabel(this)) {
+  setObjectName("residualsPanel");
+  model_->setObjectName("residualsModelCombo");
+  range_->setObjectName("residualsRangeCombo");
+  range_->addItem(tr("Estimation range"), static_cast<int>(RangeKind::Estimation));
+  range_->addItem(tr("Validation range"), static_cast<int>(RangeKind::Validation));
+  lags_->setObjectName("residualsLagSpin");
+  lags_->setRange(5, 500);
+  lags_->setValue(25);
+  lags_->setToolTip(tr("Largest lag M of the correlations"));
+  auto_->setObjectName("autocorrelationPlot");
+  cross_->setObjectName("crossCorrelationPlot");
+  setupPlot(auto_, tr("Autocorrelation of residuals (99 % bounds)"), tr("lag"));
+  setupPlot(cross_, tr("Cross-correlation of input and residuals (99 % bounds)"), tr("lag"));
+  verdict_->setObjectName("residualsVerdict");
+  verdict_->setWordWrap(true);
+
+  auto* top = new QHBoxLayout;
+  top->addWidget(new QLabel(tr("Model"), this));
+  top->addWidget(model_, 1);
+  top->addWidget(range_);
+  top->addWidget(new QLabel(tr("Lags"), this));
+  top->addWidget(lags_);
+  auto* layout = new QVBoxLayout(this);
+  layout->addLayout(top);
+  layout->addWidget(auto_, 1);
+  layout->addWidget(cross_, 1);
+  layout->addWidget(verdict_);
+
+  connect(model_, QOverload<int>::of(&QComboBox::currentIndexChanged), this, [this] {
+    if (!filling_) refresh();
+  });
+  connect(range_, QOverload<int>::of(&QComboBox::currentIndexChanged), this, &ResidualsPanel::refresh);
+  connect(lags_, QOverload<int>::of(&QSpinBox::valueChanged), this, &ResidualsPanel::refresh);
+  connect(workspace_, &Workspace::modelsChanged, this, [this](int) { refillList(); });
+  for (auto sig : {&Workspace::currentChanged, &Workspace::rangesChanged})
+    connect(workspace_, sig, this, &ResidualsPanel::refresh);
+  refillList();
+}
+
+void ResidualsPanel::refillList() {
+  filling_ = true;
+  const QString keep = model_->currentText();
+  model_->clear();
+  for (const auto& m : workspace_->models()) model_->addItem(m.name);
+  const int k = model_->findText(keep);
+  model_->setCurrentIndex(k >= 0 ? k : model_->count() - 1);  // default: the newest model
+  filling_ = false;
+  refresh();
+}
+
+void ResidualsPanel::selectModel(int index) { model_->setCurrentIndex(index); }
+void ResidualsPanel::setRangeKind(RangeKind kind) {
+  range_->setCurrentIndex(range_->findData(static_cast<int>(kind)));
+}
+void ResidualsPanel::setMaxLag(int lags) { lags_->setValue(lags); }
+QString ResidualsPanel::verdictText() const { return verdict_->text(); }
+
+void ResidualsPanel::refresh() {
+  if (filling_) return;
+  analysis_ = ResidualAnalysis{};
+  for (QCustomPlot* p : {auto_, cross_}) {
+    p->clearPlottables();
+    p->clearItems();
+    p->replot();
+  }
+  const int index = model_->currentIndex();
+  const auto& list = workspace_->models();
+  if (index < 0 || index >= static_cast<int>(list.size())) {
+    verdict_->setText(tr("No model in the list yet."));
+    return;
+  }
+  const ModelEntry& entry = list[static_cast<std::size_t>(index)];
+  QString why;
+  const int factor = workspace_->current() ? decimationFor(entry, workspace_->current()->sampleTime) : 1;
+  if (factor == 0) {
+    verdict_->setText(tr("%1: its sample time is no multiple of the data's.").arg(entry.name));
+    return;
+  }
+  const auto data = identSignals(*workspace_, factor, wantsVelocity(entry), &why);
+  if (!data) {
+    verdict_->setText(why);
+    return;
+  }
+  const auto kind = static_cast<RangeKind>(range_->currentData().toInt());
+  const SampleRange r = kind == RangeKind::Validation ? data->validation : data->estimation;
+  if (r.empty()) {
+    verdict_->setText(tr("No validation range set: select one in the Log panel (V)."));
+    return;
+  }
+  std::optional<Eigen::VectorXd> eps;
+  try {
+    eps = residualsOf(entry, data->u, data->y, data->sampleTime, &why);
+  } catch (const std::exception& e) {
+    why = QString::fromStdString(e.what());
+  }
+  const auto b = static_cast<Eigen::Index>(r.begin);
+  const auto n = static_cast<Eigen::Index>(r.size());
+  ResidualOptions o;
+  o.maxLag = lags_->value();
+  if (!eps || !eps->allFinite() || n < 2 * o.maxLag + 10) {
+    verdict_->setText(eps && eps->allFinite()
+                          ? tr("The range holds %1 samples; %2 lags need at least %3.")
+                                .arg(n).arg(o.maxLag).arg(2 * o.maxLag + 10)
+                          : tr("%1: no residuals (%2).").arg(entry.name, why.isEmpty() ? tr("unstable") : why));
+    return;
+  }
+  analysis_ = residualAnalysis(eps->segment(b, n), data->u.segment(b, n), o);
+  showCorrelation(auto_, analysis_.lags, analysis_.autocorrelation, analysis_.autocorrelationBound, 1);
+  showCorrelation(cross_, analysis_.crossLags, analysis_.crossCorrelation, analysis_.crossCorrelationBound,
+       -o.maxLag);
+  verdict_->setText(
+      tr("%1 on the %2 data, %3 samples. Whiteness: %4 (statistic %5, 99 % threshold %6). "
+         "Independence from the input: %7 (statistic %8, threshold %9).\n%10")
+          .arg(entry.name, kind == RangeKind::Validation ? tr("validation") : tr("estimation"))
+          .arg(n)
+          .arg(analysis_.white ? tr("passed") : tr("failed"))
+          .arg(analysis_.whitenessStatistic, 0, 'g', 4)
+          .arg(analysis_.whitenessThreshold, 0, 'g', 4)
+          .arg(analysis_.independent ? tr("passed") : tr("failed"))
+          .arg(analysis_.independenceStatistic, 0, 'g', 4)
+          .arg(analysis_.independenceThreshold, 0, 'g', 4)
+          .arg(QString::fromStdString(analysis_.verdict)));
+}
+
+}  // namespace flexarm
