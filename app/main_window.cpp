@@ -30,6 +30,7 @@
 #include "core/io/ranges.h"
 #include "widgets/arm_panel.h"
 #include "widgets/log_panel.h"
+#include "widgets/lqg_panel.h"
 #include "widgets/model_panel.h"
 #include "widgets/preprocess_panel.h"
 #include "widgets/workspace.h"
@@ -110,6 +111,8 @@ MainWindow::MainWindow(QWidget* parent)
                       "Ctrl+Shift+A", nullptr);
   modelDock_ = addPanel(modelPanel_ = new ModelPanel(workspace_, this), tr("Model"),
                         "modelDock", "Ctrl+Shift+M", preprocessDock_);
+  lqgDock_ = addPanel(lqgPanel_ = new LqgPanel(workspace_, this), tr("LQG"), "lqgDock",
+                      "Ctrl+Shift+L", preprocessDock_);
   preprocessDock_->raise();
   resize(1280, 860);
 

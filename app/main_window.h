@@ -16,6 +16,7 @@ namespace flexarm {
 
 class ArmPanel;
 class LogPanel;
+class LqgPanel;
 class ModelPanel;
 class PreprocessPanel;
 class Workspace;
@@ -37,6 +38,7 @@ class MainWindow : public QMainWindow {
   PreprocessPanel* preprocessPanel() const { return preprocessPanel_; }
   ArmPanel* armPanel() const { return armPanel_; }
   ModelPanel* modelPanel() const { return modelPanel_; }
+  LqgPanel* lqgPanel() const { return lqgPanel_; }
   QStringList recentFiles() const;
 
  signals:
@@ -69,6 +71,8 @@ class MainWindow : public QMainWindow {
   QDockWidget* preprocessDock_ = nullptr;
   QDockWidget* armDock_ = nullptr;
   QDockWidget* modelDock_ = nullptr;
+  LqgPanel* lqgPanel_ = nullptr;
+  QDockWidget* lqgDock_ = nullptr;
   QMenu* recentMenu_ = nullptr;
   QMenu* viewMenu_ = nullptr;
   QFutureWatcher<LogReadResult> reader_;

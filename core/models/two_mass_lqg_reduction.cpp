@@ -111,8 +111,10 @@ TwoMassReductionResult reduceToTwoMass(const PhysicalModel& model,
       p.Jm = Jm;
       p.Ja = armInertia;
       p.k = r2 * k;
-      p.d = std::max(0.0, r2 * k * k * (dg / (kg * kg) + da / (ka * ka)));
+      const double d = r2 * k * k * (dg / (kg * kg) + da / (ka * ka));
+      p.d = std::max(0.0, d);
       text << s << " with the masses after the gear merged and k_g, k_a in series, scaled by r^2";
+      if (d < 0.0) text << "; the series damping " << d << " is negative and set to 0";
     } else {
       ModelOptions velocity;  // (3.14): torque to motor velocity
       std::unique_ptr<ParametricModel> copy = model.clone();
@@ -135,9 +137,12 @@ TwoMassReductionResult reduceToTwoMass(const PhysicalModel& model,
       p.Jm = total * wz * wz / (wp * wp);
       p.Ja = total - p.Jm;
       p.k = p.Ja * wz * wz;
-      p.d = std::max(0.0, 2.0 * notches.front().damping * std::sqrt(p.k * p.Ja));
+      const double zeta = notches.front().damping;
+      p.d = std::max(0.0, 2.0 * zeta * std::sqrt(p.k * p.Ja));
       text << s << " matched at its first antiresonance " << wz << " rad/s and resonance " << wp
            << " rad/s with the total inertia kept";
+      if (zeta < 0.0)
+        text << "; the antiresonance has negative damping (" << zeta << "), d set to 0";
     }
   }
   if (kT != 1.0) text << "; u is the motor torque k_T u (k_T = " << kT << ")";

@@ -58,6 +58,13 @@ TEST(TwoMassReduction, ThreeMassMatchedAtFirstModeKeepsFrequenciesAndInertia) {
               1e-9 * peak.naturalFrequency);
   const double r2 = std::pow(m->value("r"), 2);
   EXPECT_NEAR(p.Jm + p.Ja, m->value("J_m") + r2 * (m->value("J_g") + m->value("J_a")), 1e-15);
+  // Table 5.7 p6 has d_g < 0: its first antiresonance is undamped or worse, and says so.
+  if (notch.damping < 0.0) {
+    EXPECT_EQ(p.d, 0.0);
+    EXPECT_NE(red.message.find("negative damping"), std::string::npos) << red.message;
+  } else {
+    EXPECT_NEAR(p.d, 2.0 * notch.damping * std::sqrt(p.k * p.Ja), 1e-12);
+  }
   // The reduced model's own peak (from its poles) is the three-mass first peak.
   StateSpace sys;
   const TwoMassLqgPlant g = twoMassLqgPlant(p, LqgMeasurement::MotorAngle);
