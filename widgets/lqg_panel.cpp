@@ -94,15 +94,14 @@ LqgPanel::LqgPanel(Workspace* workspace, QWidget* parent)
       unpinButton_(new QPushButton(tr("Unpin"), this)), badge_(new QLabel(this)),
       pinnedBadge_(new QLabel(this)), summary_(new QLabel(this)), nyquist_(new QCustomPlot(this)),
       sensitivity_(new QCustomPlot(this)), steps_(new QCustomPlot(this)),
-      poles_(new PoleZeroPlot(this)) {
+      poles_(new PoleZeroPlot(this)), budget_(kSynchronousBudget) {
   setObjectName("lqgPanel");
   auto* box = new QWidget;
   buildControls(box);
   auto* scroll = new QScrollArea(this);
   scroll->setWidget(box);
   scroll->setWidgetResizable(true);
-  scroll->setMinimumWidth(box->sizeHint().width() + 24);
-  scroll->setHorizontalScrollBarPolicy(Qt::ScrollBarAlwaysOff);
+  scroll->setMinimumWidth(190);  // a narrow dock scrolls instead of squeezing the window
 
   badge_->setObjectName("stabilityBadge");
   pinnedBadge_->setObjectName("pinnedBadge");
@@ -114,6 +113,7 @@ LqgPanel::LqgPanel(Workspace* workspace, QWidget* parent)
     f.setBold(true);
     b->setFont(f);
     b->setMargin(4);
+    b->setMinimumWidth(80);  // a narrow dock cuts the sentence instead of widening the window
   }
   pinnedBadge_->hide();
 
@@ -148,7 +148,9 @@ LqgPanel::LqgPanel(Workspace* workspace, QWidget* parent)
   poles_->plot()->plotLayout()->insertRow(0);
   poles_->plot()->plotLayout()->addElement(
       0, 0, new QCPTextElement(poles_->plot(), tr("Regulator poles (of F_y) and closed loop")));
-  for (QCustomPlot* p : {nyquist_, sensitivity_, steps_}) p->setMinimumSize(260, 220);
+  for (QWidget* p : {static_cast<QWidget*>(nyquist_), static_cast<QWidget*>(sensitivity_),
+                     static_cast<QWidget*>(steps_), static_cast<QWidget*>(poles_)})
+    p->setMinimumSize(150, 130);
 
   auto* zoomNear = new QPushButton(tr("Nyquist near -1"), this);
   zoomNear->setObjectName("zoomNearMinusOne");
@@ -443,7 +445,7 @@ void LqgPanel::requestUpdate() {
     pending_ = true;  // the newest settings are read when the running redesign ends
     return;
   }
-  if (lastCost_ > kSynchronousBudget) {
+  if (lastCost_ >= budget_) {
     startBackground();
     return;
   }

@@ -38,6 +38,9 @@ class LqgPanel : public QWidget {
 
   explicit LqgPanel(Workspace* workspace, QWidget* parent = nullptr);
   ~LqgPanel() override;
+  // Modest, so that docking the panel does not take width from the other panels; it grows
+  // with its dock or window.
+  QSize sizeHint() const override { return {560, 600}; }
 
   // The design variables as the controls show them.
   LqgOptions options() const;
@@ -69,6 +72,9 @@ class LqgPanel : public QWidget {
   // Seconds the last update took: redesign plus plot data handed to the plots (the drawing
   // itself follows, once per event-loop pass).
   double lastUpdateSeconds() const { return lastCost_; }
+  // Updates that took longer than this run off the GUI thread (default 12 ms); 0 sends every
+  // update there.
+  void setSynchronousBudget(double seconds) { budget_ = seconds; }
   // Zooms the Nyquist plot around -1, or shows the whole curve.
   void zoomNearMinusOne();
   void showWholeNyquist();
@@ -113,6 +119,7 @@ class LqgPanel : public QWidget {
   QFutureWatcher<std::shared_ptr<const LqgAnalysis>> watcher_;
   bool pending_ = false;
   double lastCost_ = 0.0;  // s, redesign plus drawing of the last update
+  double budget_;
   bool quiet_ = false;     // set while the controls are filled programmatically
 };
 

@@ -126,12 +126,15 @@ class LqgPanelTest : public QObject {
       QMouseEvent move(QEvent::MouseMove, p, s->mapToGlobal(p), Qt::NoButton, Qt::LeftButton,
                        Qt::NoModifier);
       QApplication::sendEvent(s, &move);
+      // Let each step's redesign show, whether it ran here or in the background.
+      QTRY_VERIFY(!panel_->isComputing());
       QTest::qWait(5);
     }
     QTest::mouseRelease(s, Qt::LeftButton, Qt::NoModifier, start + QPoint(dx, 0));
     QVERIFY2(std::abs(s->value() - target) <= 3,
              qPrintable(QString("drag ended at %1, target %2").arg(s->value()).arg(target)));
-    QVERIFY(analysed.count() >= 2);  // the plots followed the drag, not only its end
+    QVERIFY2(analysed.count() >= 6,  // the plots followed the drag, not only its end
+             qPrintable(QString::number(analysed.count())));
     qInfo("%s", qPrintable(panel_->summaryText()));
     qInfo("slider move: %d updates during the drag, last one %.2f ms (redesign + plot data)",
           static_cast<int>(analysed.count()), panel_->lastUpdateSeconds() * 1e3);
@@ -246,10 +249,42 @@ class LqgPanelTest : public QObject {
     QCOMPARE(panel_->options().parameters.Ja, 0.0762);
   }
 
+  void slowUpdatesRunInTheBackgroundAndCoalesce() {
+    // As if each redesign took longer than the budget: every update goes off the GUI thread
+    // and key presses made meanwhile are coalesced into one more redesign.
+    panel_->setSynchronousBudget(0.0);
+    QSignalSpy analysed(panel_, &LqgPanel::analysed);
+    QTest::mouseClick(panel_->findChild<QPushButton*>("preset_case-i"), Qt::LeftButton);
+    QCOMPARE(analysed.count(), 0);  // not drawn within the click: the result comes back later
+    QVERIFY(analysed.wait(10000));
+    QTRY_VERIFY(!panel_->isComputing());
+    QCOMPARE(panel_->badgeText(), QString("the regulator is stable"));
+    analysed.clear();
+    QSlider* s = panel_->weight("r2_1")->slider();
+    const int target = panel_->weight("r2_1")->positionOf(1e-8);
+    const int presses = s->value() - target;
+    QVERIFY(presses >= 20);
+    for (int i = 0; i < presses; ++i) QTest::keyClick(s, Qt::Key_Left);
+    QCOMPARE(panel_->options().r2(0), 1e-8);
+    QTRY_VERIFY(!panel_->isComputing() && analysed.count() > 0);
+    QTest::qWait(20);
+    QTRY_VERIFY(!panel_->isComputing());
+    QVERIFY2(analysed.count() < presses, qPrintable(QString::number(analysed.count())));
+    // The design shown is the one of the last setting.
+    QCOMPARE(panel_->badgeText(), QString("the regulator is unstable: 2 poles in the RHP"));
+    panel_->setSynchronousBudget(0.012);
+  }
+
   void mainWindowHasTheLqgDock() {
     MainWindow w;
     QVERIFY(w.lqgPanel() != nullptr);
     QVERIFY(w.findChild<QDockWidget*>("lqgDock") != nullptr);
+    // The dock does not force the window wider than the other panels do.
+    const QSize lqg = w.lqgPanel()->minimumSizeHint();
+    const QSize model = w.findChild<QWidget*>("modelPanel")->minimumSizeHint();
+    qInfo("minimum sizes: LQG %dx%d, Model %dx%d", lqg.width(), lqg.height(), model.width(),
+          model.height());
+    QVERIFY(lqg.width() <= 700 && lqg.height() <= 600);
   }
 
   void cleanupTestCase() {
