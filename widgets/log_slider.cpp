@@ -21,14 +21,14 @@ LogSlider::LogSlider(const QString& name, const QString& label, double lowest, d
   slider_->setRange(allowZero_ ? 0 : 1, decades * steps_ + 1);
   slider_->setSingleStep(1);
   slider_->setPageStep(steps_);
-  slider_->setMinimumWidth(120);
+  slider_->setMinimumWidth(60);
   slider_->setToolTip(tr("%1 .. %2, %3 steps per decade%4")
                           .arg(lowest)
                           .arg(highest)
                           .arg(steps_)
                           .arg(allowZero_ ? tr("; far left is 0") : QString()));
-  field_->setMaximumWidth(80);
-  label_->setMinimumWidth(90);
+  field_->setMaximumWidth(70);
+  label_->setMinimumWidth(70);
   auto* layout = new QHBoxLayout(this);
   layout->setContentsMargins(0, 0, 0, 0);
   layout->addWidget(label_);

@@ -9,6 +9,7 @@
 #include <QLabel>
 #include <QLineEdit>
 #include <QPushButton>
+#include <QResizeEvent>
 #include <QScrollArea>
 #include <QSplitter>
 #include <QVBoxLayout>
@@ -178,7 +179,11 @@ LqgPanel::LqgPanel(Workspace* workspace, QWidget* parent)
   auto* split = new QSplitter(Qt::Horizontal, this);
   split->addWidget(scroll);
   split->addWidget(right);
-  split->setStretchFactor(1, 3);
+  split->setStretchFactor(0, 0);
+  split->setStretchFactor(1, 1);
+  split_ = split;
+  controls_ = box;
+  connect(split, &QSplitter::splitterMoved, this, [this] { splitterMoved_ = true; });
   auto* layout = new QVBoxLayout(this);
   layout->setContentsMargins(4, 4, 4, 4);
   layout->addWidget(split);
@@ -189,6 +194,7 @@ LqgPanel::LqgPanel(Workspace* workspace, QWidget* parent)
     const auto a = watcher_.result();
     showAnalysis(a);
     lastCost_ = a->seconds + t.nsecsElapsed() * 1e-9;
+    inFlight_ = false;
     if (pending_) {
       pending_ = false;
       requestUpdate();
@@ -206,6 +212,14 @@ LqgPanel::LqgPanel(Workspace* workspace, QWidget* parent)
 }
 
 LqgPanel::~LqgPanel() { watcher_.waitForFinished(); }
+
+void LqgPanel::resizeEvent(QResizeEvent* e) {
+  QWidget::resizeEvent(e);
+  if (splitterMoved_) return;
+  const int total = split_->width();
+  const int left = std::min(controls_->sizeHint().width() + 20, total * 2 / 5);
+  split_->setSizes({left, total - left});
+}
 
 void LqgPanel::buildControls(QWidget* box) {
   auto* layout = new QVBoxLayout(box);
@@ -441,7 +455,7 @@ void LqgPanel::requestUpdate() {
     showFailure(tr("cannot design: %1").arg(QString::fromStdString(why)));
     return;
   }
-  if (watcher_.isRunning()) {
+  if (inFlight_) {
     pending_ = true;  // the newest settings are read when the running redesign ends
     return;
   }
@@ -459,6 +473,7 @@ void LqgPanel::startBackground() {
   const LqgOptions o = options();
   const LqgAnalysisOptions ao = analysisOptions();
   pending_ = false;
+  inFlight_ = true;
   watcher_.setFuture(QtConcurrent::run(
       [o, ao]() { return std::make_shared<const LqgAnalysis>(analyzeLqg(o, ao)); }));
 }

@@ -25,6 +25,7 @@ class QCustomPlot;
 class QLabel;
 class QLineEdit;
 class QPushButton;
+class QSplitter;
 
 namespace flexarm {
 
@@ -68,7 +69,8 @@ class LqgPanel : public QWidget {
   QCustomPlot* sensitivityPlot() const { return sensitivity_; }
   QCustomPlot* stepPlot() const { return steps_; }
   PoleZeroPlot* poleMap() const { return poles_; }
-  bool isComputing() const { return watcher_.isRunning(); }
+  // True from a background redesign's start until its result is drawn.
+  bool isComputing() const { return inFlight_; }
   // Seconds the last update took: redesign plus plot data handed to the plots (the drawing
   // itself follows, once per event-loop pass).
   double lastUpdateSeconds() const { return lastCost_; }
@@ -81,6 +83,11 @@ class LqgPanel : public QWidget {
 
  signals:
   void analysed();  // the plots show a new design
+
+ protected:
+  // Keeps the controls at their natural width, but at most 40 % of the panel, until the user
+  // moves the splitter.
+  void resizeEvent(QResizeEvent* e) override;
 
  private:
   void buildControls(QWidget* box);
@@ -112,12 +119,16 @@ class LqgPanel : public QWidget {
   QCustomPlot* sensitivity_;
   QCustomPlot* steps_;
   PoleZeroPlot* poles_;
+  QSplitter* split_ = nullptr;
+  QWidget* controls_ = nullptr;
+  bool splitterMoved_ = false;
   TwoMassLqgParameters parameters_;
 
   std::shared_ptr<const LqgAnalysis> current_, pinned_;
   QString pinnedLabel_;
   QFutureWatcher<std::shared_ptr<const LqgAnalysis>> watcher_;
   bool pending_ = false;
+  bool inFlight_ = false;
   double lastCost_ = 0.0;  // s, redesign plus drawing of the last update
   double budget_;
   bool quiet_ = false;     // set while the controls are filled programmatically

@@ -145,6 +145,7 @@ class LqgPanelTest : public QObject {
     QCOMPARE(s->value(), target);
     QCOMPARE(r2->value(), 1e-8);
     QCOMPARE(panel_->options().r2(0), 1e-8);
+    QTRY_VERIFY(!panel_->isComputing());
 
     // Case (ii): unstable regulator with two RHP poles, F_y G encircles -1 twice (8.6).
     QTRY_COMPARE(panel_->badgeText(), QString("the regulator is unstable: 2 poles in the RHP"));
@@ -225,6 +226,7 @@ class LqgPanelTest : public QObject {
     source->setFocus();
     QTest::keyClick(source, Qt::Key_Down);
     QCOMPARE(source->currentIndex(), 1);
+    QTRY_VERIFY(!panel_->isComputing());  // slow machines redesign in the background
     QVERIFY2(panel_->reductionText().contains("scaled by r^2"), qPrintable(panel_->reductionText()));
     QVERIFY(std::abs(panel_->options().parameters.Ja - 12.0 / (118.0 * 118.0)) < 1e-12);
     QTRY_VERIFY(panel_->current()->ok());
@@ -238,6 +240,7 @@ class LqgPanelTest : public QObject {
     // A three-mass model (Table 5.7 p6) matched at its first antiresonance and resonance.
     addModel("three-mass");
     panel_->selectSource(3);
+    QTRY_VERIFY(!panel_->isComputing());
     QVERIFY2(panel_->reductionText().contains("first antiresonance"),
              qPrintable(panel_->reductionText()));
     const TwoMassLqgParameters p = panel_->options().parameters;
@@ -285,6 +288,15 @@ class LqgPanelTest : public QObject {
     qInfo("minimum sizes: LQG %dx%d, Model %dx%d", lqg.width(), lqg.height(), model.width(),
           model.height());
     QVERIFY(lqg.width() <= 700 && lqg.height() <= 600);
+    // Docked and raised (a tab next to Preprocess and Model), showing the seed's case (i).
+    w.resize(1400, 900);
+    w.show();
+    QVERIFY(QTest::qWaitForWindowExposed(&w));
+    w.findChild<QDockWidget*>("lqgDock")->raise();
+    QTRY_VERIFY(!w.lqgPanel()->visibleRegion().isEmpty());
+    QCOMPARE(w.lqgPanel()->badgeText(), QString("the regulator is stable"));
+    QTest::qWait(50);
+    test::saveShot(w.grab().toImage(), "main_window_lqg_dock");
   }
 
   void cleanupTestCase() {
