@@ -33,6 +33,7 @@
 #include "widgets/compare_panel.h"
 #include "widgets/fit_panel.h"
 #include "widgets/log_panel.h"
+#include "widgets/lqg_panel.h"
 #include "widgets/model_panel.h"
 #include "widgets/preprocess_panel.h"
 #include "widgets/residuals_panel.h"
@@ -122,6 +123,8 @@ MainWindow::MainWindow(QWidget* parent)
                           "compareDock", "Ctrl+Shift+C", preprocessDock_);
   residualsDock_ = addPanel(residualsPanel_ = new ResidualsPanel(workspace_, this),
                             tr("Residuals"), "residualsDock", "Ctrl+Shift+R", preprocessDock_);
+  lqgDock_ = addPanel(lqgPanel_ = new LqgPanel(workspace_, this), tr("LQG"), "lqgDock",
+                      "Ctrl+Shift+L", preprocessDock_);
   preprocessDock_->raise();
   resize(1280, 860);
 

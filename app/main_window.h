@@ -19,6 +19,7 @@ class BodePanel;
 class ComparePanel;
 class FitPanel;
 class LogPanel;
+class LqgPanel;
 class ModelPanel;
 class PreprocessPanel;
 class ResidualsPanel;
@@ -45,6 +46,7 @@ class MainWindow : public QMainWindow {
   BodePanel* bodePanel() const { return bodePanel_; }
   ComparePanel* comparePanel() const { return comparePanel_; }
   ResidualsPanel* residualsPanel() const { return residualsPanel_; }
+  LqgPanel* lqgPanel() const { return lqgPanel_; }
   QStringList recentFiles() const;
 
  signals:
@@ -85,6 +87,8 @@ class MainWindow : public QMainWindow {
   QDockWidget* bodeDock_ = nullptr;
   QDockWidget* compareDock_ = nullptr;
   QDockWidget* residualsDock_ = nullptr;
+  LqgPanel* lqgPanel_ = nullptr;
+  QDockWidget* lqgDock_ = nullptr;
   QMenu* recentMenu_ = nullptr;
   QMenu* viewMenu_ = nullptr;
   QFutureWatcher<LogReadResult> reader_;
