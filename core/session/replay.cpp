@@ -1,6 +1,8 @@
 #include "core/session/replay.h"
 
+#include <algorithm>
 #include <chrono>
+#include <filesystem>
 #include <stdexcept>
 
 #include "core/session/session_part.h"
@@ -95,7 +97,8 @@ ReportSection dataSection(const Session& session, const PreparedSession& prepare
   ReportTable logs{"Logs", {"Log", "File", "Samples", "Rate (Hz)", "SHA-256"}, {}};
   nlohmann::json logsJson = nlohmann::json::array();
   for (const auto& l : prepared.logs) {
-    logs.rows.push_back({l.name + (l.note.empty() ? "" : " (" + l.note + ")"), l.path,
+    logs.rows.push_back({l.name + (l.note.empty() ? "" : " (" + l.note + ")"),
+                         std::filesystem::path(l.path).filename().string(),
                          std::to_string(l.raw.samples()), formatSignificant(l.raw.sampleRateHz(), 6),
                          l.sha256});
     logsJson.push_back({{"name", l.name}, {"samples", l.raw.samples()},
@@ -131,6 +134,17 @@ ReportSection dataSection(const Session& session, const PreparedSession& prepare
   addRange("validation", session.validation, d.validationRange);
   if (ranges.rows.empty()) s.paragraphs.push_back("No estimation or validation range is set.");
   else s.tables.push_back(ranges);
+  for (const Channel* c : {d.input(), d.output()}) {
+    if (!c) continue;
+    ReportSeries series{c->name, {}, {}, false};
+    const std::size_t step = std::max<std::size_t>(1, d.samples() / 3000);
+    for (std::size_t i = 0; i < d.samples(); i += step) {
+      series.x.push_back(d.timeAt(i));
+      series.y.push_back(c->values[i]);
+    }
+    s.plots.push_back(ReportPlot{std::string(c == d.input() ? "Input " : "Output ") + c->name,
+                                 "time (s)", c->name + " (" + c->unit + ")", false, false, {series}});
+  }
   s.values = {{"logs", logsJson},
               {"samples", d.samples()},
               {"rate_hz", d.sampleRateHz()},

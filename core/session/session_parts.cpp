@@ -112,8 +112,9 @@ class ModelsPart : public SessionPart {
       phase.y.push_back(p);
       last = p;
     }
-    return {ReportPlot{"Bode magnitude", "frequency (rad/s)", "|G| (rad/s per N m)", true, true, {mag}},
-            ReportPlot{"Bode phase", "frequency (rad/s)", "phase (deg)", true, false, {phase}}};
+    return {ReportPlot{"Bode magnitude, " + name, "frequency (rad/s)", "|G| (rad/s per N m)", true,
+                       true, {mag}},
+            ReportPlot{"Bode phase, " + name, "frequency (rad/s)", "phase (deg)", true, false, {phase}}};
   }
 
   // Simulation fit % (5.2) on the ranges, as the Model panel computes it for the whole log.
@@ -169,7 +170,7 @@ class ModelsPart : public SessionPart {
                  simulated.begin() + static_cast<std::ptrdiff_t>(plotRange->end));
     thin(meas.x, meas.y, 3000);
     thin(sim.x, sim.y, 3000);
-    s.plots.push_back(ReportPlot{"Measured and simulated motor velocity", "time (s)",
+    s.plots.push_back(ReportPlot{"Measured and simulated motor velocity, " + spec.name, "time (s)",
                                  "motor velocity (rad/s)", false, false, {meas, sim}});
   }
 };
