@@ -18,6 +18,7 @@ class ArmPanel;
 class LogPanel;
 class ModelPanel;
 class PreprocessPanel;
+class SessionController;
 class Workspace;
 
 class MainWindow : public QMainWindow {
@@ -37,6 +38,7 @@ class MainWindow : public QMainWindow {
   PreprocessPanel* preprocessPanel() const { return preprocessPanel_; }
   ArmPanel* armPanel() const { return armPanel_; }
   ModelPanel* modelPanel() const { return modelPanel_; }
+  SessionController* sessionController() const { return session_; }
   QStringList recentFiles() const;
 
  signals:
@@ -69,11 +71,13 @@ class MainWindow : public QMainWindow {
   QDockWidget* preprocessDock_ = nullptr;
   QDockWidget* armDock_ = nullptr;
   QDockWidget* modelDock_ = nullptr;
+  SessionController* session_ = nullptr;
   QMenu* recentMenu_ = nullptr;
   QMenu* viewMenu_ = nullptr;
   QFutureWatcher<LogReadResult> reader_;
   QProgressDialog* progress_ = nullptr;
   QString readingPath_;
+  LogReadOptions readingOptions_;
   bool readCancelled_ = false;
   qint64 readStartMs_ = 0;
 };

@@ -228,10 +228,9 @@ SessionParseResult parseSession(const std::string& text) {
   const int version = j["version"].get<int>();
   const std::string writer = j.value("written_by", std::string("a newer FlexArm"));
   if (version > kSessionVersion) {
-    r.message = "this session was saved by " + writer + " in session format " +
-                std::to_string(version) + "; FlexArm " + FLEXARM_VERSION +
-                " reads formats up to " + std::to_string(kSessionVersion) +
-                ". Open it with a newer FlexArm.";
+    r.message = "this session is in session format " + std::to_string(version) + " (written by " +
+                writer + "); FlexArm " + FLEXARM_VERSION + " reads formats up to " +
+                std::to_string(kSessionVersion) + ". Open it with a newer FlexArm.";
     return r;
   }
   std::string why;

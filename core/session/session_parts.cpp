@@ -68,7 +68,14 @@ class ModelsPart : public SessionPart {
     s.title = "Model " + spec.name;
     s.paragraphs.push_back(model.description() + ".");
     std::string fx;
-    for (const auto& e : spec.effects) fx += (fx.empty() ? "" : ", ") + toString(e);
+    for (const auto& e : spec.effects) {
+      const auto& info = effectParameters(e.kind);
+      fx += (fx.empty() ? "" : "; ") + std::string(toString(e.kind)) + " (";
+      for (std::size_t i = 0; i < info.size(); ++i)
+        fx += (i ? ", " : "") + info[i].name + " = " + formatSignificant(e.values[i]) +
+              (info[i].unit.empty() ? "" : " " + info[i].unit);
+      fx += ")";
+    }
     s.paragraphs.push_back(fx.empty() ? "No nonlinear effects." : "Effects: " + fx + ".");
     s.paragraphs.push_back("Parameter values as set in the model list (not estimated here).");
     ReportTable params{"Parameters", {"Parameter", "Value", "Unit", "Free"}, {}};
