@@ -104,39 +104,53 @@ std::unique_ptr<QCustomPlot> makePlot(const ReportPlot& p) {
   return plot;
 }
 
-QString plotDataUri(const ReportPlot& p) {
-  auto plot = makePlot(p);
+QString dataUri(const QImage& image) {
   QByteArray png;
   QBuffer buffer(&png);
   buffer.open(QIODevice::WriteOnly);
-  plot->toPixmap(kPlotWidth, kPlotHeight, 2.0).save(&buffer, "PNG");
+  image.save(&buffer, "PNG");
   return "data:image/png;base64," + QString::fromLatin1(png.toBase64());
 }
 
 }  // namespace
 
-QString reportHtml(const Report& report) {
+QList<QImage> reportPlotImages(const Report& report) {
+  QList<QImage> images;
+  for (const auto& s : report.sections)
+    for (const auto& p : s.plots) images.append(makePlot(p)->toPixmap(kPlotWidth, kPlotHeight, 2.0).toImage());
+  return images;
+}
+
+QString reportHtml(const Report& report, const QList<QImage>& plots) {
   QString h = "<!DOCTYPE html>\n<html><head><meta charset=\"utf-8\"><title>" + esc(report.title) +
               "</title><style>" + kStyle + "</style></head><body>\n" + headerHtml(report);
+  int next = 0;
   for (const auto& s : report.sections) {
     h += sectionHtml(s) + "\n";
-    for (const auto& p : s.plots)
+    for (const auto& p : s.plots) {
+      if (next >= plots.size()) break;
       h += QString("<p><img alt=\"%1\" width=\"%2\" height=\"%3\" src=\"%4\"></p>\n")
                .arg(esc(p.title))
                .arg(kPlotWidth)
                .arg(kPlotHeight)
-               .arg(plotDataUri(p));
+               .arg(dataUri(plots[next++]));
+    }
   }
   return h + "</body></html>\n";
 }
 
 bool writeReportHtml(const Report& report, const QString& path, QString* why) {
+  return writeReportHtml(report, reportPlotImages(report), path, why);
+}
+
+bool writeReportHtml(const Report& report, const QList<QImage>& plots, const QString& path,
+                     QString* why) {
   QSaveFile f(path);
   if (!f.open(QIODevice::WriteOnly)) {
     if (why) *why = f.errorString();
     return false;
   }
-  f.write(reportHtml(report).toUtf8());
+  f.write(reportHtml(report, plots).toUtf8());
   if (!f.commit()) {
     if (why) *why = f.errorString();
     return false;

@@ -3,6 +3,8 @@
 // inline, plots embedded as PNG data URIs, no external reference. PDF has text laid out by
 // QTextDocument and plots drawn as vector graphics (QCustomPlot::toPainter on QPdfWriter
 // pages). Both open with the provenance: FlexArm version, session file, every log's SHA-256.
+#include <QImage>
+#include <QList>
 #include <QString>
 #include <string>
 
@@ -10,8 +12,13 @@
 
 namespace flexarm {
 
-// The whole report as one HTML document.
-QString reportHtml(const Report& report);
+// Every plot of the report as an image, in order. GUI thread only (QCustomPlot is a widget).
+QList<QImage> reportPlotImages(const Report& report);
+// The whole report as one HTML document with the plot images embedded as PNG. Any thread:
+// the window encodes and writes in the background.
+QString reportHtml(const Report& report, const QList<QImage>& plots);
+bool writeReportHtml(const Report& report, const QList<QImage>& plots, const QString& path,
+                     QString* why);
 bool writeReportHtml(const Report& report, const QString& path, QString* why);
 bool writeReportPdf(const Report& report, const QString& path, QString* why);
 

@@ -34,6 +34,8 @@ SessionController::SessionController(MainWindow* window, Workspace* workspace)
   addMenuActions();
   connect(&opener_, &QFutureWatcher<Opened>::finished, this, &SessionController::onOpened);
   connect(&replayer_, &QFutureWatcher<ReplayResult>::finished, this, &SessionController::onReplayed);
+  connect(&writer_, &QFutureWatcher<QString>::finished, this,
+          [this] { onReportWritten(writer_.result()); });
   connect(workspace_, &Workspace::logChanged, this, [this] {
     if (restoring_) return;
     std::string why;
@@ -278,19 +280,30 @@ void SessionController::onReplayed() {
   QString why;
   if (r.termination == Termination::Converged) {
     if (path_.isEmpty()) r.report.session = "unsaved session";
-    const bool ok = reportPath_.endsWith(".pdf", Qt::CaseInsensitive)
-                        ? writeReportPdf(r.report, reportPath_, &why)
-                        : writeReportHtml(r.report, reportPath_, &why);
-    if (ok) {
-      window_->statusBar()->showMessage(tr("Wrote report %1").arg(reportPath_), 8000);
-      emit reportExported(reportPath_);
-      return;
+    if (reportPath_.endsWith(".pdf", Qt::CaseInsensitive)) {
+      const bool ok = writeReportPdf(r.report, reportPath_, &why);
+      return onReportWritten(ok ? QString() : why);
     }
-  } else {
-    why = QString::fromStdString(r.message);
+    // Plots are drawn here (widgets); encoding them as PNG and writing run in the background.
+    const QList<QImage> plots = reportPlotImages(r.report);
+    const QString path = reportPath_;
+    writer_.setFuture(QtConcurrent::run([report = std::move(r.report), plots, path] {
+      QString message;
+      return writeReportHtml(report, plots, path, &message) ? QString() : message;
+    }));
+    return;
   }
-  fail(tr("Could not export the report"), why);
-  emit reportFailed(why);
+  onReportWritten(QString::fromStdString(r.message));
+}
+
+void SessionController::onReportWritten(const QString& error) {
+  if (error.isEmpty()) {
+    window_->statusBar()->showMessage(tr("Wrote report %1").arg(reportPath_), 8000);
+    emit reportExported(reportPath_);
+    return;
+  }
+  fail(tr("Could not export the report"), error);
+  emit reportFailed(error);
 }
 
 QString SessionController::autosavePath() const {

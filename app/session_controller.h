@@ -34,7 +34,7 @@ class SessionController : public QObject {
   // Reads a session, its logs and preprocessing in the background; emits sessionOpened or
   // openFailed (then the window is unchanged).
   void open(const QString& path);
-  bool isBusy() const { return opener_.isRunning() || replayer_.isRunning(); }
+  bool isBusy() const { return opener_.isRunning() || replayer_.isRunning() || writer_.isRunning(); }
   // Replays the current state in the background and writes the report (.pdf or .html);
   // emits reportExported or reportFailed.
   void exportReport(const QString& path);
@@ -68,6 +68,7 @@ class SessionController : public QObject {
   void exportDialog();
   void onOpened();
   void onReplayed();
+  void onReportWritten(const QString& error);  // empty when the report was written
   void addRecent(const QString& path);
   void rebuildRecent();
   void offerRecovery();
@@ -89,6 +90,7 @@ class SessionController : public QObject {
   bool cancelled_ = false;
   QFutureWatcher<Opened> opener_;
   QFutureWatcher<ReplayResult> replayer_;
+  QFutureWatcher<QString> writer_;  // HTML encoding and writing
 };
 
 }  // namespace flexarm
