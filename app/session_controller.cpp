@@ -54,6 +54,13 @@ SessionController::SessionController(MainWindow* window, Workspace* workspace)
   QTimer::singleShot(0, this, &SessionController::offerRecovery);
 }
 
+SessionController::~SessionController() {
+  opener_.waitForFinished();
+  replayer_.waitForFinished();
+  writer_.waitForFinished();
+  QFile::remove(autosavePath());  // a normal end; only a crash leaves the autosave behind
+}
+
 void SessionController::addMenuActions() {
   QMenu* file = window_->menuBar()->actions().first()->menu();
   QAction* before = nullptr;  // the separator above Quit
@@ -72,7 +79,7 @@ void SessionController::addMenuActions() {
   file->insertMenu(before, recentMenu_);
   add(tr("&Save session"), "Ctrl+S", &SessionController::saveCurrent)->setObjectName("saveSessionAction");
   add(tr("Save session &as..."), "Ctrl+Shift+S", &SessionController::saveAs);
-  add(tr("Export &report (PDF, HTML)..."), "Ctrl+Shift+R", &SessionController::exportDialog);
+  add(tr("Export re&port (PDF, HTML)..."), "Ctrl+Shift+R", &SessionController::exportDialog);
   rebuildRecent();
 }
 

@@ -25,6 +25,7 @@ class SessionController : public QObject {
   Q_OBJECT
  public:
   SessionController(MainWindow* window, Workspace* workspace);
+  ~SessionController() override;
 
   // The window's state as a session; log paths are stored relative to sessionPath when the
   // log lies beside it (absolute when sessionPath is empty). Needs an open log.

@@ -4,6 +4,7 @@
 #include <QAbstractButton>
 #include <QApplication>
 #include <QFile>
+#include <QMenu>
 #include <QMenuBar>
 #include <QMessageBox>
 #include <QSettings>
@@ -78,11 +79,15 @@ class SessionTest : public QObject {
   }
 
   void fileMenuHasSessionActions() {
+    QMenu* file = window_->menuBar()->actions().first()->menu();
     QStringList shortcuts;
-    for (QAction* a : window_->menuBar()->actions().first()->menu()->actions())
-      shortcuts << a->shortcut().toString();
+    for (QAction* a : file->actions()) shortcuts << a->shortcut().toString();
     for (const char* keys : {"Ctrl+S", "Ctrl+Shift+S", "Ctrl+Shift+O", "Ctrl+Shift+R", "Ctrl+O"})
       QVERIFY2(shortcuts.contains(keys), keys);
+    file->popup(window_->mapToGlobal(QPoint(0, window_->menuBar()->height())));
+    QVERIFY(QTest::qWaitForWindowExposed(file));
+    test::saveShot(file->grab().toImage(), "session-file-menu");
+    file->hide();
   }
 
   void undoCoversRangesAndPreprocessing() {
