@@ -10,11 +10,16 @@
 #include "app/cli/cli.h"
 
 #ifdef FLEXARM_WITH_GUI
+#include "app/cli/verb_run.h"
 #include "app/gui_main.h"
+#include "app/report_writer.h"
 #endif
 
 int main(int argc, char** argv) {
   std::vector<std::string> args(argv + 1, argv + argc);
+#ifdef FLEXARM_WITH_GUI
+  flexarm::cli::setReportRenderer(&flexarm::writeReportFile);  // `flexarm run --report`
+#endif
   const bool headless = !args.empty() && (flexarm::cli::isVerb(args[0]) || args[0] == "--help" ||
                                           args[0] == "-h" || args[0] == "--version" ||
                                           args[0] == "help");

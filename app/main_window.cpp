@@ -27,6 +27,7 @@
 #include <sstream>
 
 #include "app/cli/cli.h"
+#include "app/session_controller.h"
 #include "core/io/ranges.h"
 #include "widgets/arm_panel.h"
 #include "widgets/bode_panel.h"
@@ -126,6 +127,7 @@ MainWindow::MainWindow(QWidget* parent)
   lqgDock_ = addPanel(lqgPanel_ = new LqgPanel(workspace_, this), tr("LQG"), "lqgDock",
                       "Ctrl+Shift+L", preprocessDock_);
   preprocessDock_->raise();
+  session_ = new SessionController(this, workspace_);  // File menu: sessions and reports
   resize(1280, 860);
 
   QSettings settings;
@@ -246,6 +248,7 @@ void MainWindow::openFile(const QString& path, const LogReadOptions& options) {
     return;
   }
   readingPath_ = path;
+  readingOptions_ = options;
   readCancelled_ = false;
   readStartMs_ = QDateTime::currentMSecsSinceEpoch();
   statusBar()->showMessage(tr("Reading %1...").arg(path));
@@ -282,7 +285,7 @@ void MainWindow::onReadFinished() {
   const double seconds = (QDateTime::currentMSecsSinceEpoch() - readStartMs_) / 1000.0;
   const std::size_t samples = r.data.samples(), channels = r.data.channels.size();
   const double rate = r.data.sampleRateHz();
-  workspace_->setLog(std::move(r.data), readingPath_);
+  workspace_->setLog(std::move(r.data), readingPath_, readingOptions_);
   addRecent(readingPath_);
   QSettings().setValue("lastDir", QFileInfo(readingPath_).absolutePath());
   setWindowTitle(QString("FlexArm - %1").arg(QFileInfo(readingPath_).fileName()));

@@ -23,6 +23,7 @@ class LqgPanel;
 class ModelPanel;
 class PreprocessPanel;
 class ResidualsPanel;
+class SessionController;
 class Workspace;
 
 class MainWindow : public QMainWindow {
@@ -47,6 +48,7 @@ class MainWindow : public QMainWindow {
   ComparePanel* comparePanel() const { return comparePanel_; }
   ResidualsPanel* residualsPanel() const { return residualsPanel_; }
   LqgPanel* lqgPanel() const { return lqgPanel_; }
+  SessionController* sessionController() const { return session_; }
   QStringList recentFiles() const;
 
  signals:
@@ -89,11 +91,13 @@ class MainWindow : public QMainWindow {
   QDockWidget* residualsDock_ = nullptr;
   LqgPanel* lqgPanel_ = nullptr;
   QDockWidget* lqgDock_ = nullptr;
+  SessionController* session_ = nullptr;
   QMenu* recentMenu_ = nullptr;
   QMenu* viewMenu_ = nullptr;
   QFutureWatcher<LogReadResult> reader_;
   QProgressDialog* progress_ = nullptr;
   QString readingPath_;
+  LogReadOptions readingOptions_;
   bool readCancelled_ = false;
   qint64 readStartMs_ = 0;
 };

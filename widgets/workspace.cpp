@@ -40,6 +40,37 @@ class AddModelCommand : public QUndoCommand {
   ModelEntry entry_;
 };
 
+class RangeCommand : public QUndoCommand {
+ public:
+  RangeCommand(Workspace* w, RangeKind kind, std::optional<TimeRange> after)
+      : QUndoCommand(after ? QObject::tr("set %1 range").arg(toString(kind))
+                           : QObject::tr("clear %1 range").arg(toString(kind))),
+        w_(w), kind_(kind), before_(w->range(kind)), after_(after) {}
+  void redo() override { w_->setRangeDirect(kind_, after_); }
+  void undo() override { w_->setRangeDirect(kind_, before_); }
+
+ private:
+  Workspace* w_;
+  RangeKind kind_;
+  std::optional<TimeRange> before_, after_;
+};
+
+class PreprocessCommand : public QUndoCommand {
+ public:
+  PreprocessCommand(Workspace* w, std::shared_ptr<IdData> before, PreprocessOptions beforeOptions,
+                    std::shared_ptr<IdData> after, PreprocessOptions afterOptions)
+      : QUndoCommand(after ? QObject::tr("apply preprocessing") : QObject::tr("undo preprocessing")),
+        w_(w), before_(std::move(before)), after_(std::move(after)),
+        beforeOptions_(beforeOptions), afterOptions_(afterOptions) {}
+  void redo() override { w_->setPreprocessedDirect(after_, afterOptions_); }
+  void undo() override { w_->setPreprocessedDirect(before_, beforeOptions_); }
+
+ private:
+  Workspace* w_;
+  std::shared_ptr<IdData> before_, after_;
+  PreprocessOptions beforeOptions_, afterOptions_;
+};
+
 }  // namespace
 
 Workspace::Workspace(QObject* parent) : QObject(parent), undo_(new QUndoStack(this)) {}
@@ -71,7 +102,7 @@ void Workspace::removeModelDirect(int index) {
   emit modelsChanged(-1);
 }
 
-void Workspace::setLog(IdData data, const QString& path) {
+void Workspace::setLog(IdData data, const QString& path, const LogReadOptions& read) {
   std::string ignored;
   applyStoredRanges(data, &ignored);
   estimation_.reset();
@@ -86,24 +117,28 @@ void Workspace::setLog(IdData data, const QString& path) {
   processed_.reset();
   options_ = PreprocessOptions{};
   path_ = path;
+  read_ = read;
+  undo_->clear();
   emit logChanged();
   emit currentChanged();
   emit rangesChanged();
 }
 
 void Workspace::setPreprocessed(IdData data, const PreprocessOptions& options) {
-  processed_ = std::make_shared<IdData>(std::move(data));
-  options_ = options;
-  emit currentChanged();
-  emit rangesChanged();  // sample counts change with the rate
+  undo_->push(new PreprocessCommand(this, processed_, options_,
+                                    std::make_shared<IdData>(std::move(data)), options));
 }
 
 void Workspace::clearPreprocessed() {
   if (!processed_) return;
-  processed_.reset();
-  options_ = PreprocessOptions{};
+  undo_->push(new PreprocessCommand(this, processed_, options_, nullptr, PreprocessOptions{}));
+}
+
+void Workspace::setPreprocessedDirect(std::shared_ptr<IdData> data, const PreprocessOptions& options) {
+  processed_ = std::move(data);
+  options_ = processed_ ? options : PreprocessOptions{};
   emit currentChanged();
-  emit rangesChanged();
+  emit rangesChanged();  // sample counts change with the rate
 }
 
 std::optional<TimeRange> Workspace::range(RangeKind kind) const {
@@ -112,12 +147,16 @@ std::optional<TimeRange> Workspace::range(RangeKind kind) const {
 
 void Workspace::setRange(RangeKind kind, TimeRange r) {
   if (r.end < r.start) std::swap(r.start, r.end);
-  (kind == RangeKind::Estimation ? estimation_ : validation_) = r;
-  emit rangesChanged();
+  undo_->push(new RangeCommand(this, kind, r));
 }
 
 void Workspace::clearRange(RangeKind kind) {
-  (kind == RangeKind::Estimation ? estimation_ : validation_).reset();
+  if (!range(kind)) return;
+  undo_->push(new RangeCommand(this, kind, std::nullopt));
+}
+
+void Workspace::setRangeDirect(RangeKind kind, std::optional<TimeRange> r) {
+  (kind == RangeKind::Estimation ? estimation_ : validation_) = r;
   emit rangesChanged();
 }
 

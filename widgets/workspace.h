@@ -8,6 +8,7 @@
 #include <optional>
 
 #include "core/ident/blackbox.h"
+#include "core/io/log_io.h"
 #include "core/models/effects.h"
 #include "core/models/physical_models.h"
 #include "core/signal/id_data.h"
@@ -44,16 +45,19 @@ class Workspace : public QObject {
  public:
   explicit Workspace(QObject* parent = nullptr);
 
-  // Replaces the log; ranges stored in its metadata become the workspace's ranges.
-  void setLog(IdData data, const QString& path);
+  // Replaces the log (read from path with the given options); ranges stored in its metadata
+  // become the workspace's ranges.
+  void setLog(IdData data, const QString& path, const LogReadOptions& read = {});
   bool hasLog() const { return raw_ != nullptr; }
   QString logPath() const { return path_; }
+  const LogReadOptions& logReadOptions() const { return read_; }
   const IdData* raw() const { return raw_.get(); }
 
   // The preprocessed data if preprocessing was applied, otherwise the raw log.
   const IdData* current() const { return processed_ ? processed_.get() : raw_.get(); }
   bool isPreprocessed() const { return processed_ != nullptr; }
   const PreprocessOptions& preprocessOptions() const { return options_; }
+  // Applying and clearing preprocessing, and setting ranges, go through the undo stack.
   void setPreprocessed(IdData data, const PreprocessOptions& options);
   void clearPreprocessed();
 
@@ -69,8 +73,12 @@ class Workspace : public QObject {
   const std::vector<ModelEntry>& models() const { return models_; }
   int addModel(ModelEntry entry);  // returns its index
   void replaceModel(int index, ModelEntry entry, const QString& what);
+  // Model edits, range changes and preprocessing, undoable. Opening a log starts a new
+  // history (earlier steps refer to the previous log's data).
   QUndoStack* undoStack() const { return undo_; }
-  // Applied by the undo commands; panels use addModel/replaceModel.
+  // Applied by the undo commands and by opening a session; panels use the undoable calls.
+  void setPreprocessedDirect(std::shared_ptr<IdData> data, const PreprocessOptions& options);
+  void setRangeDirect(RangeKind kind, std::optional<TimeRange> r);
   void setModelDirect(int index, const ModelEntry& entry);
   void insertModelDirect(int index, const ModelEntry& entry);
   void removeModelDirect(int index);
@@ -85,6 +93,7 @@ class Workspace : public QObject {
   std::shared_ptr<IdData> raw_, processed_;
   PreprocessOptions options_;
   QString path_;
+  LogReadOptions read_;
   std::optional<TimeRange> estimation_, validation_;
   std::vector<ModelEntry> models_;
   QUndoStack* undo_;

@@ -17,6 +17,7 @@ const std::vector<Verb>& verbs() {
       {"bode", "frequency response of a fitted model or SPA/ETFE with bands, to CSV", runBode},
       {"lqg", "LQG design of chapter 8: gains, poles, Nyquist, max |S|, Bode integral",
        runLqg},
+      {"run", "replay a saved session headless and write its PDF/HTML report", runRun},
   };
   return kVerbs;
 }

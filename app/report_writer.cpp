@@ -1,0 +1,258 @@
+#include "app/report_writer.h"
+
+#include <QAbstractTextDocumentLayout>
+#include <QApplication>
+#include <QBuffer>
+#include <QFile>
+#include <QFileInfo>
+#include <QPageLayout>
+#include <QPageSize>
+#include <QPdfWriter>
+#include <QSaveFile>
+#include <QTextDocument>
+#include <memory>
+#include <qcustomplot.h>
+
+namespace flexarm {
+namespace {
+
+constexpr int kPlotWidth = 680;   // logical pixels of a plot (96 dpi)
+constexpr int kPlotHeight = 260;
+
+QString esc(const std::string& s) { return QString::fromStdString(s).toHtmlEscaped(); }
+
+const char* kStyle =
+    "body{font-family:sans-serif;font-size:10pt;color:#222;max-width:760px;margin:24px auto}"
+    "h1{font-size:18pt;margin-bottom:4px}h2{font-size:13pt;margin-top:18px;"
+    "border-bottom:1px solid #999}"
+    "table{border-collapse:collapse;margin:6px 0}td,th{border:1px solid #bbb;padding:2px 8px}"
+    "th{background:#e8eef4;text-align:left}td.num{text-align:right}"
+    ".prov{font-size:8pt;color:#444}.warn{color:#a00000}.caption{font-weight:bold;margin-top:8px}";
+
+bool looksNumeric(const std::string& s) {
+  if (s.empty()) return false;
+  for (char c : s)
+    if (!(std::isdigit(static_cast<unsigned char>(c)) || c == '.' || c == '-' || c == '+' ||
+          c == 'e'))
+      return false;
+  return true;
+}
+
+// Title block: version, session, logs with checksums, warnings.
+QString headerHtml(const Report& r) {
+  QString h = QString("<h1>%1</h1><p class=\"prov\">FlexArm %2<br>Session: %3<br>")
+                  .arg(esc(r.title), esc(r.flexarmVersion), esc(r.session));
+  for (const auto& l : r.logs)
+    h += QString("Log %1: %2%3<br>SHA-256 %4<br>")
+             .arg(esc(l.name), esc(l.path), l.note.empty() ? QString() : " (" + esc(l.note) + ")",
+                  esc(l.sha256));
+  h += "</p>";
+  for (const auto& w : r.warnings) h += "<p class=\"warn\">Warning: " + esc(w) + "</p>";
+  return h;
+}
+
+// Section title, paragraphs and tables (plots are placed by the caller).
+QString sectionHtml(const ReportSection& s) {
+  QString h = "<h2>" + esc(s.title) + "</h2>";
+  for (const auto& p : s.paragraphs) h += "<p>" + esc(p) + "</p>";
+  for (const auto& t : s.tables) {
+    h += "<p class=\"caption\">" + esc(t.caption) + "</p><table cellspacing=\"0\" cellpadding=\"3\" border=\"1\"><tr>";
+    for (const auto& c : t.header) h += "<th>" + esc(c) + "</th>";
+    h += "</tr>";
+    for (const auto& row : t.rows) {
+      h += "<tr>";
+      for (const auto& c : row)
+        h += (looksNumeric(c) ? "<td class=\"num\" align=\"right\">" : "<td>") + esc(c) + "</td>";
+      h += "</tr>";
+    }
+    h += "</table>";
+  }
+  return h;
+}
+
+// A QCustomPlot showing one report plot.
+std::unique_ptr<QCustomPlot> makePlot(const ReportPlot& p) {
+  auto plot = std::make_unique<QCustomPlot>();
+  plot->resize(kPlotWidth, kPlotHeight);
+  plot->plotLayout()->insertRow(0);
+  plot->plotLayout()->addElement(0, 0, new QCPTextElement(plot.get(), QString::fromStdString(p.title),
+                                                          QFont("sans", 10, QFont::Bold)));
+  static const QColor kColors[] = {QColor(31, 119, 180), QColor(214, 39, 40), QColor(44, 160, 44),
+                                   QColor(148, 103, 189)};
+  for (std::size_t i = 0; i < p.series.size(); ++i) {
+    const auto& s = p.series[i];
+    QCPGraph* g = plot->addGraph();
+    g->setName(QString::fromStdString(s.name));
+    QPen pen(kColors[i % 4], 1.4);
+    if (s.dashed) pen.setStyle(Qt::DashLine);
+    g->setPen(pen);
+    g->setData(QVector<double>(s.x.begin(), s.x.end()), QVector<double>(s.y.begin(), s.y.end()), true);
+  }
+  plot->xAxis->setLabel(QString::fromStdString(p.xLabel));
+  plot->yAxis->setLabel(QString::fromStdString(p.yLabel));
+  auto logAxis = [](QCPAxis* a) {
+    a->setScaleType(QCPAxis::stLogarithmic);
+    a->setTicker(QSharedPointer<QCPAxisTickerLog>(new QCPAxisTickerLog));
+    a->setNumberFormat("eb");
+    a->setNumberPrecision(0);
+  };
+  if (p.logX) logAxis(plot->xAxis);
+  if (p.logY) logAxis(plot->yAxis);
+  plot->legend->setVisible(p.series.size() > 1);
+  plot->legend->setFont(QFont("sans", 8));
+  plot->rescaleAxes();
+  return plot;
+}
+
+QString dataUri(const QImage& image) {
+  QByteArray png;
+  QBuffer buffer(&png);
+  buffer.open(QIODevice::WriteOnly);
+  image.save(&buffer, "PNG");
+  return "data:image/png;base64," + QString::fromLatin1(png.toBase64());
+}
+
+}  // namespace
+
+QList<QImage> reportPlotImages(const Report& report) {
+  QList<QImage> images;
+  for (const auto& s : report.sections)
+    for (const auto& p : s.plots) images.append(makePlot(p)->toPixmap(kPlotWidth, kPlotHeight, 2.0).toImage());
+  return images;
+}
+
+QString reportHtml(const Report& report, const QList<QImage>& plots) {
+  QString h = "<!DOCTYPE html>\n<html><head><meta charset=\"utf-8\"><title>" + esc(report.title) +
+              "</title><style>" + kStyle + "</style></head><body>\n" + headerHtml(report);
+  int next = 0;
+  for (const auto& s : report.sections) {
+    h += sectionHtml(s) + "\n";
+    for (const auto& p : s.plots) {
+      if (next >= plots.size()) break;
+      h += QString("<p><img alt=\"%1\" width=\"%2\" height=\"%3\" src=\"%4\"></p>\n")
+               .arg(esc(p.title))
+               .arg(kPlotWidth)
+               .arg(kPlotHeight)
+               .arg(dataUri(plots[next++]));
+    }
+  }
+  return h + "</body></html>\n";
+}
+
+bool writeReportHtml(const Report& report, const QString& path, QString* why) {
+  return writeReportHtml(report, reportPlotImages(report), path, why);
+}
+
+bool writeReportHtml(const Report& report, const QList<QImage>& plots, const QString& path,
+                     QString* why) {
+  QSaveFile f(path);
+  if (!f.open(QIODevice::WriteOnly)) {
+    if (why) *why = f.errorString();
+    return false;
+  }
+  f.write(reportHtml(report, plots).toUtf8());
+  if (!f.commit()) {
+    if (why) *why = f.errorString();
+    return false;
+  }
+  return true;
+}
+
+bool writeReportPdf(const Report& report, const QString& path, QString* why) {
+  // Written to a temporary sibling first so that a failure keeps any previous report.
+  const QString tmp = path + ".part";
+  {
+    QPdfWriter writer(tmp);
+    writer.setResolution(96);
+    writer.setPageSize(QPageSize(QPageSize::A4));
+    writer.setPageMargins(QMarginsF(18, 16, 18, 16), QPageLayout::Millimeter);
+    writer.setTitle(QString::fromStdString(report.title));
+    writer.setCreator(QString("FlexArm %1").arg(FLEXARM_VERSION));
+    QCPPainter painter;
+    if (!painter.begin(&writer)) {
+      if (why) *why = "cannot write " + tmp;
+      return false;
+    }
+    painter.setMode(QCPPainter::pmVectorized);
+    painter.setMode(QCPPainter::pmNoCaching);
+    const QRect page = writer.pageLayout().paintRectPixels(writer.resolution());
+    const double width = page.width(), height = page.height();
+    double y = 0.0;
+    auto ensure = [&](double h) {
+      if (y > 0.0 && y + h > height) {
+        writer.newPage();
+        y = 0.0;
+      }
+    };
+    // Draws an HTML block, splitting it over pages at the document's own page breaks.
+    auto drawHtml = [&](const QString& html) {
+      QTextDocument doc;
+      doc.documentLayout()->setPaintDevice(&writer);
+      doc.setDefaultStyleSheet(kStyle);
+      doc.setDefaultFont(QFont("sans", 9));
+      doc.setHtml(html);
+      doc.setTextWidth(width);
+      double docH = doc.size().height();
+      double offset = 0.0;
+      while (offset < docH) {
+        ensure(std::min(docH - offset, height));
+        const double room = height - y;
+        painter.save();
+        painter.translate(0, y - offset);
+        doc.drawContents(&painter, QRectF(0, offset, width, std::min(room, docH - offset)));
+        painter.restore();
+        const double used = std::min(room, docH - offset);
+        offset += used;
+        y += used;
+        if (offset < docH) {
+          writer.newPage();
+          y = 0.0;
+        }
+      }
+    };
+    drawHtml(headerHtml(report));
+    for (const auto& s : report.sections) {
+      ensure(120);
+      drawHtml(sectionHtml(s));
+      for (const auto& p : s.plots) {
+        const double scale = width / kPlotWidth;
+        const double h = kPlotHeight * scale;
+        ensure(h + 8);
+        auto plot = makePlot(p);
+        painter.save();
+        painter.translate(0, y + 4);
+        painter.scale(scale, scale);
+        plot->toPainter(&painter, kPlotWidth, kPlotHeight);
+        painter.restore();
+        y += h + 8;
+      }
+    }
+    painter.end();
+  }
+  QFile::remove(path);
+  if (!QFile::rename(tmp, path)) {
+    if (why) *why = "cannot rename " + tmp + " to " + path;
+    QFile::remove(tmp);
+    return false;
+  }
+  return true;
+}
+
+bool writeReportFile(const Report& report, const std::string& path, std::string* why) {
+  std::unique_ptr<QApplication> app;
+  if (!QApplication::instance()) {
+    qputenv("QT_QPA_PLATFORM", "offscreen");
+    static int argc = 1;
+    static char name[] = "flexarm";
+    static char* argv[] = {name, nullptr};
+    app = std::make_unique<QApplication>(argc, argv);
+  }
+  const QString p = QString::fromStdString(path);
+  QString message;
+  const bool ok = p.endsWith(".pdf", Qt::CaseInsensitive) ? writeReportPdf(report, p, &message)
+                                                          : writeReportHtml(report, p, &message);
+  if (!ok && why) *why = message.toStdString();
+  return ok;
+}
+
+}  // namespace flexarm

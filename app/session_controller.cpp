@@ -1,0 +1,379 @@
+#include "app/session_controller.h"
+
+#include <QAction>
+#include <QFile>
+#include <QFileDialog>
+#include <QFileInfo>
+#include <QMenu>
+#include <QMenuBar>
+#include <QMessageBox>
+#include <QProgressDialog>
+#include <QSettings>
+#include <QStatusBar>
+#include <QTimer>
+#include <QUndoStack>
+#include <QtConcurrent>
+
+#include "app/main_window.h"
+#include "app/report_writer.h"
+#include "app/session_parts.h"
+#include "widgets/preprocess_panel.h"
+#include "core/session/sha256.h"
+#include "widgets/workspace.h"
+
+namespace flexarm {
+namespace {
+
+constexpr int kMaxRecentSessions = 8;
+constexpr int kAutosaveMs = 60000;
+
+}  // namespace
+
+SessionController::SessionController(MainWindow* window, Workspace* workspace)
+    : QObject(window), window_(window), workspace_(workspace), autosaveTimer_(new QTimer(this)) {
+  addMenuActions();
+  connect(&opener_, &QFutureWatcher<Opened>::finished, this, &SessionController::onOpened);
+  connect(&replayer_, &QFutureWatcher<ReplayResult>::finished, this, &SessionController::onReplayed);
+  connect(&writer_, &QFutureWatcher<QString>::finished, this,
+          [this] { onReportWritten(writer_.result()); });
+  connect(workspace_, &Workspace::logChanged, this, [this] {
+    if (restoring_) return;
+    std::string why;
+    logSha256_ = sha256OfFile(workspace_->logPath().toStdString(), &why).value_or("");
+    loaded_ = Session{};  // a log opened by hand starts a new session
+    path_.clear();
+  });
+  for (auto signal : {&Workspace::logChanged, &Workspace::currentChanged, &Workspace::rangesChanged})
+    connect(workspace_, signal, this, &SessionController::markDirty);
+  connect(workspace_, &Workspace::modelsChanged, this, &SessionController::markDirty);
+  autosaveTimer_->setInterval(kAutosaveMs);
+  connect(autosaveTimer_, &QTimer::timeout, this, &SessionController::autosave);
+  autosaveTimer_->start();
+  // A window closed normally leaves no autosave behind; one found on start means a crash.
+  connect(qApp, &QCoreApplication::aboutToQuit, this, [this] { QFile::remove(autosavePath()); });
+  QTimer::singleShot(0, this, &SessionController::offerRecovery);
+}
+
+SessionController::~SessionController() {
+  opener_.waitForFinished();
+  replayer_.waitForFinished();
+  writer_.waitForFinished();
+  QFile::remove(autosavePath());  // a normal end; only a crash leaves the autosave behind
+}
+
+void SessionController::addMenuActions() {
+  QMenu* file = window_->menuBar()->actions().first()->menu();
+  QAction* before = nullptr;  // the separator above Quit
+  for (QAction* a : file->actions())
+    if (a->isSeparator()) before = a;
+  auto add = [&](const QString& text, const QString& keys, auto slot) {
+    auto* a = new QAction(text, file);
+    if (!keys.isEmpty()) a->setShortcut(QKeySequence(keys));
+    connect(a, &QAction::triggered, this, slot);
+    file->insertAction(before, a);
+    return a;
+  };
+  file->insertSeparator(before);
+  add(tr("Open &session..."), "Ctrl+Shift+O", &SessionController::openDialog);
+  recentMenu_ = new QMenu(tr("Open recent sess&ion"), file);
+  file->insertMenu(before, recentMenu_);
+  add(tr("&Save session"), "Ctrl+S", &SessionController::saveCurrent)->setObjectName("saveSessionAction");
+  add(tr("Save session &as..."), "Ctrl+Shift+S", &SessionController::saveAs);
+  add(tr("Export re&port (PDF, HTML)..."), "Ctrl+Shift+R", &SessionController::exportDialog);
+  rebuildRecent();
+}
+
+Session SessionController::capture(const QString& sessionPath) const {
+  Session s;
+  const std::string sp = sessionPath.toStdString();
+  auto stored = [&](const std::string& path) {
+    return sp.empty() ? QFileInfo(QString::fromStdString(path)).absoluteFilePath().toStdString()
+                      : storedLogPath(sp, path);
+  };
+  LogReference main;
+  main.name = loaded_.logs.empty() ? "log" : loaded_.logs.front().name;
+  main.path = stored(workspace_->logPath().toStdString());
+  main.sha256 = logSha256_;
+  main.read = workspace_->logReadOptions();
+  s.logs.push_back(main);
+  for (std::size_t i = 1; i < loaded_.logs.size(); ++i) {
+    LogReference extra = loaded_.logs[i];
+    extra.path = stored(resolveLogPath(path_.toStdString(), extra.path));
+    s.logs.push_back(extra);
+  }
+  s.preprocessed = workspace_->isPreprocessed();
+  if (s.preprocessed) s.preprocess = workspace_->preprocessOptions();
+  auto seconds = [&](RangeKind k) -> std::optional<SecondsRange> {
+    auto r = workspace_->range(k);
+    if (!r || !(r->start < r->end)) return std::nullopt;
+    return SecondsRange{r->start, r->end};
+  };
+  s.estimation = seconds(RangeKind::Estimation);
+  s.validation = seconds(RangeKind::Validation);
+  s.parts = loaded_.parts.is_object() ? loaded_.parts : nlohmann::json::object();
+  for (const auto& part : windowSessionParts()) {
+    nlohmann::json section = part.capture(*window_);
+    if (section.is_null()) s.parts.erase(part.key);
+    else s.parts[part.key] = section;
+  }
+  return s;
+}
+
+bool SessionController::save(const QString& path, QString* why) {
+  if (!workspace_->hasLog()) {
+    if (why) *why = tr("Open a log first: a session starts from a log.");
+    return false;
+  }
+  std::string message;
+  Session s = capture(path);
+  if (!saveSession(s, path.toStdString(), &message)) {
+    if (why) *why = QString::fromStdString(message);
+    return false;
+  }
+  loaded_.logs = s.logs;
+  loaded_.parts = s.parts;
+  path_ = path;
+  dirty_ = false;
+  workspace_->undoStack()->setClean();
+  QFile::remove(autosavePath());
+  addRecent(path);
+  window_->statusBar()->showMessage(tr("Saved session %1").arg(path), 6000);
+  emit sessionSaved(path);
+  return true;
+}
+
+void SessionController::saveCurrent() {
+  if (path_.isEmpty() || recovering_) return saveAs();
+  QString why;
+  if (!save(path_, &why)) fail(tr("Could not save the session"), why);
+}
+
+void SessionController::saveAs() {
+  if (!workspace_->hasLog()) {
+    fail(tr("Nothing to save"), tr("Open a log first: a session starts from a log."));
+    return;
+  }
+  QString start = path_.isEmpty() ? QSettings().value("lastDir").toString() : path_;
+  const QString path = QFileDialog::getSaveFileName(window_, tr("Save session"), start,
+                                                    tr("FlexArm sessions (*.json)"));
+  if (path.isEmpty()) return;
+  QString why;
+  if (!save(path.endsWith(".json") ? path : path + ".json", &why))
+    fail(tr("Could not save the session"), why);
+}
+
+void SessionController::openDialog() {
+  const QString path = QFileDialog::getOpenFileName(window_, tr("Open session"),
+                                                    QSettings().value("lastDir").toString(),
+                                                    tr("FlexArm sessions (*.json);;All files (*)"));
+  if (!path.isEmpty()) open(path);
+}
+
+void SessionController::open(const QString& path) {
+  if (isBusy()) {
+    window_->statusBar()->showMessage(tr("Still busy with %1").arg(openingPath_), 4000);
+    return;
+  }
+  openingPath_ = path;
+  cancelled_ = false;
+  if (!progress_) {
+    progress_ = new QProgressDialog(window_);
+    progress_->setRange(0, 0);
+    progress_->setMinimumDuration(400);
+    progress_->setAutoClose(false);
+    progress_->setAutoReset(false);
+    connect(progress_, &QProgressDialog::canceled, this, [this] { cancelled_ = true; });
+  }
+  progress_->setWindowTitle(tr("Opening session"));
+  progress_->setLabelText(tr("Reading %1 and its logs").arg(QFileInfo(path).fileName()));
+  progress_->reset();
+  progress_->setRange(0, 0);
+  window_->statusBar()->showMessage(tr("Opening session %1...").arg(path));
+  const std::string p = path.toStdString();
+  opener_.setFuture(QtConcurrent::run([p] {
+    Opened o;
+    o.parsed = loadSession(p);
+    if (o.parsed.ok) o.prepared = prepareSession(o.parsed.session, p);
+    return o;
+  }));
+}
+
+void SessionController::onOpened() {
+  if (progress_) progress_->hide();
+  const bool recovered = openingPath_ == autosavePath();
+  if (cancelled_) {
+    window_->statusBar()->showMessage(tr("Opening %1 cancelled").arg(openingPath_), 5000);
+    return;
+  }
+  Opened o = opener_.result();
+  QString message;
+  if (!o.parsed.ok) message = QString::fromStdString(o.parsed.message);
+  else if (!o.prepared.ok) message = openingPath_ + ": " + QString::fromStdString(o.prepared.message);
+  if (!message.isEmpty()) {
+    window_->statusBar()->showMessage(tr("Could not open %1").arg(openingPath_), 10000);
+    fail(tr("Could not open the session"), message);
+    emit openFailed(message);
+    return;
+  }
+  // Everything that can fail is done: now change the window.
+  const Session& s = o.parsed.session;
+  PreparedLog& log = o.prepared.logs.front();
+  restoring_ = true;
+  workspace_->setLog(std::move(log.raw), QString::fromStdString(log.path), s.logs.front().read);
+  if (s.preprocessed) {
+    IdData processed = std::move(log.data);
+    processed.estimationRange.reset();
+    processed.validationRange.reset();
+    workspace_->setPreprocessedDirect(std::make_shared<IdData>(std::move(processed)), s.preprocess);
+    window_->preprocessPanel()->setOptions(s.preprocess);
+  }
+  auto toTime = [](const std::optional<SecondsRange>& r) -> std::optional<TimeRange> {
+    if (!r) return std::nullopt;
+    return TimeRange{r->start, r->end};
+  };
+  workspace_->setRangeDirect(RangeKind::Estimation, toTime(s.estimation));
+  workspace_->setRangeDirect(RangeKind::Validation, toTime(s.validation));
+  for (const auto& part : windowSessionParts())
+    if (s.parts.contains(part.key)) part.restore(s.parts[part.key], *window_);
+  workspace_->undoStack()->clear();
+  restoring_ = false;
+  logSha256_ = log.sha256;
+  loaded_ = s;
+  recovering_ = recovered;
+  path_ = recovered ? QString() : openingPath_;
+  dirty_ = recovered;
+  if (!recovered) {
+    addRecent(openingPath_);
+    QSettings().setValue("lastDir", QFileInfo(openingPath_).absolutePath());
+  }
+  window_->setWindowTitle(QString("FlexArm - %1").arg(recovered ? tr("recovered session")
+                                                                : QFileInfo(openingPath_).fileName()));
+  QString status = recovered ? tr("Recovered the autosaved session: save it with Ctrl+S")
+                             : tr("Opened session %1").arg(QFileInfo(openingPath_).fileName());
+  for (const auto& w : o.prepared.warnings) status += " - " + QString::fromStdString(w);
+  window_->statusBar()->showMessage(status, 15000);
+  emit sessionOpened(openingPath_);
+}
+
+void SessionController::exportDialog() {
+  if (!workspace_->hasLog()) {
+    fail(tr("Nothing to report"), tr("Open a log or a session first."));
+    return;
+  }
+  QString start = QSettings().value("lastDir").toString() + "/report.pdf";
+  const QString path = QFileDialog::getSaveFileName(window_, tr("Export report"), start,
+                                                    tr("PDF (*.pdf);;HTML (*.html)"));
+  if (!path.isEmpty()) exportReport(path);
+}
+
+void SessionController::exportReport(const QString& path) {
+  if (isBusy() || !workspace_->hasLog()) {
+    emit reportFailed(tr("Open a log first, or wait for the current task."));
+    return;
+  }
+  if (!path.endsWith(".pdf", Qt::CaseInsensitive) && !path.endsWith(".html", Qt::CaseInsensitive)) {
+    emit reportFailed(tr("A report is a .pdf or .html file."));
+    return;
+  }
+  reportPath_ = path;
+  const Session s = capture(path_);
+  const std::string sp = path_.toStdString();
+  window_->statusBar()->showMessage(tr("Computing the report..."));
+  replayer_.setFuture(QtConcurrent::run([s, sp] { return replaySession(s, sp); }));
+}
+
+void SessionController::onReplayed() {
+  ReplayResult r = replayer_.result();
+  QString why;
+  if (r.termination == Termination::Converged) {
+    if (path_.isEmpty()) r.report.session = "unsaved session";
+    if (reportPath_.endsWith(".pdf", Qt::CaseInsensitive)) {
+      const bool ok = writeReportPdf(r.report, reportPath_, &why);
+      return onReportWritten(ok ? QString() : why);
+    }
+    // Plots are drawn here (widgets); encoding them as PNG and writing run in the background.
+    const QList<QImage> plots = reportPlotImages(r.report);
+    const QString path = reportPath_;
+    writer_.setFuture(QtConcurrent::run([report = std::move(r.report), plots, path] {
+      QString message;
+      return writeReportHtml(report, plots, path, &message) ? QString() : message;
+    }));
+    return;
+  }
+  onReportWritten(QString::fromStdString(r.message));
+}
+
+void SessionController::onReportWritten(const QString& error) {
+  if (error.isEmpty()) {
+    window_->statusBar()->showMessage(tr("Wrote report %1").arg(reportPath_), 8000);
+    emit reportExported(reportPath_);
+    return;
+  }
+  fail(tr("Could not export the report"), error);
+  emit reportFailed(error);
+}
+
+QString SessionController::autosavePath() const {
+  return QFileInfo(QSettings().fileName()).absolutePath() + "/autosave-session.json";
+}
+
+bool SessionController::autosave() {
+  if (!dirty_ || !workspace_->hasLog() || restoring_) return false;
+  std::string why;
+  return saveSession(capture(autosavePath()), autosavePath().toStdString(), &why);
+}
+
+void SessionController::setAutosaveInterval(int ms) { autosaveTimer_->setInterval(ms); }
+
+void SessionController::offerRecovery() {
+  const QString path = autosavePath();
+  if (!QFile::exists(path)) return;
+  auto* box = new QMessageBox(QMessageBox::Question, tr("Recover unsaved work?"),
+                              tr("FlexArm did not close normally last time. Open the session "
+                                 "saved automatically at %1?")
+                                  .arg(QFileInfo(path).lastModified().toString("yyyy-MM-dd hh:mm")),
+                              QMessageBox::Open | QMessageBox::Discard, window_);
+  box->setObjectName("recoverBox");
+  box->setAttribute(Qt::WA_DeleteOnClose);
+  connect(box, &QMessageBox::finished, this, [this, path](int result) {
+    if (result == QMessageBox::Open) open(path);
+    else QFile::remove(path);
+  });
+  box->open();
+  emit recoveryOffered(path);
+}
+
+void SessionController::markDirty() {
+  if (!restoring_) dirty_ = true;
+}
+
+QStringList SessionController::recentSessions() const {
+  return QSettings().value("sessions/recent").toStringList();
+}
+
+void SessionController::addRecent(const QString& path) {
+  QStringList list = recentSessions();
+  const QString abs = QFileInfo(path).absoluteFilePath();
+  list.removeAll(abs);
+  list.prepend(abs);
+  while (list.size() > kMaxRecentSessions) list.removeLast();
+  QSettings().setValue("sessions/recent", list);
+  rebuildRecent();
+}
+
+void SessionController::rebuildRecent() {
+  recentMenu_->clear();
+  const QStringList list = recentSessions();
+  for (const QString& p : list)
+    recentMenu_->addAction(QFileInfo(p).fileName(), this, [this, p] { open(p); })->setToolTip(p);
+  recentMenu_->setEnabled(!list.isEmpty());
+}
+
+void SessionController::fail(const QString& title, const QString& message) {
+  auto* box = new QMessageBox(QMessageBox::Warning, title, message, QMessageBox::Ok, window_);
+  box->setAttribute(Qt::WA_DeleteOnClose);
+  box->setObjectName("sessionErrorBox");
+  box->open();
+}
+
+}  // namespace flexarm

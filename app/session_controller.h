@@ -1,0 +1,97 @@
+#pragma once
+// Sessions in the window: File -> Open session, Save session (Ctrl+S), Save session as
+// (Ctrl+Shift+S), Open recent session, Export report (PDF or HTML); autosave of unsaved work
+// every minute next to the settings, offered back after a crash. Opening reads the file,
+// its logs and the preprocessing off the GUI thread and changes the window only when all
+// of it succeeded.
+#include <QFutureWatcher>
+#include <QObject>
+#include <QString>
+#include <QStringList>
+
+#include "core/session/replay.h"
+#include "core/session/session.h"
+
+class QMenu;
+class QProgressDialog;
+class QTimer;
+
+namespace flexarm {
+
+class MainWindow;
+class Workspace;
+
+class SessionController : public QObject {
+  Q_OBJECT
+ public:
+  SessionController(MainWindow* window, Workspace* workspace);
+  ~SessionController() override;
+
+  // The window's state as a session; log paths are stored relative to sessionPath when the
+  // log lies beside it (absolute when sessionPath is empty). Needs an open log.
+  Session capture(const QString& sessionPath) const;
+  // Writes the session atomically; the previous file survives any failure.
+  bool save(const QString& path, QString* why);
+  // Reads a session, its logs and preprocessing in the background; emits sessionOpened or
+  // openFailed (then the window is unchanged).
+  void open(const QString& path);
+  bool isBusy() const { return opener_.isRunning() || replayer_.isRunning() || writer_.isRunning(); }
+  // Replays the current state in the background and writes the report (.pdf or .html);
+  // emits reportExported or reportFailed.
+  void exportReport(const QString& path);
+
+  QString sessionPath() const { return path_; }
+  bool isDirty() const { return dirty_; }
+  QStringList recentSessions() const;
+  QString autosavePath() const;
+  // Writes the autosave file now when there is unsaved work; true when written.
+  bool autosave();
+  void setAutosaveInterval(int ms);
+
+ signals:
+  void sessionOpened(const QString& path);
+  void openFailed(const QString& message);
+  void sessionSaved(const QString& path);
+  void reportExported(const QString& path);
+  void reportFailed(const QString& message);
+  // After a start that found an autosave: the recovery question is showing.
+  void recoveryOffered(const QString& autosavePath);
+
+ private:
+  struct Opened {
+    SessionParseResult parsed;
+    PreparedSession prepared;
+  };
+  void addMenuActions();
+  void saveAs();
+  void saveCurrent();
+  void openDialog();
+  void exportDialog();
+  void onOpened();
+  void onReplayed();
+  void onReportWritten(const QString& error);  // empty when the report was written
+  void addRecent(const QString& path);
+  void rebuildRecent();
+  void offerRecovery();
+  void markDirty();
+  void fail(const QString& title, const QString& message);
+
+  MainWindow* window_;
+  Workspace* workspace_;
+  QString path_;             // the session file, empty until saved or opened
+  QString openingPath_, reportPath_;
+  bool recovering_ = false;
+  bool restoring_ = false;
+  bool dirty_ = false;
+  std::string logSha256_;    // of the log when it was opened
+  Session loaded_;           // the last opened session (its extra logs and parts are kept)
+  QMenu* recentMenu_ = nullptr;
+  QTimer* autosaveTimer_;
+  QProgressDialog* progress_ = nullptr;
+  bool cancelled_ = false;
+  QFutureWatcher<Opened> opener_;
+  QFutureWatcher<ReplayResult> replayer_;
+  QFutureWatcher<QString> writer_;  // HTML encoding and writing
+};
+
+}  // namespace flexarm

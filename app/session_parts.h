@@ -1,0 +1,23 @@
+#pragma once
+// The window's side of the session parts (core/session/session_part.h): how each part's
+// section is captured from the window and restored into it. A capability that adds a core
+// part adds its capture/restore pair to windowSessionParts() in app/session_parts.cpp.
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+namespace flexarm {
+
+class MainWindow;
+
+struct WindowSessionPart {
+  const char* key;  // the core part's key
+  // The section as it stands in the window; null when there is nothing to save.
+  nlohmann::json (*capture)(const MainWindow& window);
+  // Applies a validated section. Called only after every fallible step of opening succeeded.
+  void (*restore)(const nlohmann::json& section, MainWindow& window);
+};
+
+const std::vector<WindowSessionPart>& windowSessionParts();
+
+}  // namespace flexarm

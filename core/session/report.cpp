@@ -1,0 +1,33 @@
+#include "core/session/report.h"
+
+#include <cmath>
+#include <cstdio>
+
+namespace flexarm {
+
+std::string formatFixed(double v, int decimals) {
+  if (!std::isfinite(v)) return "n/a";
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%.*f", decimals, v);
+  return buf;
+}
+
+std::string formatSignificant(double v, int digits) {
+  if (!std::isfinite(v)) return "n/a";
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%.*g", digits, v);
+  return buf;
+}
+
+nlohmann::json Report::toJson() const {
+  nlohmann::json logsJson = nlohmann::json::array();
+  for (const auto& l : logs)
+    logsJson.push_back({{"name", l.name}, {"path", l.path}, {"sha256", l.sha256}, {"note", l.note}});
+  nlohmann::json sectionsJson = nlohmann::json::array();
+  for (const auto& s : sections) sectionsJson.push_back({{"title", s.title}, {"values", s.values}});
+  return {{"title", title},       {"flexarm_version", flexarmVersion},
+          {"session", session},   {"logs", logsJson},
+          {"warnings", warnings}, {"sections", sectionsJson}};
+}
+
+}  // namespace flexarm

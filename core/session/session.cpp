@@ -1,0 +1,349 @@
+#include "core/session/session.h"
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "core/session/session_part.h"
+
+namespace flexarm {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+namespace {
+
+// Reads typed fields and remembers the first problem with the field's place in the file.
+class FieldReader {
+ public:
+  explicit FieldReader(std::string* why) : why_(why) {}
+  bool failed() const { return failed_; }
+  bool fail(const std::string& where, const std::string& problem) {
+    if (!failed_ && why_) *why_ = where + ": " + problem;
+    failed_ = true;
+    return false;
+  }
+  const json* member(const json& obj, const char* key, const std::string& where, bool required) {
+    if (!obj.is_object()) {
+      fail(where, "must be an object");
+      return nullptr;
+    }
+    auto it = obj.find(key);
+    if (it == obj.end()) {
+      if (required) fail(where, std::string("'") + key + "' is missing");
+      return nullptr;
+    }
+    return &*it;
+  }
+  bool string(const json& obj, const char* key, const std::string& where, std::string& out,
+              bool required = true) {
+    const json* v = member(obj, key, where, required);
+    if (!v) return !failed_;
+    if (!v->is_string()) return fail(where + "." + key, "must be text");
+    out = v->get<std::string>();
+    return true;
+  }
+  bool number(const json& obj, const char* key, const std::string& where, double& out,
+              bool required = true) {
+    const json* v = member(obj, key, where, required);
+    if (!v) return !failed_;
+    if (!v->is_number() || !std::isfinite(v->get<double>()))
+      return fail(where + "." + key, "must be a finite number");
+    out = v->get<double>();
+    return true;
+  }
+  bool integer(const json& obj, const char* key, const std::string& where, int& out,
+               bool required = true) {
+    const json* v = member(obj, key, where, required);
+    if (!v) return !failed_;
+    if (!v->is_number_integer()) return fail(where + "." + key, "must be a whole number");
+    out = v->get<int>();
+    return true;
+  }
+  bool boolean(const json& obj, const char* key, const std::string& where, bool& out,
+               bool required = true) {
+    const json* v = member(obj, key, where, required);
+    if (!v) return !failed_;
+    if (!v->is_boolean()) return fail(where + "." + key, "must be true or false");
+    out = v->get<bool>();
+    return true;
+  }
+
+ private:
+  std::string* why_;
+  bool failed_ = false;
+};
+
+json rangeToJson(const std::optional<SecondsRange>& r) {
+  return r ? json::array({r->start, r->end}) : json(nullptr);
+}
+
+bool rangeFromJson(const json& v, const std::string& where, std::optional<SecondsRange>& out,
+                   FieldReader& f) {
+  if (v.is_null()) {
+    out.reset();
+    return true;
+  }
+  if (!v.is_array() || v.size() != 2 || !v[0].is_number() || !v[1].is_number())
+    return f.fail(where, "must be [start, end] in seconds or null");
+  const double a = v[0].get<double>(), b = v[1].get<double>();
+  if (!std::isfinite(a) || !std::isfinite(b) || !(a < b))
+    return f.fail(where, "start must be before end");
+  out = SecondsRange{a, b};
+  return true;
+}
+
+json readOptionsToJson(const LogReadOptions& o) {
+  return {{"format", toString(o.format)},       {"input_column", o.inputColumn},
+          {"output_column", o.outputColumn},    {"time_column", o.timeColumn},
+          {"sample_time_s", o.sampleTime},      {"input_name", o.inputName},
+          {"output_name", o.outputName},        {"input_variable", o.inputVariable},
+          {"output_variable", o.outputVariable}, {"max_sample_jitter", o.maxSampleJitter}};
+}
+
+bool readOptionsFromJson(const json& j, const std::string& where, LogReadOptions& o,
+                         FieldReader& f) {
+  std::string format = toString(o.format);
+  f.string(j, "format", where, format, false);
+  bool known = false;
+  for (LogFormat k : {LogFormat::Auto, LogFormat::FlexArmCsv, LogFormat::Table, LogFormat::Mat})
+    if (format == toString(k)) {
+      o.format = k;
+      known = true;
+    }
+  if (!known) return f.fail(where + ".format", "unknown log format '" + format + "'");
+  f.integer(j, "input_column", where, o.inputColumn, false);
+  f.integer(j, "output_column", where, o.outputColumn, false);
+  f.integer(j, "time_column", where, o.timeColumn, false);
+  f.number(j, "sample_time_s", where, o.sampleTime, false);
+  f.string(j, "input_name", where, o.inputName, false);
+  f.string(j, "output_name", where, o.outputName, false);
+  f.string(j, "input_variable", where, o.inputVariable, false);
+  f.string(j, "output_variable", where, o.outputVariable, false);
+  f.number(j, "max_sample_jitter", where, o.maxSampleJitter, false);
+  if (f.failed()) return false;
+  std::string why;
+  if (!o.isValid(&why)) return f.fail(where, why);
+  return true;
+}
+
+json preprocessToJson(const Session& s) {
+  const PreprocessOptions& p = s.preprocess;
+  json j = {{"applied", s.preprocessed},
+            {"differentiate_angle", p.differentiateAngle},
+            {"range_samples", p.range ? json::array({p.range->begin, p.range->end}) : json(nullptr)},
+            {"decimation",
+             {{"factor", p.decimation.factor},
+              {"filter", toString(p.decimation.filter)},
+              {"stopband_db", p.decimation.stopbandDb}}},
+            {"detrend", toString(p.detrend)}};
+  return j;
+}
+
+bool preprocessFromJson(const json& j, Session& s, FieldReader& f) {
+  const std::string where = "preprocessing";
+  PreprocessOptions& p = s.preprocess;
+  f.boolean(j, "applied", where, s.preprocessed);
+  f.boolean(j, "differentiate_angle", where, p.differentiateAngle);
+  if (const json* r = f.member(j, "range_samples", where, false); r && !r->is_null()) {
+    if (!r->is_array() || r->size() != 2 || !(*r)[0].is_number_unsigned() ||
+        !(*r)[1].is_number_unsigned() || (*r)[1].get<std::size_t>() <= (*r)[0].get<std::size_t>())
+      return f.fail(where + ".range_samples", "must be [first, end) sample indices or null");
+    p.range = SampleRange{(*r)[0].get<std::size_t>(), (*r)[1].get<std::size_t>()};
+  }
+  if (const json* d = f.member(j, "decimation", where, true)) {
+    f.integer(*d, "factor", where + ".decimation", p.decimation.factor);
+    std::string filter;
+    if (f.string(*d, "filter", where + ".decimation", filter)) {
+      auto k = antiAliasFilterFromString(filter);
+      if (!k) return f.fail(where + ".decimation.filter", "unknown filter '" + filter + "'");
+      p.decimation.filter = *k;
+    }
+    f.number(*d, "stopband_db", where + ".decimation", p.decimation.stopbandDb);
+  }
+  std::string detrend;
+  if (f.string(j, "detrend", where, detrend)) {
+    auto k = detrendFromString(detrend);
+    if (!k) return f.fail(where + ".detrend", "unknown detrend '" + detrend + "'");
+    p.detrend = *k;
+  }
+  if (f.failed()) return false;
+  std::string why;
+  if (!p.isValid(&why)) return f.fail(where, why);
+  return true;
+}
+
+// Line and column of a byte offset, for parse errors.
+std::string placeOf(const std::string& text, std::size_t byte) {
+  int line = 1, column = 1;
+  for (std::size_t i = 0; i < byte && i < text.size(); ++i) {
+    if (text[i] == '\n') {
+      ++line;
+      column = 1;
+    } else {
+      ++column;
+    }
+  }
+  return "line " + std::to_string(line) + ", column " + std::to_string(column);
+}
+
+}  // namespace
+
+std::string toJsonText(const Session& s) {
+  json logs = json::array();
+  for (const auto& l : s.logs)
+    logs.push_back({{"name", l.name}, {"path", l.path}, {"sha256", l.sha256},
+                    {"read", readOptionsToJson(l.read)}});
+  json j = {{"format", kSessionFormat},
+            {"version", kSessionVersion},
+            {"written_by", std::string("FlexArm ") + FLEXARM_VERSION},
+            {"logs", logs},
+            {"preprocessing", preprocessToJson(s)},
+            {"ranges",
+             {{"estimation_s", rangeToJson(s.estimation)},
+              {"validation_s", rangeToJson(s.validation)}}},
+            {"parts", s.parts.is_object() ? s.parts : json::object()}};
+  return j.dump(2) + "\n";
+}
+
+SessionParseResult parseSession(const std::string& text) {
+  SessionParseResult r;
+  json j;
+  try {
+    j = json::parse(text);
+  } catch (const json::parse_error& e) {
+    r.message = "not a readable session: the JSON is damaged at " + placeOf(text, e.byte) +
+                (e.byte >= text.size() ? " (the file ends too early)" : "");
+    return r;
+  }
+  if (!j.is_object() || !j.contains("format") || j["format"] != kSessionFormat) {
+    r.message = "not a FlexArm session (\"format\": \"flexarm-session\" is missing)";
+    return r;
+  }
+  if (!j.contains("version") || !j["version"].is_number_integer() || j["version"].get<int>() < 1) {
+    r.message = "damaged session: \"version\" must be a whole number from 1 on";
+    return r;
+  }
+  const int version = j["version"].get<int>();
+  const std::string writer = j.value("written_by", std::string("a newer FlexArm"));
+  if (version > kSessionVersion) {
+    r.message = "this session is in session format " + std::to_string(version) + " (written by " +
+                writer + "); FlexArm " + FLEXARM_VERSION + " reads formats up to " +
+                std::to_string(kSessionVersion) + ". Open it with a newer FlexArm.";
+    return r;
+  }
+  std::string why;
+  FieldReader f(&why);
+  Session& s = r.session;
+  s.writtenBy = writer;
+  const json* logs = f.member(j, "logs", "session", true);
+  if (logs && !logs->is_array()) f.fail("logs", "must be a list");
+  if (logs && logs->is_array()) {
+    if (logs->empty()) f.fail("logs", "the session names no log");
+    for (std::size_t i = 0; i < logs->size() && !f.failed(); ++i) {
+      const std::string where = "logs[" + std::to_string(i) + "]";
+      LogReference l;
+      f.string((*logs)[i], "name", where, l.name);
+      f.string((*logs)[i], "path", where, l.path);
+      f.string((*logs)[i], "sha256", where, l.sha256);
+      if (!f.failed() && (l.name.empty() || l.path.empty()))
+        f.fail(where, "name and path must not be empty");
+      if (!f.failed() && l.sha256.size() != 64)
+        f.fail(where + ".sha256", "must be 64 hexadecimal digits");
+      for (const auto& other : s.logs)
+        if (!f.failed() && other.name == l.name) f.fail(where, "the name '" + l.name + "' is used twice");
+      if (const json* ro = f.member((*logs)[i], "read", where, false))
+        readOptionsFromJson(*ro, where + ".read", l.read, f);
+      s.logs.push_back(std::move(l));
+    }
+  }
+  if (!f.failed())
+    if (const json* p = f.member(j, "preprocessing", "session", true)) preprocessFromJson(*p, s, f);
+  if (!f.failed())
+    if (const json* rg = f.member(j, "ranges", "session", true)) {
+      if (const json* e = f.member(*rg, "estimation_s", "ranges", false))
+        rangeFromJson(*e, "ranges.estimation_s", s.estimation, f);
+      if (const json* v = f.member(*rg, "validation_s", "ranges", false))
+        rangeFromJson(*v, "ranges.validation_s", s.validation, f);
+    }
+  if (!f.failed())
+    if (const json* parts = f.member(j, "parts", "session", true)) {
+      if (!parts->is_object()) {
+        f.fail("parts", "must be an object");
+      } else {
+        for (auto it = parts->begin(); it != parts->end() && !f.failed(); ++it) {
+          const SessionPart* part = findSessionPart(it.key());
+          std::string partWhy;
+          if (!part)
+            f.fail("parts." + it.key(), "this FlexArm does not know this part (saved by " +
+                                            writer + "?)");
+          else if (!part->validate(it.value(), &partWhy))
+            f.fail("parts." + it.key(), partWhy);
+        }
+        if (!f.failed()) s.parts = *parts;
+      }
+    }
+  if (f.failed()) {
+    r.message = "damaged session: " + why;
+    r.session = Session{};
+    return r;
+  }
+  r.ok = true;
+  return r;
+}
+
+SessionParseResult loadSession(const std::string& path) {
+  SessionParseResult r;
+  std::ifstream in(path, std::ios::binary);
+  if (!in) {
+    r.message = path + ": cannot be read";
+    return r;
+  }
+  std::ostringstream text;
+  text << in.rdbuf();
+  r = parseSession(text.str());
+  if (!r.ok) r.message = path + ": " + r.message;
+  return r;
+}
+
+bool saveSession(const Session& session, const std::string& path, std::string* why) {
+  return writeFileAtomically(path, toJsonText(session), why);
+}
+
+std::string resolveLogPath(const std::string& sessionPath, const std::string& logPath) {
+  const fs::path p(logPath);
+  if (p.is_absolute()) return logPath;
+  return (fs::path(sessionPath).parent_path() / p).lexically_normal().string();
+}
+
+std::string storedLogPath(const std::string& sessionPath, const std::string& logPath) {
+  std::error_code ec;
+  const fs::path log = fs::absolute(logPath, ec).lexically_normal();
+  const fs::path dir = fs::absolute(sessionPath, ec).parent_path().lexically_normal();
+  const fs::path rel = log.lexically_relative(dir);
+  if (!rel.empty() && *rel.begin() != "..") return rel.generic_string();
+  return log.string();
+}
+
+std::vector<std::string> describePreprocessing(const PreprocessOptions& p) {
+  std::vector<std::string> steps;
+  if (p.differentiateAngle)
+    steps.push_back("motor velocity from the motor angle by central differences (the output)");
+  if (p.range)
+    steps.push_back("keep samples " + std::to_string(p.range->begin) + " to " +
+                    std::to_string(p.range->end));
+  if (p.decimation.factor > 1) {
+    std::string filter = toString(p.decimation.filter);
+    if (p.decimation.filter == AntiAliasFilter::Fir)
+      filter += ", " + std::to_string(static_cast<int>(std::lround(p.decimation.stopbandDb))) + " dB";
+    steps.push_back("decimation by " + std::to_string(p.decimation.factor) + " (anti-alias " +
+                    filter + ")");
+  }
+  if (p.detrend != Detrend::None)
+    steps.push_back(std::string(p.detrend == Detrend::Mean ? "mean" : "linear trend") +
+                    " removal");
+  return steps;
+}
+
+}  // namespace flexarm

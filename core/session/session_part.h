@@ -1,0 +1,48 @@
+#pragma once
+// The extension point of sessions and reports. Each capability (the model list, view state,
+// and later identification, discovery, LQG, ...) owns one section of the session file under
+// "parts"/KEY and contributes its own report sections. A capability adds itself by deriving
+// from SessionPart and adding one line to sessionParts() in session_parts.cpp; the window
+// side adds the matching capture/restore in app/session_parts.cpp.
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "core/common/progress.h"
+#include "core/session/report.h"
+#include "core/session/session.h"
+#include "core/signal/id_data.h"
+
+namespace flexarm {
+
+// What a part sees when it is replayed: the session, the data the analysis uses
+// (preprocessed, ranges set) and every log the session names, read and preprocessed alike.
+struct ReplayContext {
+  const Session& session;
+  const IdData& data;
+  const std::vector<std::pair<std::string, const IdData*>>& logs;  // by LogReference::name
+  ProgressCallback progress;
+};
+
+class SessionPart {
+ public:
+  virtual ~SessionPart() = default;
+  // The section's key under "parts", e.g. "models".
+  virtual std::string key() const = 0;
+  // Checks a section read from a file before anything is opened; false with a sentence
+  // naming the problem.
+  virtual bool validate(const nlohmann::json& section, std::string* why) const = 0;
+  // Recomputes the part's results from the section and appends its report sections. Data
+  // failures go into the report as sentences; nothing throws for bad data.
+  virtual void replay(const nlohmann::json& section, const ReplayContext& context,
+                      Report& report) const = 0;
+};
+
+// Every known part, in report order.
+const std::vector<std::shared_ptr<const SessionPart>>& sessionParts();
+// The part with this key, or nullptr.
+const SessionPart* findSessionPart(const std::string& key);
+
+}  // namespace flexarm

@@ -1,0 +1,214 @@
+// The parts a session holds today: the model list and view state. A capability that lands
+// later adds its class here (or in its own module) and one line to sessionParts().
+#include <algorithm>
+#include <cmath>
+#include <complex>
+
+
+#include <Eigen/Dense>
+
+#include "core/ident/evaluation.h"
+#include "core/models/analysis.h"
+#include "core/models/nonlinear_plant.h"
+#include "core/session/model_json.h"
+#include "core/session/session_part.h"
+#include "core/signal/preprocess.h"
+
+namespace flexarm {
+
+using nlohmann::json;
+
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+// At most n points of a series, evenly strided, for plots.
+void thin(std::vector<double>& x, std::vector<double>& y, std::size_t n) {
+  if (x.size() <= n) return;
+  const std::size_t step = (x.size() + n - 1) / n;
+  std::size_t k = 0;
+  for (std::size_t i = 0; i < x.size(); i += step, ++k) {
+    x[k] = x[i];
+    y[k] = y[i];
+  }
+  x.resize(k);
+  y.resize(k);
+}
+
+// The model list: each model's parameters (value, unit, free flag), effects, notch and peak
+// frequencies (5.4), Bode plot, and its simulation fit % (5.2) on the estimation and
+// validation ranges, simulated open loop from the log's torque reference with the effects.
+class ModelsPart : public SessionPart {
+ public:
+  std::string key() const override { return "models"; }
+
+  bool validate(const json& section, std::string* why) const override {
+    if (!section.is_array()) {
+      if (why) *why = "must be a list of models";
+      return false;
+    }
+    for (const auto& m : section)
+      if (!modelFromJson(m, why)) return false;
+    return true;
+  }
+
+  void replay(const json& section, const ReplayContext& context, Report& report) const override {
+    for (const auto& m : section) {
+      std::string why;
+      auto spec = modelFromJson(m, &why);
+      if (!spec) continue;  // validated on load
+      report.sections.push_back(modelSection(*spec, context.data));
+    }
+  }
+
+ private:
+  static ReportSection modelSection(const ModelSpec& spec, const IdData& data) {
+    const PhysicalModel& model = *spec.model;
+    ReportSection s;
+    s.title = "Model " + spec.name;
+    s.paragraphs.push_back(model.description() + ".");
+    std::string fx;
+    for (const auto& e : spec.effects) {
+      const auto& info = effectParameters(e.kind);
+      fx += (fx.empty() ? "" : "; ") + std::string(toString(e.kind)) + " (";
+      for (std::size_t i = 0; i < info.size(); ++i)
+        fx += (i ? ", " : "") + info[i].name + " = " + formatSignificant(e.values[i]) +
+              (info[i].unit.empty() ? "" : " " + info[i].unit);
+      fx += ")";
+    }
+    s.paragraphs.push_back(fx.empty() ? "No nonlinear effects." : "Effects: " + fx + ".");
+    s.paragraphs.push_back("Parameter values as set in the model list (not estimated here).");
+    ReportTable params{"Parameters", {"Parameter", "Value", "Unit", "Free"}, {}};
+    json paramsJson = json::object();
+    for (const auto& p : model.parameters()) {
+      params.rows.push_back({p.name, formatSignificant(p.value, 6), p.unit, p.free ? "yes" : "no"});
+      paramsJson[p.name] = p.value;
+    }
+    s.tables.push_back(params);
+    s.values = {{"name", spec.name}, {"structure", model.structureName()}, {"parameters", paramsJson}};
+
+    const StateSpace sys = model.stateSpace();
+    ReportTable modes{"Notches and peaks (5.4)", {"Kind", "Frequency (rad/s)", "Damping"}, {}};
+    json notches = json::array(), peaks = json::array();
+    for (const auto& n : notchFrequencies(sys)) {
+      modes.rows.push_back({"notch", formatSignificant(n.frequency, 5), formatSignificant(n.damping, 3)});
+      notches.push_back(n.frequency);
+    }
+    for (const auto& p : peakFrequencies(sys)) {
+      modes.rows.push_back({"peak", formatSignificant(p.frequency, 5), formatSignificant(p.damping, 3)});
+      peaks.push_back(p.frequency);
+    }
+    s.tables.push_back(modes);
+    s.values["notches_rad_s"] = notches;
+    s.values["peaks_rad_s"] = peaks;
+    s.plots = bodePlots(sys, spec.name);
+    addFit(spec, data, s);
+    return s;
+  }
+
+  static std::vector<ReportPlot> bodePlots(const StateSpace& sys, const std::string& name) {
+    const std::vector<double> w = logGrid(1.0, 3000.0, 500);
+    const auto g = frequencyResponse(sys, w);
+    ReportSeries mag{name, w, {}, false}, phase{name, w, {}, false};
+    double offset = 0.0, last = 0.0;
+    for (std::size_t i = 0; i < g.size(); ++i) {
+      mag.y.push_back(std::abs(g[i]));
+      double p = std::arg(g[i]) * 180.0 / kPi + offset;
+      while (i > 0 && p - last > 180.0) p -= 360.0, offset -= 360.0;
+      while (i > 0 && p - last < -180.0) p += 360.0, offset += 360.0;
+      phase.y.push_back(p);
+      last = p;
+    }
+    return {ReportPlot{"Bode magnitude, " + name, "frequency (rad/s)", "|G| (rad/s per N m)", true,
+                       true, {mag}},
+            ReportPlot{"Bode phase, " + name, "frequency (rad/s)", "phase (deg)", true, false, {phase}}};
+  }
+
+  // Simulation fit % (5.2) on the ranges, as the Model panel computes it for the whole log.
+  static void addFit(const ModelSpec& spec, const IdData& data, ReportSection& s) {
+    const Channel* torque = data.channel(columns::kTorqueRef);
+    if (!torque) torque = data.input();
+    const Channel* velocity = data.channel(columns::kMotorVelocity);
+    const Channel* angle = data.channel(columns::kMotorAngle);
+    if (!torque || (!velocity && !angle) || data.samples() < 2) {
+      s.paragraphs.push_back("No fit: the log needs a torque reference and a motor angle or velocity.");
+      return;
+    }
+    std::vector<double> simulated;
+    try {
+      NonlinearPlant plant(*spec.model, spec.effects);
+      TorqueResponseOptions o;
+      o.substeps = std::max(2, static_cast<int>(std::ceil(data.sampleTime / 2.5e-4)));
+      simulated = simulateTorque(plant, torque->values, data.sampleTime, o).motorVelocity;
+    } catch (const std::invalid_argument& e) {
+      s.paragraphs.push_back(std::string("No fit: the simulation failed: ") + e.what());
+      return;
+    }
+    const std::vector<double> measured =
+        velocity ? velocity->values : differentiate(angle->values, data.sampleTime);
+    const Eigen::Map<const Eigen::VectorXd> y(measured.data(), static_cast<Eigen::Index>(measured.size()));
+    const Eigen::Map<const Eigen::VectorXd> yhat(simulated.data(), static_cast<Eigen::Index>(simulated.size()));
+    ReportTable fit{"Simulation fit % (5.2), open loop from the torque reference",
+                    {"Range", "Samples", "Fit %"}, {}};
+    std::optional<SampleRange> plotRange;
+    for (const auto& [name, range] : {std::pair{"estimation", data.estimationRange},
+                                      std::pair{"validation", data.validationRange}}) {
+      if (!range) continue;
+      const double f = fitPercent(y, yhat, static_cast<Eigen::Index>(range->begin),
+                                  static_cast<Eigen::Index>(range->end));
+      fit.rows.push_back({name, std::to_string(range->size()), formatFixed(f, 2)});
+      s.values[std::string("fit_") + name + "_percent"] = f;
+      plotRange = range;  // the validation range when there is one
+    }
+    if (fit.rows.empty()) {
+      const double f = fitPercent(y, yhat);
+      fit.rows.push_back({"whole log", std::to_string(data.samples()), formatFixed(f, 2)});
+      s.values["fit_whole_log_percent"] = f;
+      plotRange = SampleRange{0, data.samples()};
+    }
+    s.tables.push_back(fit);
+    ReportSeries meas{"measured", {}, {}, false}, sim{"simulated " + spec.name, {}, {}, true};
+    for (std::size_t i = plotRange->begin; i < plotRange->end; ++i) {
+      meas.x.push_back(data.timeAt(i));
+      meas.y.push_back(measured[i]);
+    }
+    sim.x = meas.x;
+    sim.y.assign(simulated.begin() + static_cast<std::ptrdiff_t>(plotRange->begin),
+                 simulated.begin() + static_cast<std::ptrdiff_t>(plotRange->end));
+    thin(meas.x, meas.y, 3000);
+    thin(sim.x, sim.y, 3000);
+    s.plots.push_back(ReportPlot{"Measured and simulated motor velocity, " + spec.name, "time (s)",
+                                 "motor velocity (rad/s)", false, false, {meas, sim}});
+  }
+};
+
+// View state (window layout, selected panel items): restored by the window, not replayed.
+class ViewPart : public SessionPart {
+ public:
+  std::string key() const override { return "view"; }
+  bool validate(const json& section, std::string* why) const override {
+    if (section.is_object()) return true;
+    if (why) *why = "must be an object";
+    return false;
+  }
+  void replay(const json&, const ReplayContext&, Report&) const override {}
+};
+
+}  // namespace
+
+const std::vector<std::shared_ptr<const SessionPart>>& sessionParts() {
+  // Report order. Identification, discovery, LQG and later capabilities add their part here.
+  static const std::vector<std::shared_ptr<const SessionPart>> kParts = {
+      std::make_shared<ModelsPart>(),
+      std::make_shared<ViewPart>(),
+  };
+  return kParts;
+}
+
+const SessionPart* findSessionPart(const std::string& key) {
+  for (const auto& p : sessionParts())
+    if (p->key() == key) return p.get();
+  return nullptr;
+}
+
+}  // namespace flexarm

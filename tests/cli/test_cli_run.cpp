@@ -1,0 +1,129 @@
+// flexarm run: replays the sample session headless and writes PDF and HTML reports whose text
+// carries the section titles, parameter names, checksums and the same fit % as --json.
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <regex>
+
+#include "cli_test_support.h"
+
+using flexarm::test::readAll;
+using flexarm::test::runFlexarm;
+using flexarm::test::scratchDir;
+
+namespace {
+
+const std::string kSession = std::string(FLEXARM_SAMPLE_DIR) + "/sample_session.json";
+const std::string kMultisine =
+    std::string(FLEXARM_SAMPLE_DIR) + "/three_mass_validation_multisine.csv";
+
+// This build renders reports (the GUI build); a build without Qt refuses --report clearly.
+bool reportsRendered() {
+  auto r = runFlexarm({"run", kSession, "--report", (scratchDir() / "probe.html").string()});
+  return r.err.find("built without the GUI") == std::string::npos;
+}
+
+std::string pdfText(const std::string& pdf) {
+  const std::string txt = pdf + ".txt";
+  const std::string cmd = "pdftotext -layout '" + pdf + "' '" + txt + "'";
+  EXPECT_EQ(std::system(cmd.c_str()), 0) << cmd;
+  return readAll(txt);
+}
+
+}  // namespace
+
+TEST(CliRun, JsonNamesVersionLogChecksumAndEveryModel) {
+  auto r = runFlexarm({"run", kSession, "--json"});
+  ASSERT_EQ(r.code, 0) << r.err;
+  auto j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["flexarm_version"], FLEXARM_VERSION);
+  auto session = nlohmann::json::parse(readAll(kSession));
+  EXPECT_EQ(j["logs"][0]["sha256"], session["logs"][0]["sha256"]);
+  std::vector<std::string> titles;
+  for (const auto& s : j["sections"]) titles.push_back(s["title"]);
+  EXPECT_EQ(titles, (std::vector<std::string>{"Data", "Model three-mass", "Model two-mass"}));
+  EXPECT_EQ(j["sections"][0]["values"]["rate_hz"].get<double>(), 200.0);
+}
+
+TEST(CliRun, PdfTextHasTitlesParametersChecksumAndTheJsonFitPercent) {
+  if (!reportsRendered()) GTEST_SKIP() << "this build has no GUI: reports are not rendered";
+  const std::string pdf = (scratchDir() / "report.pdf").string();
+  auto r = runFlexarm({"run", kSession, "--report", pdf, "--json"});
+  ASSERT_EQ(r.code, 0) << r.err;
+  auto j = nlohmann::json::parse(r.out);
+  const std::string text = pdfText(pdf);
+  ASSERT_FALSE(text.empty());
+  EXPECT_NE(text.find("FlexArm " FLEXARM_VERSION), std::string::npos);
+  EXPECT_NE(text.find(j["logs"][0]["sha256"].get<std::string>()), std::string::npos);
+  int fits = 0;
+  for (const auto& s : j["sections"]) {
+    EXPECT_NE(text.find(s["title"].get<std::string>()), std::string::npos) << s["title"];
+    if (!s["values"].contains("parameters")) continue;
+    for (const auto& [name, value] : s["values"]["parameters"].items())
+      EXPECT_NE(text.find(name), std::string::npos) << name;
+    for (const char* key : {"fit_estimation_percent", "fit_validation_percent"}) {
+      char buf[32];
+      std::snprintf(buf, sizeof buf, "%.2f", s["values"][key].get<double>());
+      EXPECT_NE(text.find(buf), std::string::npos) << key << " " << buf;
+      ++fits;
+    }
+  }
+  EXPECT_EQ(fits, 4);
+}
+
+TEST(CliRun, HtmlIsSelfContained) {
+  if (!reportsRendered()) GTEST_SKIP() << "this build has no GUI: reports are not rendered";
+  const std::string html = (scratchDir() / "report.html").string();
+  auto r = runFlexarm({"run", kSession, "--report", html});
+  ASSERT_EQ(r.code, 0) << r.err;
+  const std::string text = readAll(html);
+  EXPECT_NE(text.find("Model three-mass"), std::string::npos);
+  EXPECT_EQ(text.find("http:"), std::string::npos);
+  EXPECT_EQ(text.find("https:"), std::string::npos);
+  EXPECT_EQ(text.find("<link"), std::string::npos);
+  EXPECT_EQ(text.find("url("), std::string::npos);
+  // Every image is embedded: src attributes are data URIs, and there are plots.
+  const std::regex src("src=\"([^\"]{0,16})");
+  int images = 0;
+  for (auto it = std::sregex_iterator(text.begin(), text.end(), src); it != std::sregex_iterator(); ++it) {
+    EXPECT_EQ((*it)[1].str().rfind("data:image/png", 0), 0u) << (*it)[1].str();
+    ++images;
+  }
+  EXPECT_GE(images, 6);  // Bode magnitude, phase and compare plot of each of the two models
+}
+
+TEST(CliRun, SubstitutedLogIsReplayedAndNamed) {
+  auto r = runFlexarm({"run", kSession, "--log", "estimation=" + kMultisine, "--json"});
+  ASSERT_EQ(r.code, 0) << r.err;
+  auto j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["logs"][0]["note"], "substituted");
+  EXPECT_EQ(j["logs"][0]["path"], kMultisine);
+}
+
+TEST(CliRun, BadInputAndUsageExitCodes) {
+  const auto dir = scratchDir();
+  const std::string damaged = (dir / "damaged.json").string();
+  std::string text = readAll(kSession);
+  std::ofstream(damaged) << text.substr(0, text.size() / 3);
+  auto r = runFlexarm({"run", damaged, "--json"});
+  EXPECT_EQ(r.code, 3);
+  EXPECT_NE(r.err.find("damaged"), std::string::npos) << r.err;
+
+  auto j = nlohmann::json::parse(text);
+  j["version"] = 99;
+  const std::string newer = (dir / "newer.json").string();
+  std::ofstream(newer) << j.dump();
+  r = runFlexarm({"run", newer, "--json"});
+  EXPECT_EQ(r.code, 3);
+  EXPECT_NE(r.err.find("newer FlexArm"), std::string::npos) << r.err;
+
+  EXPECT_EQ(runFlexarm({"run", kSession}).code, 2);
+  EXPECT_EQ(runFlexarm({"run", kSession, "--report", "out.docx"}).code, 2);
+  EXPECT_EQ(runFlexarm({"run", kSession, "--log", "estimation", "--json"}).code, 2);
+  r = runFlexarm({"run", kSession, "--log", "tomorrow=" + kMultisine, "--json"});
+  EXPECT_EQ(r.code, 3);
+  EXPECT_NE(r.err.find("no log named 'tomorrow'"), std::string::npos) << r.err;
+  EXPECT_EQ(runFlexarm({"run", "--help"}).code, 0);
+}

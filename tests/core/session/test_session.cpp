@@ -1,0 +1,283 @@
+// Sessions: format round trip, refusal of damaged and newer files, atomic save under a write
+// that fails or crashes half-way, replay of the sample session and its reproducibility.
+#include <gtest/gtest.h>
+
+#include <csignal>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <sys/resource.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include "core/io/log_io.h"
+#include "core/session/model_json.h"
+#include "core/session/replay.h"
+#include "core/session/session.h"
+#include "core/session/sha256.h"
+#include "core/signal/preprocess.h"
+
+namespace fs = std::filesystem;
+using namespace flexarm;
+
+namespace {
+
+const std::string kSample = std::string(FLEXARM_SAMPLE_DIR) + "/sample_session.json";
+const std::string kChirp = std::string(FLEXARM_SAMPLE_DIR) + "/three_mass_estimation_chirp.csv";
+const std::string kMultisine =
+    std::string(FLEXARM_SAMPLE_DIR) + "/three_mass_validation_multisine.csv";
+
+std::string readText(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+fs::path scratch() {
+  auto p = fs::temp_directory_path() / ("flexarm_session_" + std::to_string(::getpid()));
+  fs::create_directories(p);
+  return p;
+}
+
+Session sampleSession() {
+  auto r = loadSession(kSample);
+  EXPECT_TRUE(r.ok) << r.message;
+  return r.session;
+}
+
+const nlohmann::json* sectionValues(const nlohmann::json& report, const std::string& title) {
+  for (const auto& s : report["sections"])
+    if (s["title"] == title) return &s["values"];
+  return nullptr;
+}
+
+}  // namespace
+
+TEST(Sha256, KnownDigestsOfFips180Examples) {
+  EXPECT_EQ(sha256Hex(""), "e3b0c44298fc1c149afbf4c8996fb92427ae41e4649b934ca495991b7852b855");
+  EXPECT_EQ(sha256Hex("abc"), "ba7816bf8f01cfea414140de5dae2223b00361a396177a9cb410ff61f20015ad");
+  EXPECT_EQ(sha256Hex("abcdbcdecdefdefgefghfghighijhijkijkljklmklmnlmnomnopnopq"),
+            "248d6a61d20638b8e5c026930c3e6039a33ce45964ff2167f6ecedd419db06c1");
+  EXPECT_EQ(sha256Hex(std::string(1000000, 'a')),
+            "cdc76e5c9914fb9281a1c7e284d73e67f1809a48a497200e046d39ccc7112cd0");
+}
+
+TEST(Session, SampleSessionChecksumMatchesItsLog) {
+  Session s = sampleSession();
+  ASSERT_EQ(s.logs.size(), 1u);
+  std::string why;
+  EXPECT_EQ(sha256OfFile(kChirp, &why).value_or(why), s.logs[0].sha256);
+  EXPECT_TRUE(s.preprocessed);
+  EXPECT_TRUE(s.preprocess.differentiateAngle);
+  EXPECT_EQ(s.preprocess.decimation.factor, 10);
+  EXPECT_EQ(s.preprocess.detrend, Detrend::Mean);
+}
+
+TEST(Session, TextRoundTripKeepsEveryField) {
+  Session s = sampleSession();
+  s.preprocess.range = SampleRange{100, 30000};
+  s.logs[0].read.format = LogFormat::Table;
+  s.logs[0].read.inputColumn = 3;
+  s.logs[0].read.sampleTime = 0.0005;
+  s.validation.reset();
+  const std::string text = toJsonText(s);
+  auto back = parseSession(text);
+  ASSERT_TRUE(back.ok) << back.message;
+  EXPECT_EQ(toJsonText(back.session), text);
+  EXPECT_EQ(back.session.logs[0].read.format, LogFormat::Table);
+  EXPECT_EQ(back.session.logs[0].read.inputColumn, 3);
+  ASSERT_TRUE(back.session.preprocess.range);
+  EXPECT_EQ(back.session.preprocess.range->end, 30000u);
+  EXPECT_FALSE(back.session.validation);
+  ASSERT_TRUE(back.session.estimation);
+  EXPECT_EQ(*back.session.estimation, (SecondsRange{0.5, 12.0}));
+}
+
+TEST(Session, ModelJsonRoundTripKeepsValuesFreeFlagsAndEffects) {
+  auto m = makeModel("three-mass");
+  m->setParameter("k_g", 1.234e5);
+  m->setFree("J_m", false);
+  std::vector<Effect> fx = {Effect::withDefaults(EffectKind::Backlash)};
+  fx[0].values[0] = 3e-4;
+  std::string why;
+  auto back = modelFromJson(modelToJson("arm", *m, fx), &why);
+  ASSERT_TRUE(back) << why;
+  EXPECT_EQ(back->name, "arm");
+  EXPECT_EQ(back->model->value("k_g"), 1.234e5);
+  EXPECT_FALSE(back->model->parameters()[back->model->indexOf("J_m")].free);
+  ASSERT_EQ(back->effects.size(), 1u);
+  EXPECT_EQ(back->effects[0].kind, EffectKind::Backlash);
+  EXPECT_EQ(back->effects[0].values[0], 3e-4);
+}
+
+TEST(Session, DamagedFilesAreRefusedWithThePlace) {
+  const std::string text = toJsonText(sampleSession());
+  auto cut = parseSession(text.substr(0, text.size() / 2));
+  EXPECT_FALSE(cut.ok);
+  EXPECT_NE(cut.message.find("damaged"), std::string::npos) << cut.message;
+  EXPECT_NE(cut.message.find("line"), std::string::npos) << cut.message;
+
+  auto j = nlohmann::json::parse(text);
+  j["ranges"]["estimation_s"] = nlohmann::json::array({5.0, 1.0});
+  auto backwards = parseSession(j.dump());
+  EXPECT_FALSE(backwards.ok);
+  EXPECT_NE(backwards.message.find("ranges.estimation_s"), std::string::npos) << backwards.message;
+
+  j = nlohmann::json::parse(text);
+  j["parts"]["models"][0]["parameters"][0]["value"] = -1.0;  // J_m below its bound
+  auto bad = parseSession(j.dump());
+  EXPECT_FALSE(bad.ok);
+  EXPECT_NE(bad.message.find("J_m"), std::string::npos) << bad.message;
+
+  j = nlohmann::json::parse(text);
+  j["parts"]["hologram"] = nlohmann::json::object();
+  auto unknown = parseSession(j.dump());
+  EXPECT_FALSE(unknown.ok);
+  EXPECT_NE(unknown.message.find("hologram"), std::string::npos) << unknown.message;
+
+  j = nlohmann::json::parse(text);
+  j["logs"][0].erase("sha256");
+  auto noSum = parseSession(j.dump());
+  EXPECT_FALSE(noSum.ok);
+  EXPECT_NE(noSum.message.find("sha256"), std::string::npos) << noSum.message;
+
+  EXPECT_FALSE(parseSession("{\"hello\": 1}").ok);
+}
+
+TEST(Session, NewerVersionIsRefusedNamingBothVersions) {
+  auto j = nlohmann::json::parse(toJsonText(sampleSession()));
+  j["version"] = kSessionVersion + 1;
+  j["written_by"] = "FlexArm 9.0";
+  auto r = parseSession(j.dump());
+  EXPECT_FALSE(r.ok);
+  EXPECT_NE(r.message.find("FlexArm 9.0"), std::string::npos) << r.message;
+  EXPECT_NE(r.message.find("format " + std::to_string(kSessionVersion + 1)), std::string::npos)
+      << r.message;
+  EXPECT_NE(r.message.find("newer"), std::string::npos) << r.message;
+}
+
+// A save whose write fails half-way (file size limit) and one whose process dies half-way
+// (SIGXFSZ kills it, as a crash would) both leave the previous session file untouched.
+TEST(Session, WriteFailingOrCrashingMidSaveKeepsTheOldFile) {
+  const auto dir = scratch();
+  const std::string path = (dir / "kept.json").string();
+  Session small = sampleSession();
+  std::string why;
+  ASSERT_TRUE(saveSession(small, path, &why)) << why;
+  const std::string before = readText(path);
+  Session big = small;
+  big.parts["view"] = {{"padding", std::string(200000, 'x')}};
+  ASSERT_GT(toJsonText(big).size(), 100000u);
+
+  for (bool crash : {false, true}) {
+    const pid_t child = fork();
+    ASSERT_GE(child, 0);
+    if (child == 0) {
+      if (!crash) std::signal(SIGXFSZ, SIG_IGN);  // the write then fails with EFBIG
+      rlimit limit{50000, 50000};
+      setrlimit(RLIMIT_FSIZE, &limit);
+      std::string childWhy;
+      const bool ok = saveSession(big, path, &childWhy);
+      _exit(ok ? 0 : 7);
+    }
+    int status = 0;
+    waitpid(child, &status, 0);
+    if (crash) {
+      ASSERT_TRUE(WIFSIGNALED(status));
+      EXPECT_EQ(WTERMSIG(status), SIGXFSZ);
+    } else {
+      ASSERT_TRUE(WIFEXITED(status));
+      EXPECT_EQ(WEXITSTATUS(status), 7) << "the failed write must be reported";
+    }
+    EXPECT_EQ(readText(path), before);
+    auto reread = loadSession(path);
+    EXPECT_TRUE(reread.ok) << reread.message;
+  }
+  ASSERT_TRUE(saveSession(big, path, &why)) << why;  // without the limit it succeeds
+  EXPECT_EQ(readText(path), toJsonText(big));
+}
+
+TEST(Replay, SampleSessionPreparesDataAsTheSeed) {
+  Session s = sampleSession();
+  ReplayResult r = replaySession(s, kSample);
+  ASSERT_EQ(r.termination, Termination::Converged) << r.message;
+  const nlohmann::json j = r.report.toJson();
+  const auto* data = sectionValues(j, "Data");
+  ASSERT_NE(data, nullptr);
+  // The same steps by hand: differentiate, decimate by 10 (2 kHz -> 200 Hz), remove means.
+  auto log = readLog(kChirp);
+  ASSERT_TRUE(log.ok);
+  PreprocessOptions p;
+  p.differentiateAngle = true;
+  p.decimation.factor = 10;
+  p.detrend = Detrend::Mean;
+  const IdData pre = preprocess(log.data, p);
+  EXPECT_EQ((*data)["samples"].get<std::size_t>(), pre.samples());
+  EXPECT_DOUBLE_EQ((*data)["rate_hz"].get<double>(), 200.0);
+  EXPECT_EQ((*data)["ranges"]["estimation"]["samples"].get<std::size_t>(),
+            pre.rangeForTimes(0.5, 12.0).size());
+  EXPECT_EQ(r.report.logs.at(0).sha256, s.logs[0].sha256);
+  EXPECT_TRUE(r.report.warnings.empty());
+}
+
+TEST(Replay, TrueThreeMassModelFitsBetterThanTheTwoMassModel) {
+  ReplayResult r = replaySession(sampleSession(), kSample);
+  ASSERT_EQ(r.termination, Termination::Converged) << r.message;
+  const nlohmann::json j = r.report.toJson();
+  const auto* three = sectionValues(j, "Model three-mass");
+  const auto* two = sectionValues(j, "Model two-mass");
+  ASSERT_NE(three, nullptr);
+  ASSERT_NE(two, nullptr);
+  // The chirp log was simulated with the three-mass model (Table 5.7 p6) the session holds.
+  EXPECT_GT((*three)["fit_validation_percent"].get<double>(), (*two)["fit_validation_percent"].get<double>());
+  EXPECT_GT((*three)["fit_estimation_percent"].get<double>(), (*two)["fit_estimation_percent"].get<double>());
+  EXPECT_EQ((*three)["parameters"]["J_m"].get<double>(), 0.000456);
+  // Two lightly damped resonances of the three-mass model, one of the two-mass model.
+  EXPECT_EQ((*three)["peaks_rad_s"].size(), 2u);
+  EXPECT_EQ((*two)["peaks_rad_s"].size(), 1u);
+}
+
+TEST(Replay, SaveReopenGivesIdenticalResults) {
+  const auto dir = scratch();
+  const std::string path = (dir / "reopen.json").string();
+  Session s = sampleSession();
+  s.logs[0].path = storedLogPath(path, kChirp);
+  std::string why;
+  ASSERT_TRUE(saveSession(s, path, &why)) << why;
+  auto reopened = loadSession(path);
+  ASSERT_TRUE(reopened.ok) << reopened.message;
+  nlohmann::json a = replaySession(sampleSession(), kSample).report.toJson();
+  nlohmann::json b = replaySession(reopened.session, path).report.toJson();
+  a.erase("session");
+  b.erase("session");
+  for (auto* j : {&a, &b}) (*j)["logs"][0].erase("path");
+  EXPECT_EQ(a.dump(), b.dump());
+}
+
+TEST(Replay, SubstitutedAndChangedLogsAreNamed) {
+  Session s = sampleSession();
+  ReplayOptions o;
+  o.substitutes["estimation"] = kMultisine;
+  ReplayResult sub = replaySession(s, kSample, o);
+  ASSERT_EQ(sub.termination, Termination::Converged) << sub.message;
+  EXPECT_EQ(sub.report.logs[0].note, "substituted");
+  EXPECT_NE(sub.report.logs[0].sha256, s.logs[0].sha256);
+
+  o.substitutes = {{"tomorrow", kMultisine}};
+  ReplayResult unknown = replaySession(s, kSample, o);
+  EXPECT_EQ(unknown.termination, Termination::Failed);
+  EXPECT_TRUE(unknown.badInput);
+  EXPECT_NE(unknown.message.find("tomorrow"), std::string::npos);
+
+  s.logs[0].sha256 = std::string(64, '0');
+  ReplayResult changed = replaySession(s, kSample);
+  ASSERT_EQ(changed.termination, Termination::Converged);
+  ASSERT_EQ(changed.report.warnings.size(), 1u);
+  EXPECT_NE(changed.report.warnings[0].find("changed since the session was saved"), std::string::npos);
+
+  s.logs[0].path = "no_such_log.csv";
+  ReplayResult missing = replaySession(s, kSample);
+  EXPECT_EQ(missing.termination, Termination::Failed);
+  EXPECT_NE(missing.message.find("no_such_log.csv"), std::string::npos) << missing.message;
+}

@@ -1,0 +1,249 @@
+// Sessions in the window: save -> reopen in a new window gives the same data, ranges and
+// models; damaged and newer files are refused and leave the window as it was; undo covers
+// ranges and preprocessing; autosave is offered back; reports are exported as PDF and HTML.
+#include <QAbstractButton>
+#include <QApplication>
+#include <QFile>
+#include <QMenu>
+#include <QMenuBar>
+#include <QMessageBox>
+#include <QSettings>
+#include <QSignalSpy>
+#include <QTemporaryDir>
+#include <QUndoStack>
+#include <QtTest>
+
+#include "app/main_window.h"
+#include "app/session_controller.h"
+#include "core/session/session.h"
+#include "core/signal/preprocess.h"
+#include "widget_test_support.h"
+#include "widgets/arm/vtk_view.h"
+#include "widgets/model_panel.h"
+#include "widgets/preprocess_panel.h"
+#include "widgets/workspace.h"
+
+using namespace flexarm;
+
+namespace {
+
+const QString kSampleLog = QString(FLEXARM_SAMPLE_DIR) + "/three_mass_estimation_chirp.csv";
+
+PreprocessOptions seedPreprocessing() {
+  PreprocessOptions p;
+  p.differentiateAngle = true;
+  p.decimation.factor = 10;
+  p.detrend = Detrend::Mean;
+  return p;
+}
+
+// The session JSON of a window without its view state (window layouts differ).
+nlohmann::json stateOf(const MainWindow& w, const QString& path) {
+  auto j = nlohmann::json::parse(toJsonText(w.sessionController()->capture(path)));
+  j["parts"].erase("view");
+  return j;
+}
+
+QMessageBox* findBox(const char* name) {
+  for (QWidget* w : QApplication::topLevelWidgets())
+    if (auto* box = qobject_cast<QMessageBox*>(w); box && box->objectName() == name && box->isVisible())
+      return box;
+  return nullptr;
+}
+
+}  // namespace
+
+class SessionTest : public QObject {
+  Q_OBJECT
+ private:
+  MainWindow* window_ = nullptr;
+  QTemporaryDir dir_;
+  QString saved_;
+
+  static MainWindow* newWindow() {
+    auto* w = new MainWindow;
+    w->resize(1400, 900);
+    w->show();
+    return w;
+  }
+
+ private slots:
+  void initTestCase() {
+    QVERIFY(dir_.isValid());
+    window_ = newWindow();
+    QVERIFY(QTest::qWaitForWindowExposed(window_));
+    QFile::remove(window_->sessionController()->autosavePath());
+    QSignalSpy opened(window_, &MainWindow::logOpened);
+    window_->openFile(kSampleLog);
+    QVERIFY(opened.wait(30000));
+  }
+
+  void fileMenuHasSessionActions() {
+    QMenu* file = window_->menuBar()->actions().first()->menu();
+    QStringList shortcuts;
+    for (QAction* a : file->actions()) shortcuts << a->shortcut().toString();
+    for (const char* keys : {"Ctrl+S", "Ctrl+Shift+S", "Ctrl+Shift+O", "Ctrl+Shift+R", "Ctrl+O"})
+      QVERIFY2(shortcuts.contains(keys), keys);
+    file->popup(window_->mapToGlobal(QPoint(0, window_->menuBar()->height())));
+    QVERIFY(QTest::qWaitForWindowExposed(file));
+    test::saveShot(file->grab().toImage(), "session-file-menu");
+    file->hide();
+  }
+
+  void undoCoversRangesAndPreprocessing() {
+    Workspace* ws = window_->workspace();
+    const std::size_t rawSamples = ws->raw()->samples();
+    ws->setRange(RangeKind::Estimation, {1.0, 2.0});
+    ws->setRange(RangeKind::Estimation, {0.5, 12.0});
+    ws->undoStack()->undo();
+    QCOMPARE(ws->range(RangeKind::Estimation)->end, 2.0);
+    ws->undoStack()->redo();
+    QCOMPARE(ws->range(RangeKind::Estimation)->end, 12.0);
+    const PreprocessOptions p = seedPreprocessing();
+    ws->setPreprocessed(preprocess(*ws->raw(), p), p);
+    QCOMPARE(ws->current()->samples(), (rawSamples + 9) / 10);
+    ws->undoStack()->undo();
+    QVERIFY(!ws->isPreprocessed());
+    QCOMPARE(ws->current()->samples(), rawSamples);
+    ws->undoStack()->redo();
+    QVERIFY(ws->isPreprocessed());
+    QCOMPARE(ws->preprocessOptions().decimation.factor, 10);
+  }
+
+  void saveAndReopenGiveTheSameState() {
+    Workspace* ws = window_->workspace();
+    ws->setRange(RangeKind::Validation, {12.0, 17.5});
+    window_->modelPanel()->newModel("three-mass");
+    ModelEntry edited = ws->models().back();
+    auto changed = std::shared_ptr<PhysicalModel>(makeModel("three-mass"));
+    changed->setParameter("k_g", 1.4e5);
+    changed->setFree("J_m", false);
+    edited.model = changed;
+    edited.effects = {Effect::withDefaults(EffectKind::CoulombFriction)};
+    ws->replaceModel(static_cast<int>(ws->models().size()) - 1, edited, "edit k_g");
+
+    saved_ = dir_.filePath("afternoon.json");
+    QString why;
+    QVERIFY2(window_->sessionController()->save(saved_, &why), qPrintable(why));
+    QVERIFY(!window_->sessionController()->isDirty());
+    QVERIFY(window_->sessionController()->recentSessions().contains(QFileInfo(saved_).absoluteFilePath()));
+
+    std::unique_ptr<MainWindow> other(newWindow());
+    QSignalSpy opened(other->sessionController(), &SessionController::sessionOpened);
+    other->sessionController()->open(saved_);
+    QVERIFY(opened.wait(30000));
+    QCOMPARE(QString::fromStdString(stateOf(*other, saved_).dump(1)),
+             QString::fromStdString(stateOf(*window_, saved_).dump(1)));
+    const IdData* a = window_->workspace()->current();
+    const IdData* b = other->workspace()->current();
+    QCOMPARE(b->samples(), a->samples());
+    QVERIFY(b->output()->values == a->output()->values);
+    QCOMPARE(other->workspace()->samples(RangeKind::Validation).size(),
+             window_->workspace()->samples(RangeKind::Validation).size());
+    QCOMPARE(other->workspace()->models().back().model->value("k_g"), 1.4e5);
+    QCOMPARE(other->modelPanel()->currentIndex(), window_->modelPanel()->currentIndex());
+    QCOMPARE(other->preprocessPanel()->options().decimation.factor, 10);
+    QVERIFY(other->preprocessPanel()->options().differentiateAngle);
+    test::saveShot(other->grab().toImage(), "session-reopened");
+  }
+
+  void damagedAndNewerFilesAreRefusedAndChangeNothing() {
+    QFile in(saved_);
+    QVERIFY(in.open(QIODevice::ReadOnly));
+    const QByteArray text = in.readAll();
+    const QString damaged = dir_.filePath("damaged.json");
+    QFile out(damaged);
+    QVERIFY(out.open(QIODevice::WriteOnly));
+    out.write(text.left(text.size() / 2));
+    out.close();
+    auto j = nlohmann::json::parse(text.toStdString());
+    j["version"] = kSessionVersion + 1;
+    const QString newer = dir_.filePath("newer.json");
+    QFile out2(newer);
+    QVERIFY(out2.open(QIODevice::WriteOnly));
+    out2.write(QByteArray::fromStdString(j.dump()));
+    out2.close();
+
+    const auto before = stateOf(*window_, saved_);
+    for (const auto& [path, words] : {std::pair{damaged, QString("damaged")},
+                                      std::pair{newer, QString("newer FlexArm")}}) {
+      QSignalSpy failed(window_->sessionController(), &SessionController::openFailed);
+      window_->sessionController()->open(path);
+      QVERIFY(failed.wait(30000));
+      const QString message = failed.first().first().toString();
+      QVERIFY2(message.contains(words), qPrintable(message));
+      QMessageBox* box = findBox("sessionErrorBox");
+      QVERIFY(box != nullptr);
+      QVERIFY(box->text().contains(words));
+      if (path == newer) test::saveShot(box->grab().toImage(), "session-newer-refused");
+      box->close();
+      QVERIFY(stateOf(*window_, saved_) == before);
+      QCOMPARE(window_->sessionController()->sessionPath(), saved_);
+    }
+  }
+
+  void exportsPdfAndHtmlReports() {
+    for (const char* name : {"report.pdf", "report.html"}) {
+      const QString path = dir_.filePath(name);
+      QSignalSpy done(window_->sessionController(), &SessionController::reportExported);
+      window_->sessionController()->exportReport(path);
+      QVERIFY(done.wait(60000));
+      QFile f(path);
+      QVERIFY(f.open(QIODevice::ReadOnly));
+      const QByteArray bytes = f.readAll();
+      if (QString(name).endsWith(".pdf")) {
+        QVERIFY(bytes.startsWith("%PDF"));
+        const QString png = QString(FLEXARM_SCREENSHOT_DIR) + "/session-report-page";
+        QDir().mkpath(FLEXARM_SCREENSHOT_DIR);
+        QCOMPARE(std::system(qPrintable("pdftoppm -png -r 70 -f 1 -l 3 '" + path + "' '" + png + "'")), 0);
+        QCOMPARE(std::system(qPrintable("pdftotext '" + path + "' '" + path + ".txt'")), 0);
+        QFile t(path + ".txt");
+        QVERIFY(t.open(QIODevice::ReadOnly));
+        const QString text = QString::fromUtf8(t.readAll());
+        for (const char* words : {"Data", "Model three-mass", "k_g", "coulomb_friction", "afternoon.json"})
+          QVERIFY2(text.contains(words), words);
+      } else {
+        QVERIFY(bytes.contains("data:image/png;base64,"));
+        QVERIFY(!bytes.contains("http"));
+      }
+    }
+  }
+
+  void autosaveIsOfferedBackAfterACrash() {
+    Workspace* ws = window_->workspace();
+    ws->setRange(RangeKind::Estimation, {0.7, 11.0});
+    QVERIFY(window_->sessionController()->isDirty());
+    QVERIFY(window_->sessionController()->autosave());
+    QVERIFY(QFile::exists(window_->sessionController()->autosavePath()));
+    // A window started while the autosave exists (as after a crash) offers it back.
+    std::unique_ptr<MainWindow> next(newWindow());
+    QSignalSpy offered(next->sessionController(), &SessionController::recoveryOffered);
+    QVERIFY(offered.wait(5000));
+    QMessageBox* box = findBox("recoverBox");
+    QVERIFY(box != nullptr);
+    test::saveShot(box->grab().toImage(), "session-recover");
+    QSignalSpy opened(next->sessionController(), &SessionController::sessionOpened);
+    box->button(QMessageBox::Open)->click();
+    QVERIFY(opened.wait(30000));
+    QCOMPARE(next->workspace()->range(RangeKind::Estimation)->start, 0.7);
+    QCOMPARE(next->workspace()->models().size(), ws->models().size());
+    QVERIFY(next->sessionController()->isDirty());
+    QVERIFY(next->sessionController()->sessionPath().isEmpty());
+    // The original window still owns its file; saving it removes the autosave.
+    QString why;
+    QVERIFY2(window_->sessionController()->save(saved_, &why), qPrintable(why));
+    QVERIFY(!QFile::exists(window_->sessionController()->autosavePath()));
+  }
+
+  void cleanupTestCase() { delete window_; }
+};
+
+int main(int argc, char** argv) {
+  VtkView::installDefaultSurfaceFormat();
+  QApplication app(argc, argv);
+  QApplication::setOrganizationName("FlexArmSessionTests");
+  SessionTest t;
+  return QTest::qExec(&t, argc, argv);
+}
+
+#include "tst_session.moc"
