@@ -14,8 +14,9 @@ using nlohmann::json;
 
 json captureModels(const MainWindow& w) {
   json list = json::array();
+  // Physical models only: black-box estimates are recomputed from the data, not stored yet.
   for (const auto& m : w.workspace()->models())
-    list.push_back(modelToJson(m.name.toStdString(), *m.model, m.effects));
+    if (m.model) list.push_back(modelToJson(m.name.toStdString(), *m.model, m.effects));
   return list;
 }
 
@@ -26,8 +27,11 @@ void restoreModels(const json& section, MainWindow& w) {
     std::string why;
     auto spec = modelFromJson(m, &why);
     if (!spec) continue;  // validated when the file was read
-    ws->insertModelDirect(static_cast<int>(ws->models().size()),
-                          ModelEntry{QString::fromStdString(spec->name), spec->model, spec->effects});
+    ModelEntry entry;
+    entry.name = QString::fromStdString(spec->name);
+    entry.model = spec->model;
+    entry.effects = spec->effects;
+    ws->insertModelDirect(static_cast<int>(ws->models().size()), entry);
   }
 }
 

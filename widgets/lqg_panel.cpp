@@ -346,6 +346,11 @@ void LqgPanel::selectSource(int index) {
     return;
   }
   const ModelEntry& entry = workspace_->models()[static_cast<std::size_t>(index - 1)];
+  if (!entry.model) {
+    reductionLabel_->setText(tr("Cannot use %1: a black-box estimate has no physical "
+                                "parameters to reduce. The parameters stay.").arg(entry.name));
+    return;
+  }
   TwoMassReductionOptions o;
   o.method = twoMassReductionFromString(reduction_->currentText().toStdString())
                  .value_or(TwoMassReduction::MatchFirstMode);
