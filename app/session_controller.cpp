@@ -79,7 +79,7 @@ void SessionController::addMenuActions() {
   file->insertMenu(before, recentMenu_);
   add(tr("&Save session"), "Ctrl+S", &SessionController::saveCurrent)->setObjectName("saveSessionAction");
   add(tr("Save session &as..."), "Ctrl+Shift+S", &SessionController::saveAs);
-  add(tr("Export re&port (PDF, HTML)..."), "Ctrl+Shift+R", &SessionController::exportDialog);
+  add(tr("Export re&port (PDF, HTML)..."), "Ctrl+Shift+E", &SessionController::exportDialog);
   rebuildRecent();
 }
 

@@ -230,6 +230,20 @@ class MainWindowTest : public QObject {
     QVERIFY(opened.takeFirst().at(0).toString().endsWith("effect_backlash.csv"));
   }
 
+  void everyShortcutIsUnique() {
+    // Two actions on one key sequence make Qt ignore the key for both.
+    QMap<QString, QString> seen;
+    for (QAction* a : window_->findChildren<QAction*>()) {
+      for (const QKeySequence& k : a->shortcuts()) {
+        const QString key = k.toString();
+        QVERIFY2(!seen.contains(key), qPrintable(key + ": " + seen.value(key) + " and " + a->text()));
+        seen.insert(key, a->text());
+      }
+    }
+    QVERIFY(seen.size() >= 15);
+    QVERIFY(seen.contains("Ctrl+Shift+E") && seen.contains("Ctrl+Shift+R"));  // report, residuals
+  }
+
   void cleanupTestCase() { delete window_; }
 };
 

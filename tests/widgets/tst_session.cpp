@@ -82,7 +82,7 @@ class SessionTest : public QObject {
     QMenu* file = window_->menuBar()->actions().first()->menu();
     QStringList shortcuts;
     for (QAction* a : file->actions()) shortcuts << a->shortcut().toString();
-    for (const char* keys : {"Ctrl+S", "Ctrl+Shift+S", "Ctrl+Shift+O", "Ctrl+Shift+R", "Ctrl+O"})
+    for (const char* keys : {"Ctrl+S", "Ctrl+Shift+S", "Ctrl+Shift+O", "Ctrl+Shift+E", "Ctrl+O"})
       QVERIFY2(shortcuts.contains(keys), keys);
     file->popup(window_->mapToGlobal(QPoint(0, window_->menuBar()->height())));
     QVERIFY(QTest::qWaitForWindowExposed(file));
