@@ -63,8 +63,8 @@ struct PemOptions {
   double screenFactor = 4.0;
   double level = 0.99;  // confidence level of the reported intervals
   CovarianceKind covariance = CovarianceKind::White;
-  // Lag window M of the sandwich (Bartlett weights over |tau| <= M); 0: chosen from the
-  // residual autocorrelation (automaticCovarianceLags).
+  // Lag window M of the sandwich (Bartlett weights over |tau| <= M); 0: a tenth of the
+  // record (automaticCovarianceLags).
   int covarianceLags = 0;
   bool isValid(std::string* why) const;
 };
