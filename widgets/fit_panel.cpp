@@ -41,6 +41,7 @@ struct Request {
   std::shared_ptr<PhysicalModel> model;  // a private copy with the free flags applied
   QString name;
   PemOptions pem;
+  ClosedLoopMethod closedLoop = ClosedLoopMethod::TwoStage;
   int maxIterations = 100;
 };
 
@@ -51,7 +52,7 @@ FitPanel::FitPanel(Workspace* workspace, QWidget* parent)
       na_(new QSpinBox(this)), nb_(new QSpinBox(this)), nc_(new QSpinBox(this)),
       nd_(new QSpinBox(this)), nf_(new QSpinBox(this)), nk_(new QSpinBox(this)),
       free_(new QListWidget(this)), ranges_(new QLabel(this)), decimation_(new QSpinBox(this)),
-      noise_(new QComboBox(this)), starts_(new QSpinBox(this)), iterations_(new QSpinBox(this)),
+      noise_(new QComboBox(this)), closedLoop_(new QComboBox(this)), starts_(new QSpinBox(this)), iterations_(new QSpinBox(this)),
       estimate_(new QPushButton(tr("Estimate"), this)),
       cancel_(new QPushButton(tr("Cancel"), this)), progress_(new QProgressBar(this)),
       table_(new QTableWidget(0, 6, this)), summary_(new QLabel(this)),
@@ -86,6 +87,13 @@ FitPanel::FitPanel(Workspace* workspace, QWidget* parent)
   noise_->setObjectName("noiseModelCombo");
   noise_->addItem(tr("Output error (K = 0)"), "output-error");
   noise_->addItem(tr("Innovations form (K estimated)"), "innovations");
+  closedLoop_->setObjectName("closedLoopCombo");
+  closedLoop_->addItem(tr("Two-stage: fit to the input part the reference explains"), "two-stage");
+  closedLoop_->addItem(tr("Direct: fit to the logged input"), "direct");
+  closedLoop_->setToolTip(tr("For output-error fits of logs with a reference channel. Noise "
+                             "reaches the input through the controller, which biases the "
+                             "direct fit (4.43); the two-stage fit is consistent and its "
+                             "intervals allow coloured errors"));
   starts_->setRange(0, 200);
   starts_->setObjectName("startsSpin");
   starts_->setToolTip(tr("Random starts besides the model's own values, plus two whose "
@@ -100,6 +108,7 @@ FitPanel::FitPanel(Workspace* workspace, QWidget* parent)
   form->addRow(tr("Ranges"), ranges_);
   form->addRow(tr("Decimation"), decimation_);
   form->addRow(tr("Noise model"), noise_);
+  form->addRow(tr("Closed loop"), closedLoop_);
   form->addRow(tr("Extra starts"), starts_);
   form->addRow(tr("Max iterations"), iterations_);
 
@@ -166,6 +175,8 @@ FitPanel::FitPanel(Workspace* workspace, QWidget* parent)
     refillParameters();
     updateControls();
   });
+  connect(noise_, QOverload<int>::of(&QComboBox::currentIndexChanged), this,
+          &FitPanel::updateControls);
   connect(estimate_, &QPushButton::clicked, this, &FitPanel::estimate);
   connect(cancel_, &QPushButton::clicked, this, &FitPanel::cancel);
   connect(study_button_, &QPushButton::clicked, this, &FitPanel::runStudy);
@@ -237,6 +248,9 @@ QStringList FitPanel::freeParameters() const {
 
 void FitPanel::setDecimation(int factor) { decimation_->setValue(factor); }
 void FitPanel::setNoiseModel(NoiseModel m) { noise_->setCurrentIndex(m == NoiseModel::Innovations); }
+void FitPanel::setClosedLoopMethod(ClosedLoopMethod m) {
+  closedLoop_->setCurrentIndex(m == ClosedLoopMethod::Direct);
+}
 void FitPanel::setStarts(int randomStarts) { starts_->setValue(randomStarts); }
 void FitPanel::setStudyRuns(int runs) { studyRuns_->setValue(runs); }
 
@@ -271,6 +285,7 @@ void FitPanel::updateControls() {
   nk_->setEnabled(s.has_value() && !busy);
   free_->setEnabled(!s && !busy);
   noise_->setEnabled(!s && !busy);
+  closedLoop_->setEnabled(!s && !busy && noise_->currentIndex() == 0);
   starts_->setEnabled(!s && !busy);
   estimate_->setEnabled(!busy && workspace_->hasLog());
   cancel_->setEnabled(busy);
@@ -360,6 +375,8 @@ void FitPanel::estimate() {
     req.pem.maxIterations = req.maxIterations;
     req.pem.noiseModel = noise_->currentIndex() == 1 ? NoiseModel::Innovations
                                                      : NoiseModel::OutputError;
+    req.closedLoop = closedLoop_->currentIndex() == 1 ? ClosedLoopMethod::Direct
+                                                      : ClosedLoopMethod::TwoStage;
     req.pem.randomStarts = starts_->value();
     req.pem.seed = static_cast<unsigned>(++fits_);
   }
@@ -394,7 +411,23 @@ void FitPanel::estimate() {
           po.targetPeaks = np.peaks;
           if (!np.notches.empty() || !np.peaks.empty()) po.notchPeakStarts = 2;
         }
-        PemResult r = pem(*req.model, u, y, T, po, progress);
+        ClosedLoopPemOptions co;
+        co.pem = po;
+        co.method = req.closedLoop == ClosedLoopMethod::TwoStage && sig.r.size() == sig.u.size() &&
+                            po.noiseModel == NoiseModel::OutputError
+                        ? ClosedLoopMethod::TwoStage
+                        : ClosedLoopMethod::Direct;
+        const Eigen::VectorXd r0 =
+            co.method == ClosedLoopMethod::TwoStage ? Eigen::VectorXd(sig.r.segment(b, n))
+                                                    : Eigen::VectorXd();
+        ClosedLoopPemResult cl = pemClosedLoop(*req.model, u, y, r0, T, co, progress);
+        if (cl.method == ClosedLoopMethod::TwoStage && cl.projection.ok)
+          out.note += QObject::tr(", two-stage closed-loop fit: the reference explains %1 % of "
+                                  "the input, intervals allow coloured errors")
+                          .arg(cl.projection.fitPercent, 0, 'f', 1);
+        else if (sig.r.size() > 0)
+          out.note += QObject::tr(", direct fit of closed-loop data");
+        PemResult r = std::move(cl.pem);
         out.summary = r.summary;
         for (const auto& p : r.parameters)
           out.rows.push_back({QString::fromStdString(p.name), QString::fromStdString(p.unit),

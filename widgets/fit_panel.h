@@ -12,6 +12,7 @@
 #include <atomic>
 #include <memory>
 
+#include "core/ident/closed_loop_pem.h"
 #include "core/ident/pem.h"
 #include "core/ident/sensitivity.h"
 #include "widgets/workspace.h"
@@ -42,6 +43,8 @@ class FitPanel : public QWidget {
   QStringList freeParameters() const;
   void setDecimation(int factor);
   void setNoiseModel(NoiseModel m);
+  // Output-error fits of closed-loop logs (with a reference channel): two-stage or direct.
+  void setClosedLoopMethod(ClosedLoopMethod m);
   void setStarts(int randomStarts);
 
   bool isBusy() const { return watcher_.isRunning() || study_.isRunning(); }
@@ -107,6 +110,7 @@ class FitPanel : public QWidget {
   QLabel* ranges_;
   QSpinBox* decimation_;
   QComboBox* noise_;
+  QComboBox* closedLoop_;
   QSpinBox* starts_;
   QSpinBox* iterations_;
   QPushButton* estimate_;

@@ -76,6 +76,10 @@ std::optional<IdentSignals> identSignals(const Workspace& workspace, int decimat
   const auto b = static_cast<Eigen::Index>(s.estimation.begin);
   s.u.array() -= s.u.segment(b, n).mean();
   s.y.array() -= s.y.segment(b, n).mean();
+  if (const Channel* ref = data.withRole(ChannelRole::Reference)) {
+    s.r = Eigen::Map<const Eigen::VectorXd>(ref->values.data(), static_cast<Eigen::Index>(ref->values.size()));
+    s.r.array() -= s.r.segment(b, n).mean();
+  }
   notes << QObject::tr("estimation means removed");
   s.note = notes.join(", ");
   return s;

@@ -27,6 +27,7 @@ bool isModelChecked(const QListWidget* list, std::size_t index);
 // does, Section 5.2), and the sample ranges the workspace's ranges cover.
 struct IdentSignals {
   Eigen::VectorXd u, y;
+  Eigen::VectorXd r;  // the reference channel (empty when the log has none)
   SampleRange estimation;  // the estimation range, or every sample when none is set
   SampleRange validation;  // empty when no validation range is set
   double sampleTime = 1.0;

@@ -120,7 +120,7 @@ bool parseModelSpec(const std::string& text, ModelSpec& spec, std::string* why,
 std::vector<std::string> fitValuedOptionNames() {
   std::vector<std::string> v = logReadOptionNames();
   for (const char* n : {"model", "free", "fix", "decimate", "range", "validation-log",
-                        "validation-range", "max-iterations", "starts", "seed"})
+                        "validation-range", "max-iterations", "starts", "seed", "closed-loop"})
     v.push_back(n);
   return v;
 }
@@ -137,6 +137,11 @@ const char* fitOptionsHelp() {
          "  --starts N            physical models: N random starts besides the nominal one,\n"
          "                        plus two whose notches and peaks match the SPA estimate\n"
          "  --seed N              random seed for the starts (default 1)\n"
+         "  --closed-loop M       physical models: auto|direct|two-stage. two-stage fits output\n"
+         "                        error to the part of the input the reference explains (an\n"
+         "                        FIR of the reference channel), consistent in closed loop,\n"
+         "                        with a covariance that allows coloured errors; auto (default)\n"
+         "                        uses it when the log has a reference and no --noise-model\n"
          "  --decimate N          decimate by N with the anti-alias FIR before fitting\n"
          "  --range A:B           estimation data from A to B seconds (default: the log's\n"
          "                        stored estimation range, else everything)\n"
@@ -218,8 +223,9 @@ int prepareAndFit(ArgParser& args, const std::string& verb, FitOutcome& out, std
       return kExitUsage;
     }
   } else if (args.value("free") || args.value("fix") || args.flag("noise-model") ||
-             args.value("starts")) {
-    err << pre << "--free, --fix, --noise-model and --starts apply to physical models only\n";
+             args.value("starts") || args.value("closed-loop")) {
+    err << pre << "--free, --fix, --noise-model, --starts and --closed-loop apply to physical "
+                  "models only\n";
     return kExitUsage;
   }
   long decimation = 1, maxIter = 100, starts = 0, seed = 1;
@@ -231,6 +237,18 @@ int prepareAndFit(ArgParser& args, const std::string& verb, FitOutcome& out, std
   if (maxIter < 0 || starts < 0 || decimation < 1) {
     err << pre << "--decimate must be at least 1, --max-iterations and --starts not negative\n";
     return kExitUsage;
+  }
+  std::optional<ClosedLoopMethod> askedMethod;  // nullopt: automatic
+  if (auto m = args.value("closed-loop"); m && *m != "auto") {
+    askedMethod = closedLoopMethodFromString(*m);
+    if (!askedMethod) {
+      err << pre << "--closed-loop expects auto, direct or two-stage, not '" << *m << "'\n";
+      return kExitUsage;
+    }
+    if (*askedMethod == ClosedLoopMethod::TwoStage && args.flag("noise-model")) {
+      err << pre << "--closed-loop two-stage fits output error; it excludes --noise-model\n";
+      return kExitUsage;
+    }
   }
   if (args.value("validation-log") && args.value("validation-range")) {
     err << pre << "give --validation-log or --validation-range, not both\n";
@@ -257,6 +275,16 @@ int prepareAndFit(ArgParser& args, const std::string& verb, FitOutcome& out, std
   inputOutput(*data, out.uEst, out.yEst, est);
   out.sampleTime = data->sampleTime;
   out.closedLoop = data->isClosedLoop();
+  Eigen::VectorXd rEst;
+  if (const Channel* ref = data->withRole(ChannelRole::Reference)) {
+    rEst = Eigen::Map<const Eigen::VectorXd>(ref->values.data() + est.begin, est.size());
+    rEst.array() -= rEst.mean();
+  }
+  if (askedMethod == ClosedLoopMethod::TwoStage && rEst.size() == 0) {
+    err << "flexarm: " << args.positional()[0]
+        << ": --closed-loop two-stage needs a reference channel, and the log has none\n";
+    return kExitBadInput;
+  }
   const double uMean = args.flag("keep-means") ? 0.0 : out.uEst.mean();
   const double yMean = args.flag("keep-means") ? 0.0 : out.yEst.mean();
   out.uEst.array() -= uMean;
@@ -380,8 +408,18 @@ int prepareAndFit(ArgParser& args, const std::string& verb, FitOutcome& out, std
         if (!np.notches.empty() || !np.peaks.empty()) po.notchPeakStarts = 2;
       }
     }
+    ClosedLoopPemOptions co;
+    co.pem = po;
+    co.method = askedMethod.value_or(rEst.size() && !args.flag("noise-model")
+                                         ? ClosedLoopMethod::TwoStage
+                                         : ClosedLoopMethod::Direct);
     try {
-      out.grey = pem(*physical, out.uEst, out.yEst, out.sampleTime, po);
+      ClosedLoopPemResult cl = pemClosedLoop(*physical, out.uEst, out.yEst, rEst,
+                                             out.sampleTime, co);
+      out.closedLoopMethod = cl.method;
+      if (cl.method == ClosedLoopMethod::TwoStage && cl.projection.ok)
+        out.referenceFit = cl.projection.fitPercent;
+      out.grey = std::move(cl.pem);
     } catch (const std::invalid_argument& e) {
       err << pre << e.what() << "\n";
       return kExitUsage;
@@ -418,7 +456,7 @@ int runFit(const std::vector<std::string>& argv, std::ostream& out, std::ostream
     warnings.push_back("the model's G is unstable, so its simulated output diverges and the "
                        "fit % is undefined; it can still predict one step ahead");
   }
-  if (fit.closedLoop)
+  if (fit.closedLoop && fit.closedLoopMethod != ClosedLoopMethod::TwoStage)
     warnings.push_back("the log was recorded in closed loop: only models with a flexible, "
                        "independently parameterized noise model (BJ) are free of bias (4.43)");
   auto optJson = [](const std::optional<double>& v) {
@@ -463,12 +501,21 @@ int runFit(const std::vector<std::string>& argv, std::ostream& out, std::ostream
                         {"sample_time_s", T},
                         {"samples_estimation", fit.yEst.size()},
                         {"samples_validation", fit.validation.size()},
-                        {"closed_loop", fit.closedLoop}};
+                        {"closed_loop", fit.closedLoop},
+                        {"closed_loop_method", fit.closedLoopMethod
+                                                   ? nlohmann::json(toString(*fit.closedLoopMethod))
+                                                   : nlohmann::json(nullptr)},
+                        {"reference_fit_percent", optJson(fit.referenceFit)},
+                        {"covariance", fit.spec.physical
+                                           ? nlohmann::json(toString(fit.grey.covarianceKind))
+                                           : nlohmann::json("white")}};
     out << j.dump(2) << "\n";
     return kExitOk;
   }
   out << fit.modelName() << ": " << toString(s.termination) << " after " << s.iterations
       << " iterations (" << s.message << ")\n";
+  if (fit.closedLoopMethod)
+    out << "closed-loop method: " << toString(*fit.closedLoopMethod) << "\n";
   for (auto it = params.begin(); it != params.end(); ++it)
     out << "  " << it.key() << " = " << it.value().get<double>() << " +- "
         << (stds[it.key()].is_null() ? std::string("?") : stds[it.key()].dump()) << "\n";

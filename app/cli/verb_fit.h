@@ -9,6 +9,7 @@
 
 #include "app/cli/cli.h"
 #include "core/ident/blackbox.h"
+#include "core/ident/closed_loop_pem.h"
 #include "core/ident/nonparametric.h"
 #include "core/ident/pem.h"
 
@@ -54,6 +55,10 @@ struct FitOutcome {
   Eigen::VectorXd uVal, yVal;
   SampleRange validation;
   bool closedLoop = false;
+  // Physical fits: how the closed loop was handled (two-stage when the log has a reference
+  // channel, unless --closed-loop direct or --noise-model), and stage 1's fit % of the input.
+  std::optional<ClosedLoopMethod> closedLoopMethod;
+  std::optional<double> referenceFit;
   NonparametricEstimate nonparametric;  // when spec.nonparametric
   PolyEstimate poly;  // when a polynomial structure
   PemResult grey;     // when spec.physical

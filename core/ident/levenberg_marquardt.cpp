@@ -2,6 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <complex>
+#include <vector>
+#include <stdexcept>
 
 namespace flexarm {
 
@@ -20,6 +23,108 @@ Eigen::MatrixXd gaussNewtonCovariance(const Eigen::MatrixXd& psi, double sumSqua
   if (ldlt.info() != Eigen::Success || !(ldlt.vectorD().array() > 1e-14 * R.diagonal().maxCoeff()).all())
     return {};
   return sumSquares / static_cast<double>(n - p) * ldlt.solve(Eigen::MatrixXd::Identity(p, p));
+}
+
+namespace {
+
+// In-place radix-2 FFT (length a power of two); inverse without the 1/n factor.
+void fft(std::vector<std::complex<double>>& a, bool inverse) {
+  const std::size_t n = a.size();
+  for (std::size_t i = 1, j = 0; i < n; ++i) {
+    std::size_t bit = n >> 1;
+    for (; j & bit; bit >>= 1) j ^= bit;
+    j ^= bit;
+    if (i < j) std::swap(a[i], a[j]);
+  }
+  for (std::size_t len = 2; len <= n; len <<= 1) {
+    const double ang = 2.0 * M_PI / static_cast<double>(len) * (inverse ? 1.0 : -1.0);
+    const std::complex<double> wl(std::cos(ang), std::sin(ang));
+    for (std::size_t i = 0; i < n; i += len) {
+      std::complex<double> w(1.0, 0.0);
+      for (std::size_t k = 0; k < len / 2; ++k) {
+        const std::complex<double> x = a[i + k], y = a[i + k + len / 2] * w;
+        a[i + k] = x + y;
+        a[i + k + len / 2] = x - y;
+        w *= wl;
+      }
+    }
+  }
+}
+
+std::vector<std::complex<double>> padded(const Eigen::VectorXd& x, std::size_t len) {
+  std::vector<std::complex<double>> a(len, 0.0);
+  for (Eigen::Index i = 0; i < x.size(); ++i) a[static_cast<std::size_t>(i)] = x[i];
+  return a;
+}
+
+}  // namespace
+
+Eigen::MatrixXd longRunCovariance(const std::vector<RegressorErrorPair>& terms, int lags) {
+  if (terms.empty()) throw std::invalid_argument("longRunCovariance: no terms");
+  if (lags < 0) throw std::invalid_argument("longRunCovariance: the number of lags must not be negative");
+  const Eigen::Index n = terms[0].psi->rows(), p = terms[0].psi->cols();
+  for (const auto& t : terms)
+    if (t.psi->rows() != n || t.psi->cols() != p || t.eps->size() != n)
+      throw std::invalid_argument("longRunCovariance: regressors and errors differ in size");
+  if (n < 2) return Eigen::MatrixXd::Zero(p, p);
+  const Eigen::Index m = std::min<Eigen::Index>(lags, n - 1);
+  // Transforms of length L >= n + m, so that no circular wrap reaches the lags |tau| <= m.
+  std::size_t len = 1;
+  while (len < static_cast<std::size_t>(n + m + 1)) len <<= 1;
+  const double L = static_cast<double>(len);
+  std::vector<std::vector<std::complex<double>>> E;
+  std::vector<Eigen::MatrixXcd> Psi;
+  for (const auto& t : terms) {
+    E.push_back(padded(*t.eps, len));
+    fft(E.back(), false);
+    Eigen::MatrixXcd P(static_cast<Eigen::Index>(len), p);
+    for (Eigen::Index j = 0; j < p; ++j) {
+      auto col = padded(t.psi->col(j), len);
+      fft(col, false);
+      for (std::size_t k = 0; k < len; ++k) P(static_cast<Eigen::Index>(k), j) = col[k];
+    }
+    Psi.push_back(std::move(P));
+  }
+  Eigen::MatrixXd Q = Eigen::MatrixXd::Zero(p, p);
+  for (std::size_t i = 0; i < terms.size(); ++i)
+    for (std::size_t j = 0; j < terms.size(); ++j) {
+      // R_ij(tau) = (1/n) sum_t eps_i(t) eps_j(t - tau), windowed, then its transform S_ij.
+      std::vector<std::complex<double>> a(len);
+      for (std::size_t k = 0; k < len; ++k) a[k] = E[i][k] * std::conj(E[j][k]);
+      fft(a, true);
+      std::vector<std::complex<double>> w(len, 0.0);
+      for (Eigen::Index tau = -m; tau <= m; ++tau) {
+        const std::size_t at = tau >= 0 ? static_cast<std::size_t>(tau) : len - static_cast<std::size_t>(-tau);
+        const double weight = 1.0 - static_cast<double>(std::abs(tau)) / static_cast<double>(m + 1);
+        w[at] = weight * a[at].real() / (L * static_cast<double>(n));
+      }
+      fft(w, false);
+      Eigen::VectorXcd S(static_cast<Eigen::Index>(len));
+      for (std::size_t k = 0; k < len; ++k) S[static_cast<Eigen::Index>(k)] = w[k];
+      // sum_tau R(tau) sum_t a(t) b(t - tau) = (1/L) sum_k S(k) conj(A(k)) B(k).
+      Q += (Psi[i].adjoint() * S.asDiagonal() * Psi[j]).real() / L;
+    }
+  return 0.5 * (Q + Q.transpose());
+}
+
+Eigen::MatrixXd sandwichCovariance(const Eigen::MatrixXd& psi, const Eigen::VectorXd& eps,
+                                   int lags) {
+  const Eigen::Index n = psi.rows(), p = psi.cols();
+  if (eps.size() != n) throw std::invalid_argument("sandwichCovariance: psi and eps differ in length");
+  if (lags < 0) throw std::invalid_argument("sandwichCovariance: the number of lags must not be negative");
+  if (n <= p || p == 0) return {};
+  const Eigen::MatrixXd H = psi.transpose() * psi;
+  Eigen::LDLT<Eigen::MatrixXd> ldlt(H);
+  if (ldlt.info() != Eigen::Success || !(ldlt.vectorD().array() > 1e-14 * H.diagonal().maxCoeff()).all())
+    return {};
+  const Eigen::MatrixXd Q = longRunCovariance({{&psi, &eps}}, lags);
+  const Eigen::MatrixXd Hi = ldlt.solve(Eigen::MatrixXd::Identity(p, p));
+  return static_cast<double>(n) / static_cast<double>(n - p) * (Hi * Q * Hi);
+}
+
+int automaticCovarianceLags(const Eigen::VectorXd& eps) {
+  const Eigen::Index n = eps.size();
+  return static_cast<int>(std::max<Eigen::Index>(std::min<Eigen::Index>(10, n - 1), n / 10));
 }
 
 LeastSquaresSolution levenbergMarquardt(const LeastSquaresProblem& problem,

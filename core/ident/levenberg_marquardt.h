@@ -2,6 +2,7 @@
 // The damped Gauss-Newton / Levenberg-Marquardt search (4.17)-(4.21) shared by the black-box
 // and grey-box prediction-error estimators: R = sum psi psi^T (4.21) plus lambda diag(R).
 #include <functional>
+#include <vector>
 
 #include <Eigen/Dense>
 
@@ -33,6 +34,30 @@ LeastSquaresSolution levenbergMarquardt(const LeastSquaresProblem& problem,
 
 // Covariance lambda (psi^T psi)^{-1} with lambda = sumSquares / (N - p); empty when singular.
 Eigen::MatrixXd gaussNewtonCovariance(const Eigen::MatrixXd& psi, double sumSquares);
+
+// Long-run covariance Q = Var(sum_i psi_i^T eps_i) of sums of regressors (columns of psi_i,
+// treated as given) times stationary, possibly coloured and mutually correlated errors eps_i:
+// Q = sum_{i,j} sum_{|tau| <= lags} w_tau R_ij(tau) sum_t psi_i(t) psi_j(t - tau)^T, with the
+// error covariances R_ij(tau) = (1/N) sum_t eps_i(t) eps_j(t - tau) weighted by the Bartlett
+// (Newey-West) window w_tau = 1 - |tau| / (lags + 1). Computed with FFTs in O(N log N p^2).
+// Every psi_i has N rows and the same columns; every eps_i N entries.
+struct RegressorErrorPair {
+  const Eigen::MatrixXd* psi;
+  const Eigen::VectorXd* eps;
+};
+Eigen::MatrixXd longRunCovariance(const std::vector<RegressorErrorPair>& terms, int lags);
+
+// Covariance of the least-squares estimate that holds when the errors are coloured (and
+// independent of psi): the sandwich H^{-1} Q H^{-1} N / (N - p) with H = sum psi psi^T
+// (4.21) and Q = longRunCovariance({psi, eps}), the sample form of R^{-1} Q R^{-1} / N for
+// coloured noise (Ljung's (9.17), which (4.37) simplifies for white noise). With white errors
+// and lags = 0 it equals gaussNewtonCovariance. Empty when H is singular.
+Eigen::MatrixXd sandwichCovariance(const Eigen::MatrixXd& psi, const Eigen::VectorXd& eps,
+                                   int lags);
+
+// Lag window for the sandwich: a tenth of the record (at least 10 lags): the errors' long
+// correlations (slow disturbances) must fit inside the window.
+int automaticCovarianceLags(const Eigen::VectorXd& eps);
 
 // Sets loss (4.6), FPE and AIC from the sum of squared errors of N samples and p parameters.
 void fillStatistics(EstimateSummary& s, double sumSquares, Eigen::Index n, int p);

@@ -35,6 +35,15 @@ std::optional<ParameterScaling> parameterScalingFromString(std::string_view s) {
   return std::nullopt;
 }
 
+const char* toString(CovarianceKind k) {
+  return k == CovarianceKind::White ? "white" : "sandwich";
+}
+std::optional<CovarianceKind> covarianceKindFromString(std::string_view s) {
+  if (s == "white") return CovarianceKind::White;
+  if (s == "sandwich") return CovarianceKind::Sandwich;
+  return std::nullopt;
+}
+
 bool PemOptions::isValid(std::string* why) const {
   auto fail = [&](const char* text) {
     if (why) *why = text;
@@ -50,6 +59,7 @@ bool PemOptions::isValid(std::string* why) const {
   if (notchPeakStarts > 0 && targetNotches.empty() && targetPeaks.empty())
     return fail("starts from notches and peaks need target notch or peak frequencies");
   if (!(level > 0.0 && level < 1.0)) return fail("the level must lie strictly between 0 and 1");
+  if (covarianceLags < 0) return fail("covarianceLags must not be negative");
   return true;
 }
 
@@ -515,7 +525,15 @@ PemResult pem(const ParametricModel& model0, const Eigen::VectorXd& u, const Eig
                    std::to_string(result.bestStart) + ")";
   fillStatistics(sum, best.sol.sumSquares, y.size(), p);
   // Covariance in phi, mapped to theta with the Jacobian of the transform.
-  const Eigen::MatrixXd covPhi = gaussNewtonCovariance(best.sol.psi, best.sol.sumSquares);
+  result.covarianceKind = options.covariance;
+  Eigen::MatrixXd covPhi;
+  if (options.covariance == CovarianceKind::Sandwich) {
+    result.covarianceLags = options.covarianceLags > 0 ? options.covarianceLags
+                                                       : automaticCovarianceLags(best.sol.eps);
+    covPhi = sandwichCovariance(best.sol.psi, best.sol.eps, result.covarianceLags);
+  } else {
+    covPhi = gaussNewtonCovariance(best.sol.psi, best.sol.sumSquares);
+  }
   Eigen::VectorXd jac(p);
   const auto& pe = result.model->parameters();
   for (int j = 0; j < pf; ++j) jac[j] = tr.dThetaDPhi(j, pe[tr.free[j]].value);

@@ -34,6 +34,13 @@ std::optional<ParameterScaling> parameterScalingFromString(std::string_view s);
 // Ad = e^{A T}, Bd = int_0^T e^{A s} ds B of a continuous model (zero-order hold).
 StateSpace discretizeZoh(const StateSpace& continuous, double sampleTime);
 
+// How the covariance of the estimate is formed: lambda R^{-1} assuming white prediction
+// errors (4.37), or the sandwich R^{-1} Q R^{-1} that also holds for coloured errors
+// independent of the input (e.g. output error on the noise-free input of a closed loop).
+enum class CovarianceKind { White, Sandwich };
+const char* toString(CovarianceKind k);
+std::optional<CovarianceKind> covarianceKindFromString(std::string_view s);
+
 struct PemOptions {
   NoiseModel noiseModel = NoiseModel::OutputError;
   // Log applies to parameters whose lower bound is >= 0 and value > 0; others are scaled.
@@ -55,6 +62,10 @@ struct PemOptions {
   int screenCandidates = 300;
   double screenFactor = 4.0;
   double level = 0.99;  // confidence level of the reported intervals
+  CovarianceKind covariance = CovarianceKind::White;
+  // Lag window M of the sandwich (Bartlett weights over |tau| <= M); 0: a tenth of the
+  // record (automaticCovarianceLags).
+  int covarianceLags = 0;
   bool isValid(std::string* why) const;
 };
 
@@ -79,6 +90,8 @@ struct PemResult {
   int starts = 0;        // number of starting points tried
   int bestStart = -1;    // 0: the model's own values; then user, notch/peak and random ones
   std::vector<double> startLosses;
+  CovarianceKind covarianceKind = CovarianceKind::White;
+  int covarianceLags = 0;  // lag window used by the sandwich covariance
 };
 
 // Estimates the free parameters of model from u and y sampled at sampleTime (the data's rate).

@@ -87,7 +87,8 @@ TEST(CliIdent, FitPhysicalWithFreeAndFixedParametersOnTheSampleLog) {
   // (d_g given explicitly by --fix, as the seed's p1 holds d = 0).
   const std::string fixDg = "d_g=" + std::to_string(t.at("d_g"));
   const auto r = runFlexarm({"fit", velocityLog(), "--model", "three-mass", "--free",
-                             "J_m,J_g,J_a,k_g,k_a", "--fix", fixDg, "--json"});
+                             "J_m,J_g,J_a,k_g,k_a", "--fix", fixDg, "--closed-loop", "direct",
+                             "--json"});
   ASSERT_EQ(r.code, 0) << r.err;
   const json j = json::parse(r.out);
   EXPECT_EQ(j["model"], "three-mass (K = 0)");
@@ -106,6 +107,31 @@ TEST(CliIdent, FitPhysicalWithFreeAndFixedParametersOnTheSampleLog) {
   EXPECT_EQ(j["notches_rad_s"].size(), 2u);  // three masses: two resonances
   EXPECT_EQ(j["peaks_rad_s"].size(), 2u);
   EXPECT_TRUE(j["closed_loop"].get<bool>());
+  EXPECT_EQ(j["closed_loop_method"], "direct");
+  EXPECT_EQ(j["covariance"], "white");
+}
+
+// The default for a log with a reference channel: the two-stage fit (output error on the part
+// of the torque the reference explains), consistent in closed loop, with sandwich intervals
+// that allow coloured errors: every truth of the sidecar lies inside its 99 % interval.
+TEST(CliIdent, FitPhysicalOnAClosedLoopLogRunsTwoStageAndCoversTheTruth) {
+  const auto t = truth();
+  const std::string fixDg = "d_g=" + std::to_string(t.at("d_g"));
+  const auto r = runFlexarm({"fit", velocityLog(), "--model", "three-mass", "--free",
+                             "J_m,J_g,J_a,k_g,k_a", "--fix", fixDg, "--json"});
+  ASSERT_EQ(r.code, 0) << r.err;
+  const json j = json::parse(r.out);
+  EXPECT_EQ(j["closed_loop_method"], "two-stage");
+  EXPECT_EQ(j["covariance"], "sandwich");
+  EXPECT_GT(j["reference_fit_percent"].get<double>(), 10.0);
+  EXPECT_LT(j["reference_fit_percent"].get<double>(), 100.0);
+  const double z = 2.5758293035489;  // 99 % two-sided
+  for (const char* p : {"J_m", "J_g", "J_a", "k_g", "k_a"}) {
+    const double v = j["parameters"][p].get<double>(), s = j["std"][p].get<double>();
+    EXPECT_GT(s, 0.0) << p;
+    EXPECT_LT(std::abs(v - t.at(p)), z * s) << p << " = " << v << " +- " << s << ", truth " << t.at(p);
+  }
+  for (const auto& w : j["warnings"]) EXPECT_EQ(w.get<std::string>().find("(4.43)"), std::string::npos) << w;
 }
 
 TEST(CliIdent, BodeWritesMagnitudePhaseAndBandLimits) {
@@ -166,6 +192,13 @@ TEST(CliIdent, BadRequestsExitWithUsageBadInputOrNumericalCodes) {
   r = runFlexarm({"fit", kChirp, "--model", "three-mass", "--fix", "k_g"});
   EXPECT_EQ(r.code, 2);
   EXPECT_NE(r.err.find("NAME=VALUE"), std::string::npos) << r.err;
+  r = runFlexarm({"fit", kChirp, "--model", "three-mass", "--closed-loop", "indirect"});
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("auto, direct or two-stage"), std::string::npos) << r.err;
+  r = runFlexarm({"fit", kChirp, "--model", "three-mass", "--closed-loop", "two-stage",
+                  "--noise-model"});
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("excludes --noise-model"), std::string::npos) << r.err;
   EXPECT_EQ(runFlexarm(daisy({"bode", "--model", "arx:2,2,1"})).code, 2) << "--out missing";
   EXPECT_EQ(runFlexarm(daisy({"bode", "--model", "arx:2,2,1", "--out", "/tmp/x.csv", "--level",
                               "1.5"})).code, 2);
@@ -176,6 +209,9 @@ TEST(CliIdent, BadRequestsExitWithUsageBadInputOrNumericalCodes) {
   EXPECT_NE(r.err.find("/no/such/log.csv"), std::string::npos) << r.err;
   r = runFlexarm(daisy({"bode", "--model", "arx:2,2,1", "--out", "/no/such/dir/b.csv"}));
   EXPECT_EQ(r.code, 3);
+  r = runFlexarm(daisy({"fit", "--model", "two-mass", "--closed-loop", "two-stage"}));
+  EXPECT_EQ(r.code, 3);
+  EXPECT_NE(r.err.find("needs a reference channel"), std::string::npos) << r.err;
 
   // 4: numerical failure. A log whose input is constant zero carries no information.
   const std::string flat = (scratchDir() / "flat.dat").string();

@@ -4,6 +4,7 @@
 // Compare fits, the residual tests, Cancel and the sensitivity study; screenshots of every
 // panel.
 #include <QApplication>
+#include <QComboBox>
 #include <QDockWidget>
 #include <QListWidget>
 #include <QPushButton>
@@ -107,7 +108,20 @@ class IdentificationTest : public QObject {
     QVERIFY2(s.contains("% on the estimation data") && s.contains("% on the validation data"),
              qPrintable(s));
     QVERIFY2(s.contains("Notches: ") && s.contains("rad/s"), qPrintable(s));
+    // The log has a reference channel: the default is the two-stage closed-loop fit.
+    QVERIFY2(s.contains("two-stage closed-loop fit: the reference explains"), qPrintable(s));
     test::saveShot(fit->grab().toImage(), "fit_panel_three_mass");
+    // Direct on request, and the combo is off for the innovations form (it needs output error).
+    auto* combo = fit->findChild<QComboBox*>("closedLoopCombo");
+    QVERIFY(combo && combo->isEnabled());
+    fit->setNoiseModel(NoiseModel::Innovations);
+    QVERIFY(!combo->isEnabled());
+    fit->setNoiseModel(NoiseModel::OutputError);
+    fit->setClosedLoopMethod(ClosedLoopMethod::Direct);
+    QVERIFY2(clickEstimate(fit), qPrintable(fit->summaryText()));
+    QVERIFY2(fit->summaryText().contains("direct fit of closed-loop data"),
+             qPrintable(fit->summaryText()));
+    fit->setClosedLoopMethod(ClosedLoopMethod::TwoStage);
   }
 
   void blackBoxFitJoinsTheListToo() {

@@ -106,7 +106,8 @@ TEST(ThreeMassFit, OutputErrorRecoversTheTruthInsideItsIntervalsAcrossSeeds) {
 // input through the controller, so the output-error estimate is biased (the seed's (4.43):
 // only an independently parameterized, correct noise model removes the bias). What the
 // engineer reads from the fit still holds: inertias and stiffnesses within 30 %, the notch
-// and peak frequencies within 8 %, and a validation fit as good as the truth's own.
+// and peak frequencies within 8 %, and a validation fit as good as the truth's own. (The
+// two-stage fit of test_closed_loop_pem.cpp removes the bias and gives honest intervals.)
 TEST(ThreeMassFit, ClosedLoopOutputErrorKeepsResonancesAndValidationFit) {
   const auto truth = makeModel("three-mass");
   const auto truthNp = notchesAndPeaks(frequencyResponse(*truth, grid()));

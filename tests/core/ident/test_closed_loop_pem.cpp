@@ -1,0 +1,239 @@
+// Two-stage closed-loop identification (Van den Hof and Schrama; Forssell and Ljung) on the
+// simulator's closed-loop logs: the three-mass truth of Table 5.7 under the cascaded
+// controller of Figure 5.1 with torque noise, load disturbance and a quantized encoder (the
+// same generator and realistic noise as test_three_mass_fit.cpp). The output-error fit on
+// (u, y) is biased there (the seed's (4.43)); on (u_r, y), with u_r the part of u explained by
+// the reference, it is consistent, and the sandwich covariance makes its 99 % intervals
+// honest although the prediction errors are coloured.
+// The fit runs at the log's own rate, 2 kHz, where the zero-order hold the estimator assumes
+// (5.3) is what the plant sees: the controller holds the torque for one 0.5 ms tick.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <random>
+#include <string>
+
+#include "core/ident/closed_loop_pem.h"
+#include "core/ident/levenberg_marquardt.h"
+#include "core/ident/pem.h"
+#include "core/models/physical_models.h"
+#include "core/signal/preprocess.h"
+#include "core/sim/closed_loop.h"
+
+namespace flexarm {
+namespace {
+
+Eigen::VectorXd centred(const std::vector<double>& v) {
+  Eigen::VectorXd x = Eigen::Map<const Eigen::VectorXd>(v.data(), static_cast<Eigen::Index>(v.size()));
+  x.array() -= x.mean();
+  return x;
+}
+
+struct LoopLog {
+  Eigen::VectorXd u, y, r;  // means removed
+  double sampleTime = 0.0;
+};
+
+// Closed-loop log of the three-mass truth with the sample logs' controller, disturbances and
+// chirp; y is the motor velocity from central differences of the measured angle.
+LoopLog simulateLog(std::uint64_t seed) {
+  SimulationOptions o;
+  o.durationS = 18.0;
+  o.seed = seed;
+  const SimulationResult sim = simulateClosedLoop(*makeModel("three-mass"), {}, o);
+  EXPECT_EQ(sim.termination, Termination::Converged) << sim.message;
+  const IdData d = addDerivative(sim.data);
+  LoopLog l;
+  l.u = centred(d.input()->values);
+  l.y = centred(d.output()->values);
+  l.r = centred(d.withRole(ChannelRole::Reference)->values);
+  l.sampleTime = d.sampleTime;
+  return l;
+}
+
+// Starting point away from the truth: every free parameter off by 10-30 %.
+void perturb(PhysicalModel& m) {
+  const std::pair<const char*, double> f[] = {{"J_m", 1.2},  {"J_g", 0.8}, {"J_a", 1.15},
+                                              {"f_m", 1.3},  {"k_g", 0.85}, {"k_a", 1.1},
+                                              {"d_g", 0.8},  {"d_a", 1.25}};
+  for (const auto& [name, factor] : f) m.setParameter(name, m.value(name) * factor);
+}
+
+// Six logs of the same generator (seeds 11-16; 11-13 are those of the closed-loop test in
+// test_three_mass_fit.cpp): every free parameter of the three-mass model, 48 intervals. The
+// direct output-error fit with the white-noise covariance leaves about half of the truths
+// outside their 99 % intervals on these logs; the two-stage fit with the sandwich covariance
+// that carries the stage-1 error leaves at most four outside (on 24 seeds, 1-24, it leaves 7
+// of 192 outside: 3.6 % where 1 % is promised; the misses are the arm's J_a, k_a, d_a and the
+// friction f_m, whose estimates keep a bias of about one standard deviation from the load
+// disturbance), and the intervals stay narrow.
+TEST(ClosedLoopPem, TwoStageRecoversTheThreeMassTruthInsideHonestIntervalsAcrossSeeds) {
+  const auto truth = makeModel("three-mass");
+  int inside = 0, total = 0;
+  std::string report;
+  for (std::uint64_t seed : {11u, 12u, 13u, 14u, 15u, 16u}) {
+    const LoopLog d = simulateLog(seed);
+    auto start = makeModel("three-mass");
+    perturb(*start);
+    const ClosedLoopPemResult r = pemClosedLoop(*start, d.u, d.y, d.r, d.sampleTime);
+    ASSERT_TRUE(r.pem.summary.ok()) << r.pem.summary.message;
+    ASSERT_EQ(r.method, ClosedLoopMethod::TwoStage);
+    ASSERT_TRUE(r.projection.ok) << r.projection.message;
+    EXPECT_EQ(r.pem.covarianceKind, CovarianceKind::Sandwich);
+    // The reference explains most, but not all, of the torque: the rest is the controller's
+    // answer to the noise.
+    EXPECT_GT(r.projection.fitPercent, 90.0);
+    EXPECT_LT(r.projection.fitPercent, 99.5);
+    char head[120];
+    std::snprintf(head, sizeof head, "seed %d: stage 1 explains %.2f %% of u, %d lags\n",
+                  static_cast<int>(seed), r.projection.fitPercent, r.pem.covarianceLags);
+    report += head;
+    for (const auto& p : r.pem.parameters) {
+      if (!p.free) continue;
+      const double t = truth->value(p.name);
+      const bool in = t >= p.lower && t <= p.upper;
+      inside += in;
+      ++total;
+      char line[200];
+      std::snprintf(line, sizeof line, "  %-4s %12.6g +- %10.4g (%5.1f %%)  truth %12.6g  %+.2f std%s\n",
+                    p.name.c_str(), p.value, p.std, 100.0 * p.std / std::abs(p.value), t,
+                    (p.value - t) / p.std, in ? "" : "  OUTSIDE");
+      report += line;
+      if (p.name == "J_m" || p.name == "J_a" || p.name == "k_g" || p.name == "k_a") {
+        EXPECT_LT(p.std / t, 0.2) << p.name << " interval too wide\n" << report;
+      }
+    }
+  }
+  ::testing::Test::RecordProperty("inside99", inside);
+  ::testing::Test::RecordProperty("total", total);
+  std::printf("%s%d of %d truths inside the 99 %% intervals\n", report.c_str(), inside, total);
+  EXPECT_EQ(total, 48);
+  EXPECT_GE(inside, total - 4) << report;
+}
+
+// The direct fit of the same kind of log, for contrast: the noise fed back through the
+// controller biases output error (4.43), and its white-noise intervals miss the truth.
+TEST(ClosedLoopPem, DirectOutputErrorMissesTheTruthOnTheSameLogs) {
+  const auto truth = makeModel("three-mass");
+  const LoopLog d = simulateLog(11);
+  auto start = makeModel("three-mass");
+  perturb(*start);
+  ClosedLoopPemOptions o;
+  o.method = ClosedLoopMethod::Direct;
+  const ClosedLoopPemResult r = pemClosedLoop(*start, d.u, d.y, {}, d.sampleTime, o);
+  ASSERT_TRUE(r.pem.summary.ok()) << r.pem.summary.message;
+  EXPECT_EQ(r.pem.covarianceKind, CovarianceKind::White);
+  int outside = 0;
+  for (const auto& p : r.pem.parameters)
+    if (p.free) outside += truth->value(p.name) < p.lower || truth->value(p.name) > p.upper;
+  EXPECT_GE(outside, 3);
+}
+
+// Stage 1 alone: on a noise-free loop, u is an exact linear function of r and the FIR with
+// its spline tail reproduces it.
+TEST(ClosedLoopPem, StageOneReproducesANoiseFreeInput) {
+  SimulationOptions o;
+  o.durationS = 6.0;
+  o.disturbance.torqueNoiseStd = 0.0;
+  o.disturbance.loadTorqueStd = 0.0;
+  o.disturbance.encoderCountsPerRev = 0;
+  const SimulationResult sim = simulateClosedLoop(*makeModel("three-mass"), {}, o);
+  ASSERT_EQ(sim.termination, Termination::Converged) << sim.message;
+  const Eigen::VectorXd u = centred(sim.data.input()->values);
+  const Eigen::VectorXd r = centred(sim.data.withRole(ChannelRole::Reference)->values);
+  const ReferenceProjection p = projectOnReference(u, r, sim.data.sampleTime);
+  ASSERT_TRUE(p.ok) << p.message;
+  EXPECT_GT(p.fitPercent, 99.9);
+  EXPECT_LT(p.freeParameters, p.pastTaps + p.futureTaps + 1);  // the tail is a spline
+  // A too short FIR cannot hold the loop's memory.
+  ReferenceProjectionOptions shortFir;
+  shortFir.pastS = 0.05;
+  EXPECT_LT(projectOnReference(u, r, sim.data.sampleTime, shortFir).fitPercent, 99.0);
+}
+
+TEST(ClosedLoopPem, MisuseThrowsAndBadDataFailWithASentence) {
+  const Eigen::VectorXd u = Eigen::VectorXd::LinSpaced(100, 0.0, 1.0);
+  EXPECT_THROW(projectOnReference(u, Eigen::VectorXd::Zero(50), 0.01), std::invalid_argument);
+  ReferenceProjectionOptions bad;
+  bad.pastS = -1.0;
+  EXPECT_THROW(projectOnReference(u, u, 0.01, bad), std::invalid_argument);
+  EXPECT_THROW(projectOnReference(u, u, 0.0), std::invalid_argument);
+  // Too few samples for the FIR.
+  const ReferenceProjection shortLog = projectOnReference(u, u, 0.0005);
+  EXPECT_FALSE(shortLog.ok);
+  EXPECT_NE(shortLog.message.find("too few samples"), std::string::npos) << shortLog.message;
+  // A constant reference explains nothing.
+  const ReferenceProjection flat = projectOnReference(u, Eigen::VectorXd::Zero(100), 0.1);
+  EXPECT_FALSE(flat.ok);
+  EXPECT_NE(flat.message.find("constant"), std::string::npos) << flat.message;
+  // The two-stage fit needs a reference as long as the input.
+  EXPECT_THROW(pemClosedLoop(*makeModel("two-mass"), u, u, {}, 0.01), std::invalid_argument);
+  EXPECT_EQ(toString(ClosedLoopMethod::TwoStage), std::string("two-stage"));
+  EXPECT_EQ(closedLoopMethodFromString("direct"), ClosedLoopMethod::Direct);
+  EXPECT_FALSE(closedLoopMethodFromString("indirect").has_value());
+  EXPECT_EQ(covarianceKindFromString("sandwich"), CovarianceKind::Sandwich);
+}
+
+// The long-run covariance by FFT equals its defining double sum; with white errors and no
+// lags the sandwich is the usual lambda R^{-1} (4.37); with coloured errors it follows the
+// long-run variance, which the white form misses.
+TEST(ClosedLoopPem, SandwichMatchesItsDefinitionAndTheWhiteFormAndWidensForColouredErrors) {
+  std::mt19937 rng(5);
+  std::normal_distribution<double> nd(0.0, 1.0);
+  {
+    const Eigen::Index n = 300;
+    const int lags = 25;
+    Eigen::MatrixXd psi(n, 2), chi(n, 2);
+    Eigen::VectorXd e(n), f(n);
+    for (Eigen::Index t = 0; t < n; ++t) {
+      psi(t, 0) = nd(rng), psi(t, 1) = std::sin(0.1 * t);
+      chi(t, 0) = nd(rng), chi(t, 1) = std::cos(0.05 * t);
+      e[t] = nd(rng) + (t ? 0.5 * e[t - 1] : 0.0);
+      f[t] = nd(rng) + 0.3 * e[t];
+    }
+    const Eigen::MatrixXd* ps[] = {&psi, &chi};
+    const Eigen::VectorXd* es[] = {&e, &f};
+    Eigen::MatrixXd direct = Eigen::MatrixXd::Zero(2, 2);
+    for (int i = 0; i < 2; ++i)
+      for (int j = 0; j < 2; ++j)
+        for (int tau = -lags; tau <= lags; ++tau) {
+          double rij = 0.0;
+          Eigen::Matrix2d c = Eigen::Matrix2d::Zero();
+          for (Eigen::Index t = 0; t < n; ++t) {
+            if (t - tau < 0 || t - tau >= n) continue;
+            rij += (*es[i])[t] * (*es[j])[t - tau];
+            c += ps[i]->row(t).transpose() * ps[j]->row(t - tau);
+          }
+          direct += (1.0 - std::abs(tau) / (lags + 1.0)) * rij / static_cast<double>(n) * c;
+        }
+    direct = 0.5 * (direct + direct.transpose()).eval();
+    const Eigen::MatrixXd fast = longRunCovariance({{&psi, &e}, {&chi, &f}}, lags);
+    EXPECT_TRUE(fast.isApprox(direct, 1e-9)) << fast << "\n" << direct;
+  }
+  const Eigen::Index n = 40000;
+  Eigen::MatrixXd psi(n, 2);
+  Eigen::VectorXd e(n), c(n);
+  double ar = 0.0;
+  for (Eigen::Index t = 0; t < n; ++t) {
+    psi(t, 0) = nd(rng);
+    psi(t, 1) = 1.0;
+    e[t] = nd(rng);
+    ar = 0.9 * ar + nd(rng);
+    c[t] = ar;
+  }
+  const Eigen::MatrixXd white = gaussNewtonCovariance(psi, e.squaredNorm());
+  const Eigen::MatrixXd sw0 = sandwichCovariance(psi, e, 0);
+  EXPECT_TRUE(sw0.isApprox(white, 0.05)) << sw0 << "\n" << white;
+  // AR(1) with pole 0.9: the long-run variance of a mean is (1 + 0.9) / (1 - 0.9) = 19 times
+  // the white one (Bartlett's window over 400 lags takes off about 0.5); the estimate's own
+  // relative spread is about sqrt(4 M / 3 N) = 12 %.
+  const Eigen::MatrixXd sw = sandwichCovariance(psi, c, 400);
+  const Eigen::MatrixXd wc = gaussNewtonCovariance(psi, c.squaredNorm());
+  EXPECT_GT(sw(1, 1) / wc(1, 1), 12.0);
+  EXPECT_LT(sw(1, 1) / wc(1, 1), 26.0);
+  EXPECT_THROW(sandwichCovariance(psi, e.head(10), 3), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace flexarm
