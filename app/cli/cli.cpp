@@ -17,6 +17,8 @@ const std::vector<Verb>& verbs() {
       {"bode", "frequency response of a fitted model or SPA/ETFE with bands, to CSV", runBode},
       {"lqg", "LQG design of chapter 8: gains, poles, Nyquist, max |S|, Bode integral",
        runLqg},
+      {"discover", "find the effect a physical model misses and show the gap shrink",
+       runDiscover},
   };
   return kVerbs;
 }

@@ -69,5 +69,6 @@ int runSimulate(const std::vector<std::string>& args, std::ostream& out, std::os
 int runFit(const std::vector<std::string>& args, std::ostream& out, std::ostream& err);
 int runBode(const std::vector<std::string>& args, std::ostream& out, std::ostream& err);
 int runLqg(const std::vector<std::string>& args, std::ostream& out, std::ostream& err);
+int runDiscover(const std::vector<std::string>& args, std::ostream& out, std::ostream& err);
 
 }  // namespace flexarm::cli
