@@ -29,6 +29,7 @@
 #include "app/cli/cli.h"
 #include "core/io/ranges.h"
 #include "widgets/arm_panel.h"
+#include "widgets/discovery_panel.h"
 #include "widgets/log_panel.h"
 #include "widgets/model_panel.h"
 #include "widgets/preprocess_panel.h"
@@ -110,6 +111,7 @@ MainWindow::MainWindow(QWidget* parent)
                       "Ctrl+Shift+A", nullptr);
   modelDock_ = addPanel(modelPanel_ = new ModelPanel(workspace_, this), tr("Model"),
                         "modelDock", "Ctrl+Shift+M", preprocessDock_);
+  discoveryDock_ = addPanel(discoveryPanel_ = new DiscoveryPanel(workspace_, this), tr("Discovery"), "discoveryDock", "Ctrl+Shift+D", preprocessDock_);
   preprocessDock_->raise();
   resize(1280, 860);
 

@@ -15,6 +15,7 @@ class QProgressDialog;
 namespace flexarm {
 
 class ArmPanel;
+class DiscoveryPanel;
 class LogPanel;
 class ModelPanel;
 class PreprocessPanel;
@@ -37,6 +38,7 @@ class MainWindow : public QMainWindow {
   PreprocessPanel* preprocessPanel() const { return preprocessPanel_; }
   ArmPanel* armPanel() const { return armPanel_; }
   ModelPanel* modelPanel() const { return modelPanel_; }
+  DiscoveryPanel* discoveryPanel() const { return discoveryPanel_; }
   QStringList recentFiles() const;
 
  signals:
@@ -66,9 +68,11 @@ class MainWindow : public QMainWindow {
   PreprocessPanel* preprocessPanel_ = nullptr;
   ArmPanel* armPanel_ = nullptr;
   ModelPanel* modelPanel_ = nullptr;
+  DiscoveryPanel* discoveryPanel_ = nullptr;
   QDockWidget* preprocessDock_ = nullptr;
   QDockWidget* armDock_ = nullptr;
   QDockWidget* modelDock_ = nullptr;
+  QDockWidget* discoveryDock_ = nullptr;
   QMenu* recentMenu_ = nullptr;
   QMenu* viewMenu_ = nullptr;
   QFutureWatcher<LogReadResult> reader_;

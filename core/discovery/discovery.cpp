@@ -128,17 +128,20 @@ bool predictVelocity(const NonlinearPlant& plant, const Series& s, int substeps,
   // a sample edge crosses a stage point, giving a zero gradient), and the average of a held
   // signal over a window is exact wherever the window holds no sample edge.
   auto held = [&u, N](double k) { return k < 0.0 ? 0.0 : u[std::min(static_cast<std::size_t>(k), N - 1)]; };
-  // The observer's torque acts on the motor (in units of u, undelayed): the load it stands
-  // for reaches the motor through the gear at low frequency, and a motor-side correction
-  // still acts when backlash opens the gear.
-  double correction = 0.0;
+  // The observer's torque tau (motor side) gives every mass the same acceleration tau / J:
+  // the share J_m / J acts on the motor (in units of u, undelayed), the rest on the arm as a
+  // load. The correction thus moves the rigid-body mode only, leaves the gear deflection to
+  // the model (backlash, stiffening) and still acts on both sides when backlash opens.
+  double correction = 0.0, load = 0.0;
   auto torqueAt = [&held, &correction, Ts, h, delay](double t) {
     const double a = (t - delay - 0.5 * h) / Ts, b = (t - delay + 0.5 * h) / Ts;
     const double edge = std::floor(b);
     if (edge <= a) return held(a) + correction;
     return ((edge - a) * held(a) + (b - edge) * held(b)) / (b - a) + correction;
   };
-  const double gain = totalInertia(plant.model()) / plant.model().value("k_T");
+  const double J = totalInertia(plant.model());
+  const double motorShare = plant.model().value("J_m") / J;
+  const double kT = plant.model().value("k_T"), r = plant.model().value("r");
   const double kp = 2.0 * wo, ki = wo * wo;
   double integral = 0.0;
   const double limit = 1e6 + 1e3 * std::abs(s.phi[0]);
@@ -149,10 +152,12 @@ bool predictVelocity(const NonlinearPlant& plant, const Series& s, int substeps,
     if (wo > 0.0 && k > 0) {
       const double e = ((s.phi[k] - s.phi[k - 1]) - (phiHat[k] - phiHat[k - 1])) / Ts;
       integral += e * Ts;
-      correction = gain * (kp * e + ki * integral);
+      const double tau = J * (kp * e + ki * integral);
+      correction = motorShare * tau / kT;
+      load = (1.0 - motorShare) * tau / r;
     }
     const double t = static_cast<double>(k) * Ts;
-    for (int i = 0; i < substeps; ++i) plant.step(x, t + i * h, h, torqueAt, 0.0);
+    for (int i = 0; i < substeps; ++i) plant.step(x, t + i * h, h, torqueAt, load);
   }
   yhat = differentiate(phiHat, Ts);
   return true;
@@ -177,8 +182,12 @@ struct Coordinate {
     if (map == Map::Fraction) phi = std::clamp(phi, 0.01 / scale, 0.95 / scale);
     if (map == Map::Log) phi = std::clamp(phi, -300.0, 300.0);
   }
+  // Finite-difference step: small for the smooth base parameters, about 1 % of the effect's
+  // typical size for effect values (dead zones and delays move the response in small jumps
+  // at the integration grid, which a tiny step would see as a zero or a spike).
   double step(double phi) const {
-    return map == Map::Log ? 1e-4 : 1e-4 * std::max(1.0, std::abs(phi));
+    if (base) return map == Map::Log ? 1e-4 : 1e-4 * std::max(1.0, std::abs(phi));
+    return map == Map::Log ? 2e-3 : 1e-2 * std::max(1.0, std::abs(phi));
   }
   // d value / d phi, to carry covariances into physical units.
   double slope(double phi) const { return map == Map::Log ? std::exp(phi) : scale; }
@@ -342,6 +351,30 @@ double correlationInflation(const Eigen::VectorXd& e) {
   return std::max(1.0, s);
 }
 
+// Variance of coordinate j by the Gauss approximation, lambda / |psi_j - P psi_j|^2 with P
+// the projection on the other columns of psi (rank-revealing QR): the (j, j) element of
+// lambda (psi^T psi)^{-1} when that exists, and still meaningful when other parameters are
+// collinear among themselves; infinite when psi_j lies in their span.
+double conditionalVariance(const LeastSquaresSolution& sol, Eigen::Index j) {
+  const Eigen::MatrixXd& psi = sol.psi;
+  const Eigen::Index n = psi.rows(), p = psi.cols();
+  if (n <= p) return INFINITY;
+  const double lambda = sol.sumSquares / static_cast<double>(n - p);
+  Eigen::MatrixXd others(n, p - 1);
+  for (Eigen::Index c = 0, o = 0; c < p; ++c)
+    if (c != j) others.col(o++) = psi.col(c);
+  Eigen::VectorXd rest = psi.col(j);
+  if (p > 1) {
+    Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(others);
+    qr.setThreshold(1e-9);
+    const Eigen::VectorXd coef = qr.solve(rest);
+    rest -= others * coef;
+  }
+  const double norm2 = rest.squaredNorm();
+  if (!(norm2 > 1e-12 * psi.col(j).squaredNorm()) || !(norm2 > 0.0)) return INFINITY;
+  return lambda / norm2;
+}
+
 struct FitOutcome {
   LeastSquaresSolution sol;
   std::unique_ptr<PhysicalModel> model;
@@ -410,12 +443,19 @@ void fitCandidate(EffectKind kind, const PhysicalModel& base, const Series& est,
   int extraCount = 0;  // parameters chosen on a grid (count in the penalty)
   switch (kind) {
     case EffectKind::CoulombFriction:
-    case EffectKind::Backlash:
-    case EffectKind::NonlinearSpring:
-    case EffectKind::InputDelay:
       addEffect(0, Map::NonNegative);
       e0.values[0] = 0.5 * info[0].defaultValue;
       starts.push_back(e0);
+      break;
+    case EffectKind::Backlash:
+    case EffectKind::NonlinearSpring:
+    case EffectKind::InputDelay:
+      // Responses far from linear in the value: a few starts over a decade.
+      addEffect(0, Map::NonNegative);
+      for (double f : {0.25, 0.8, 2.5}) {
+        e0.values[0] = f * info[0].defaultValue;
+        starts.push_back(e0);
+      }
       break;
     case EffectKind::TorqueRipple: {
       addEffect(0, Map::NonNegative);
@@ -489,12 +529,8 @@ void fitCandidate(EffectKind kind, const PhysicalModel& base, const Series& est,
       const auto& cj = pr.coords[j];
       if (cj.base || cj.index != static_cast<int>(i)) continue;
       p.estimated = true;
-      if (f.covariance.size()) {
-        const double slope = cj.slope(f.sol.phi[static_cast<Eigen::Index>(j)]);
-        p.std = std::abs(slope) * std::sqrt(std::max(0.0, f.covariance(static_cast<Eigen::Index>(j), static_cast<Eigen::Index>(j))));
-      } else {
-        p.std = INFINITY;
-      }
+      const double slope = cj.slope(f.sol.phi[static_cast<Eigen::Index>(j)]);
+      p.std = std::abs(slope) * std::sqrt(f.inflation * conditionalVariance(f.sol, static_cast<Eigen::Index>(j)));
     }
     p.lower = p.value - z * p.std;
     p.upper = p.value + z * p.std;
