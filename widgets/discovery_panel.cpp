@@ -123,6 +123,9 @@ DiscoveryPanel::DiscoveryPanel(Workspace* workspace, QWidget* parent)
   plots->addWidget(residualTime_);
   plots->addWidget(residualSpectrum_);
   plots->addWidget(overlay_);
+  table_->setMaximumHeight(240);
+  plots->setStretchFactor(0, 1);
+  for (int i = 1; i < 4; ++i) plots->setStretchFactor(i, 2);
   auto* layout = new QVBoxLayout(this);
   layout->addLayout(top);
   layout->addLayout(status);
@@ -356,8 +359,8 @@ void DiscoveryPanel::showOverlay() {
   if (added_) {
     overlay_->graph(2)->setData(toQ(t.time), toQ(t.augmented), true);
     const auto& e = r.estimation;
-    residualTime_->graph(1)->setData(toQ(e.time), toQ(difference(e.measured, e.augmented)), true);
     const auto augRes = difference(e.measured, e.augmented);
+    residualTime_->graph(1)->setData(toQ(e.time), toQ(augRes), true);
     const auto s = amplitudeSpectrum(augRes, r.sampleTime, static_cast<int>(std::min<std::size_t>(2048, augRes.size() / 2)));
     QVector<double> w, a;
     for (std::size_t i = 1; i < s.frequencyHz.size(); ++i)

@@ -118,8 +118,17 @@ bool predictVelocity(const NonlinearPlant& plant, const Series& s, int substeps,
   const std::size_t N = s.u.size();
   std::vector<double> phiHat(N);
   if (deflection) deflection->resize(N);
+  // Start in rigid-body motion at the measured speed (a data set cut from a longer log need
+  // not start at rest): phi_m' = y(0), every arm-side speed r y(0), the springs relaxed.
   NonlinearPlant::State x{};
   x[static_cast<std::size_t>(plant.motorAngleState())] = s.phi[0];
+  {
+    const auto names = plant.model().stateNames();
+    const double r = plant.model().value("r");
+    for (std::size_t i = 0; i < names.size() && i < x.size(); ++i)
+      if (!names[i].empty() && names[i].back() == '\'')
+        x[i] = names[i] == "phi_m'" ? s.y[0] : r * s.y[0];
+  }
   const double Ts = s.Ts, delay = plant.inputDelay();
   const double h = Ts / substeps;
   const auto& u = s.u;
