@@ -48,6 +48,19 @@ QCPGraph* addCurve(QCustomPlot* p, const QString& name, const QColor& c) {
 
 QString num(double v, int digits = 3) { return QString::number(v, 'g', digits); }
 
+// Amplitude spectrum of a residual against frequency in rad/s (positive values only, for the
+// logarithmic axes).
+void setSpectrum(QCPGraph* g, const std::vector<double>& x, double sampleTime) {
+  const auto s = amplitudeSpectrum(x, sampleTime, static_cast<int>(std::min<std::size_t>(2048, x.size() / 2)));
+  QVector<double> w, a;
+  for (std::size_t i = 1; i < s.frequencyHz.size(); ++i)
+    if (s.amplitude[i] > 0.0) {
+      w << 2.0 * M_PI * s.frequencyHz[i];
+      a << s.amplitude[i];
+    }
+  g->setData(w, a, true);
+}
+
 }  // namespace
 
 DiscoveryPanel::DiscoveryPanel(Workspace* workspace, QWidget* parent)
@@ -328,17 +341,7 @@ void DiscoveryPanel::showResult() {
   residualTime_->rescaleAxes();
   residualTime_->replot();
   residualSpectrum_->clearItems();
-  auto setSpectrum = [this, &r](QCPGraph* g, const std::vector<double>& x) {
-    const auto s = amplitudeSpectrum(x, r.sampleTime, static_cast<int>(std::min<std::size_t>(2048, x.size() / 2)));
-    QVector<double> w, a;
-    for (std::size_t i = 1; i < s.frequencyHz.size(); ++i)
-      if (s.amplitude[i] > 0.0) {
-        w << 2.0 * M_PI * s.frequencyHz[i];
-        a << s.amplitude[i];
-      }
-    g->setData(w, a, true);
-  };
-  setSpectrum(residualSpectrum_->graph(0), baseRes);
+  setSpectrum(residualSpectrum_->graph(0), baseRes, r.sampleTime);
   residualSpectrum_->graph(1)->data()->clear();
   residualSpectrum_->rescaleAxes();
   for (double w : r.disagreement.resonancesRadS) {
@@ -361,14 +364,7 @@ void DiscoveryPanel::showOverlay() {
     const auto& e = r.estimation;
     const auto augRes = difference(e.measured, e.augmented);
     residualTime_->graph(1)->setData(toQ(e.time), toQ(augRes), true);
-    const auto s = amplitudeSpectrum(augRes, r.sampleTime, static_cast<int>(std::min<std::size_t>(2048, augRes.size() / 2)));
-    QVector<double> w, a;
-    for (std::size_t i = 1; i < s.frequencyHz.size(); ++i)
-      if (s.amplitude[i] > 0.0) {
-        w << 2.0 * M_PI * s.frequencyHz[i];
-        a << s.amplitude[i];
-      }
-    residualSpectrum_->graph(1)->setData(w, a, true);
+    setSpectrum(residualSpectrum_->graph(1), augRes, r.sampleTime);
     residualTime_->replot();
     residualSpectrum_->replot();
   } else {
