@@ -179,6 +179,7 @@ struct Coordinate {
   int index = 0;
   Map map = Map::Log;
   double scale = 1.0;
+  double minPhi = -300.0, maxPhi = 300.0;  // bounds of logarithmic coordinates
   double toValue(double phi) const {
     switch (map) {
       case Map::Log: return std::exp(phi);
@@ -189,7 +190,7 @@ struct Coordinate {
   void project(double& phi) const {
     if (map == Map::NonNegative) phi = std::max(phi, 0.0);
     if (map == Map::Fraction) phi = std::clamp(phi, 0.01 / scale, 0.95 / scale);
-    if (map == Map::Log) phi = std::clamp(phi, -300.0, 300.0);
+    if (map == Map::Log) phi = std::clamp(phi, minPhi, maxPhi);
   }
   // Finite-difference step: small for the smooth base parameters, about 1 % of the effect's
   // typical size for effect values (dead zones and delays move the response in small jumps
@@ -479,6 +480,11 @@ void fitCandidate(EffectKind kind, const PhysicalModel& base, const Series& est,
     }
     case EffectKind::ExtraMass: {
       addEffect(0, Map::Log);
+      // The new mode lies within a band around the base model's resonance that the data
+      // inform (0.25 to 6 times it): far below it a mass on a very soft spring would stand
+      // for a motor running free of the arm, which is not a mass the arm has.
+      pr.coords.back().minPhi = std::log(0.25 * baseResonance);
+      pr.coords.back().maxPhi = std::log(6.0 * baseResonance);
       addEffect(1, Map::Fraction);
       std::vector<double> omegas = {0.5 * baseResonance, 0.8 * baseResonance,
                                     1.3 * baseResonance, 2.0 * baseResonance};

@@ -94,9 +94,6 @@ Outcome runCase(const Case& c) {
   const IdData val = makeLog(*truth, effects, c.seed, true, turning);
   DiscoveryOptions o;
   o.threads = 1;  // the cases run in parallel
-  if (const char* b = std::getenv("DISCOVERY_OBS")) o.observerBandwidthHz = std::atof(b);
-  if (const char* b = std::getenv("DISCOVERY_ITERS")) o.candidateIterations = std::atoi(b);
-  if (std::getenv("DISCOVERY_BACKLASH")) o.candidates = {EffectKind::Backlash, EffectKind::NonlinearSpring};
   auto base = makeModel("two-mass");
   return {c, discoverMissingEffect(*base, est, &val, o), {}};
 }
@@ -154,12 +151,6 @@ TEST(Discovery, NamesTheHiddenEffect) {
       cases.push_back({k, 11 + 7 * s + static_cast<int>(k), mag});
     }
   for (int s = 0; s < 4; ++s) cases.push_back({std::nullopt, 5 + 3 * s, 0.0});
-  if (const char* only = std::getenv("DISCOVERY_ONLY")) {
-    std::vector<Case> keep;
-    for (const auto& c : cases)
-      if ((c.hidden ? toString(*c.hidden) : "none") == std::string(only)) keep.push_back(c);
-    cases = keep;
-  }
 
   const auto outcomes = runAll(cases);
   std::map<std::string, std::map<std::string, int>> confusion;
@@ -175,17 +166,6 @@ TEST(Discovery, NamesTheHiddenEffect) {
                 o.c.seed, o.c.magnitude, said.c_str(), o.result.base.rmsValidation,
                 o.result.augmented.rmsValidation, o.result.evidence.c_str());
     ASSERT_EQ(o.result.termination, Termination::Converged) << o.result.message;
-    if (std::getenv("DISCOVERY_BANDS")) {
-      const auto& D = o.result.disagreement;
-      const double edges[] = {0, 1, 3, 10, 30, 100, 600};
-      for (int b = 0; b < 6; ++b) {
-        double p = 0;
-        for (std::size_t i = 0; i < D.spectrumHz.size(); ++i)
-          if (D.spectrumHz[i] >= edges[b] && D.spectrumHz[i] < edges[b + 1]) p += D.spectrum[i] * D.spectrum[i] / 2;
-        std::printf("  band %g-%g Hz rms %.4f\n", edges[b], edges[b + 1], std::sqrt(p));
-      }
-      std::printf("  %s\n", D.summary.c_str());
-    }
     for (const auto& c : o.result.candidates)
       std::printf("    %-17s loss %.5f val %.4f aic %.1f F %.1f/%.1f %s %s\n", toString(c.kind),
                   c.lossEst, c.score.rmsValidation, c.aic - o.result.baseAic, c.fStatistic,
