@@ -9,11 +9,11 @@
 // angle is (central differences, the seed's Section 5.2), so the prediction error
 //   eps(t) = phi_m'(t) - phi_m'_hat(t | theta)                                      (4.3)
 // is in rad/s. Closed-loop logs carry an unmeasured load torque on the arm (Figure 5.1) that
-// the controller answers with u; a slow load observer (a PI estimate of the arm-side torque
-// from the motor velocity error, bandwidth of about 1 Hz) keeps the simulation on the measured
-// operating point, so that friction, backlash and ripple are evaluated where the arm really
-// was. The parameters minimize V_N = (1/N) sum eps^2 (4.6) by Levenberg-Marquardt (4.17)-(4.21)
-// with a finite-difference gradient psi.
+// the controller answers with u; a slow observer (a PI torque on the motor from the motor
+// velocity error, bandwidth of about 1 Hz) keeps the simulation on the measured operating
+// point, so that friction and backlash are evaluated where the arm really was; the ripple is
+// positioned by the measured motor angle. The parameters minimize V_N = (1/N) sum eps^2 (4.6)
+// by Levenberg-Marquardt (4.17)-(4.21) with a finite-difference gradient psi.
 #include <memory>
 #include <optional>
 #include <string>
