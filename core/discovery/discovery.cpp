@@ -427,7 +427,8 @@ struct CandidateWork {
 // Fits one candidate: short screening fits from a few starts, then the full refit.
 void fitCandidate(EffectKind kind, const PhysicalModel& base, const Series& est,
                   const Series* val, const DiscoveryOptions& o, int substeps, double wo,
-                  double residualPeakRadS, double baseResonance, const std::vector<double>& eBase,
+                  double residualPeakRadS, double baseResonance, double deflectionRange,
+                  const std::vector<double>& eBase,
                   const std::atomic<bool>& cancel, CandidateWork& w) {
   Problem pr;
   pr.base = &base;
@@ -457,7 +458,21 @@ void fitCandidate(EffectKind kind, const PhysicalModel& base, const Series& est,
       e0.values[0] = 0.5 * info[0].defaultValue;
       starts.push_back(e0);
       break;
-    case EffectKind::Backlash:
+    case EffectKind::Backlash: {
+      // The gap is searched on a logarithmic grid over the gear deflections the base model
+      // sees in the data and kept inside them: a gap wider than the deflections would stand
+      // for a motor running free of the arm, which explains much of any data and is not a
+      // gear the arm has; a gap far below them changes nothing the data can show.
+      addEffect(0, Map::Log);
+      const double range = std::max(deflectionRange, 1e-3 * info[0].defaultValue);
+      pr.coords.back().minPhi = std::log(1e-3 * range);
+      pr.coords.back().maxPhi = std::log(range);
+      for (double f : {0.02, 0.05, 0.1, 0.2, 0.35, 0.6, 0.9}) {
+        e0.values[0] = f * range;
+        starts.push_back(e0);
+      }
+      break;
+    }
     case EffectKind::NonlinearSpring:
     case EffectKind::InputDelay:
       // Responses far from linear in the value: a few starts over a decade.
@@ -746,6 +761,18 @@ DiscoveryResult discoverMissingEffect(const PhysicalModel& base, const IdData& e
     D.summary = s;
   }
 
+  // The size of the gear deflections in the data: the 99th percentile of |delta|.
+  double deflectionRange = 0.0;
+  {
+    std::vector<double> a(deflection.size());
+    for (std::size_t k = 0; k < a.size(); ++k) a[k] = std::abs(deflection[k]);
+    if (!a.empty()) {
+      const std::size_t q = std::min(a.size() - 1, a.size() * 99 / 100);
+      std::nth_element(a.begin(), a.begin() + static_cast<long>(q), a.end());
+      deflectionRange = a[q];
+    }
+  }
+
   // 3. Candidates in parallel.
   std::vector<EffectKind> kinds;
   for (EffectKind k : o.candidates) {
@@ -760,7 +787,7 @@ DiscoveryResult discoverMissingEffect(const PhysicalModel& base, const IdData& e
       const std::size_t i = next++;
       if (i >= kinds.size() || cancel.load()) return;
       fitCandidate(kinds[i], *baseFit, *est, valp, o, substeps, wo, D.spectrumPeakRadS,
-                   baseResonance, eBase, cancel, work[i]);
+                   baseResonance, deflectionRange, eBase, cancel, work[i]);
       const std::size_t f = ++finished;
       report(0.15 + 0.8 * static_cast<double>(f) / kinds.size(),
              std::string("fitted ") + toString(kinds[i]));
