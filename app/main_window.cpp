@@ -33,6 +33,7 @@
 #include "widgets/bode_panel.h"
 #include "widgets/compare_panel.h"
 #include "widgets/fit_panel.h"
+#include "widgets/discovery_panel.h"
 #include "widgets/log_panel.h"
 #include "widgets/lqg_panel.h"
 #include "widgets/model_panel.h"
@@ -126,6 +127,7 @@ MainWindow::MainWindow(QWidget* parent)
                             tr("Residuals"), "residualsDock", "Ctrl+Shift+R", preprocessDock_);
   lqgDock_ = addPanel(lqgPanel_ = new LqgPanel(workspace_, this), tr("LQG"), "lqgDock",
                       "Ctrl+Shift+L", preprocessDock_);
+  discoveryDock_ = addPanel(discoveryPanel_ = new DiscoveryPanel(workspace_, this), tr("Discovery"), "discoveryDock", "Ctrl+Shift+D", preprocessDock_);
   preprocessDock_->raise();
   session_ = new SessionController(this, workspace_);  // File menu: sessions and reports
   resize(1280, 860);

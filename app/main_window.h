@@ -18,6 +18,7 @@ class ArmPanel;
 class BodePanel;
 class ComparePanel;
 class FitPanel;
+class DiscoveryPanel;
 class LogPanel;
 class LqgPanel;
 class ModelPanel;
@@ -49,6 +50,7 @@ class MainWindow : public QMainWindow {
   ResidualsPanel* residualsPanel() const { return residualsPanel_; }
   LqgPanel* lqgPanel() const { return lqgPanel_; }
   SessionController* sessionController() const { return session_; }
+  DiscoveryPanel* discoveryPanel() const { return discoveryPanel_; }
   QStringList recentFiles() const;
 
  signals:
@@ -78,6 +80,7 @@ class MainWindow : public QMainWindow {
   PreprocessPanel* preprocessPanel_ = nullptr;
   ArmPanel* armPanel_ = nullptr;
   ModelPanel* modelPanel_ = nullptr;
+  DiscoveryPanel* discoveryPanel_ = nullptr;
   QDockWidget* preprocessDock_ = nullptr;
   QDockWidget* armDock_ = nullptr;
   QDockWidget* modelDock_ = nullptr;
@@ -92,6 +95,7 @@ class MainWindow : public QMainWindow {
   LqgPanel* lqgPanel_ = nullptr;
   QDockWidget* lqgDock_ = nullptr;
   SessionController* session_ = nullptr;
+  QDockWidget* discoveryDock_ = nullptr;
   QMenu* recentMenu_ = nullptr;
   QMenu* viewMenu_ = nullptr;
   QFutureWatcher<LogReadResult> reader_;

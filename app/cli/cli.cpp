@@ -18,6 +18,8 @@ const std::vector<Verb>& verbs() {
       {"lqg", "LQG design of chapter 8: gains, poles, Nyquist, max |S|, Bode integral",
        runLqg},
       {"run", "replay a saved session headless and write its PDF/HTML report", runRun},
+      {"discover", "find the effect a physical model misses and show the gap shrink",
+       runDiscover},
   };
   return kVerbs;
 }

@@ -70,5 +70,6 @@ int runFit(const std::vector<std::string>& args, std::ostream& out, std::ostream
 int runBode(const std::vector<std::string>& args, std::ostream& out, std::ostream& err);
 int runLqg(const std::vector<std::string>& args, std::ostream& out, std::ostream& err);
 int runRun(const std::vector<std::string>& args, std::ostream& out, std::ostream& err);
+int runDiscover(const std::vector<std::string>& args, std::ostream& out, std::ostream& err);
 
 }  // namespace flexarm::cli

@@ -1,0 +1,107 @@
+// The Discovery panel on a sample log with one hidden effect (sample_logs/README.md: a
+// three-mass arm, Table 5.7 p6, at 1 kHz): pick the three-mass base, click "Find missing
+// effect", check the verdict, the candidates table and the plots, click "Add to model" and
+// check the new model (undoable) and the gap shrinking; screenshots before and after.
+#include <QComboBox>
+#include <QPushButton>
+#include <QSignalSpy>
+#include <QTableWidget>
+#include <QUndoStack>
+#include <QtTest>
+#include <qcustomplot.h>
+
+#include "core/io/log_io.h"
+#include "widget_test_support.h"
+#include "widgets/discovery_panel.h"
+#include "widgets/workspace.h"
+
+using namespace flexarm;
+
+namespace {
+const QString kLog = QString(FLEXARM_SAMPLE_DIR) + "/effect_torque_ripple.csv";
+const char* kEffect = "torque_ripple";
+}  // namespace
+
+class DiscoveryPanelTest : public QObject {
+  Q_OBJECT
+ private:
+  Workspace* workspace_ = nullptr;
+  DiscoveryPanel* panel_ = nullptr;
+
+ private slots:
+  void initTestCase() {
+    const auto read = readLog(kLog.toStdString());
+    QVERIFY2(read.ok, qPrintable("cannot read " + kLog));
+    workspace_ = new Workspace(this);
+    workspace_->setLog(read.data, kLog);
+    // First 6 s estimate, last 4 s validate (the log is 10 s long).
+    workspace_->setRange(RangeKind::Estimation, {0.0, 6.0});
+    workspace_->setRange(RangeKind::Validation, {6.0, 10.0});
+    panel_ = new DiscoveryPanel(workspace_);
+    panel_->resize(1100, 1150);
+    panel_->show();
+    QVERIFY(QTest::qWaitForWindowExposed(panel_));
+  }
+
+  void offersBaseModels() {
+    QComboBox* box = panel_->baseModelBox();
+    QVERIFY(box->findText("three-mass (nominal)") >= 0);
+    QVERIFY(box->findText("two-mass (nominal)") >= 0);
+    QVERIFY(!panel_->addButton()->isEnabled());  // nothing to add yet
+  }
+
+  void findsTheEffect() {
+    QComboBox* box = panel_->baseModelBox();
+    box->setCurrentIndex(box->findText("three-mass (nominal)"));
+    QSignalSpy done(panel_, &DiscoveryPanel::finished);
+    QTest::mouseClick(panel_->findButton(), Qt::LeftButton);
+    QVERIFY(panel_->isBusy());
+    QVERIFY(!panel_->findButton()->isEnabled());
+    QVERIFY(done.wait(240000));
+    QVERIFY2(panel_->hasResult(), qPrintable(panel_->verdictText()));
+    QVERIFY2(panel_->verdictText().contains(kEffect), qPrintable(panel_->verdictText()));
+    QVERIFY2(panel_->evidenceText().contains("rad/s"), qPrintable(panel_->evidenceText()));
+    // One row per candidate; the winner's row says "yes".
+    QTableWidget* t = panel_->candidatesTable();
+    QCOMPARE(t->rowCount(), 6);
+    bool winnerSignificant = false;
+    for (int r = 0; r < t->rowCount(); ++r)
+      if (t->item(r, 0)->text() == kEffect) winnerSignificant = t->item(r, 5)->text() == "yes";
+    QVERIFY(winnerSignificant);
+    // Residual plots hold the base residual; the augmented curve waits for "Add to model".
+    QVERIFY(panel_->residualTimePlot()->graph(0)->dataCount() > 1000);
+    QVERIFY(panel_->residualSpectrumPlot()->graph(0)->dataCount() > 100);
+    QCOMPARE(panel_->overlayPlot()->graph(2)->dataCount(), 0);
+    QVERIFY(panel_->addButton()->isEnabled());
+    QTest::qWait(100);
+    flexarm::test::saveShot(panel_->grab().toImage(), "discovery_panel_found");
+  }
+
+  void addsTheAugmentedModel() {
+    const std::size_t before = workspace_->models().size();
+    QSignalSpy added(panel_, &DiscoveryPanel::modelAdded);
+    QTest::mouseClick(panel_->addButton(), Qt::LeftButton);
+    QCOMPARE(added.count(), 1);
+    QCOMPARE(workspace_->models().size(), before + 1);
+    const ModelEntry& m = workspace_->models().back();
+    QVERIFY(m.name.contains(kEffect));
+    QCOMPARE(m.effects.size(), std::size_t{1});
+    QCOMPARE(QString(toString(m.effects[0].kind)), QString(kEffect));
+    // The gap shrinks: augmented curves shown, validation residual RMS lower.
+    const DiscoveryResult* r = panel_->result();
+    QVERIFY(r->augmented.rmsValidation < r->base.rmsValidation);
+    QVERIFY(panel_->overlayPlot()->graph(2)->dataCount() > 1000);
+    QVERIFY(panel_->residualTimePlot()->graph(1)->dataCount() > 1000);
+    QVERIFY2(panel_->comparisonText().contains("Augmented"), qPrintable(panel_->comparisonText()));
+    QTest::qWait(100);
+    flexarm::test::saveShot(panel_->grab().toImage(), "discovery_panel_added");
+    // Undo removes the model again.
+    workspace_->undoStack()->undo();
+    QCOMPARE(workspace_->models().size(), before);
+  }
+
+  void cleanupTestCase() { delete panel_; }
+};
+
+QTEST_MAIN(DiscoveryPanelTest)
+#include "tst_discovery.moc"

@@ -1,0 +1,91 @@
+#pragma once
+// Discovery panel: finds the effect the chosen base model misses (core/discovery). One button
+// runs the base fit, the map of the disagreement and every candidate off the GUI thread, with
+// progress and Cancel; the panel then shows the candidates table, the verdict with its
+// evidence, the base residual in time and frequency (with the model's resonances), and, after
+// "Add to model" (undoable, a new entry in the model list), the measured, base and augmented
+// simulations overlaid with fit % and residual RMS before and after.
+#include <QFutureWatcher>
+#include <QWidget>
+#include <atomic>
+#include <memory>
+
+#include "core/discovery/discovery.h"
+#include "widgets/workspace.h"
+
+class QComboBox;
+class QCustomPlot;
+class QLabel;
+class QProgressBar;
+class QPushButton;
+class QTableWidget;
+
+namespace flexarm {
+
+class DiscoveryPanel : public QWidget {
+  Q_OBJECT
+ public:
+  explicit DiscoveryPanel(Workspace* workspace, QWidget* parent = nullptr);
+  ~DiscoveryPanel() override;
+
+  bool isBusy() const { return watcher_.isRunning(); }
+  bool hasResult() const { return result_ != nullptr; }
+  const DiscoveryResult* result() const { return result_.get(); }
+  // Base models offered: the model list's entries with a gear spring, then nominal structures.
+  QComboBox* baseModelBox() const { return base_; }
+  QPushButton* findButton() const { return find_; }
+  QPushButton* addButton() const { return add_; }
+  QTableWidget* candidatesTable() const { return table_; }
+  QString verdictText() const;
+  QString evidenceText() const;
+  QString comparisonText() const;
+  QCustomPlot* residualTimePlot() const { return residualTime_; }
+  QCustomPlot* residualSpectrumPlot() const { return residualSpectrum_; }
+  QCustomPlot* overlayPlot() const { return overlay_; }
+  DiscoveryOptions& options() { return options_; }
+
+ public slots:
+  void findMissingEffect();
+  void cancel();
+  // Adds the augmented model to the model list (undoable) and shows the gap shrink.
+  void addToModel();
+
+ signals:
+  void finished();  // a run ended (result, failure or cancel)
+  void modelAdded(int index);
+
+ private:
+  struct Outcome {
+    std::shared_ptr<DiscoveryResult> result;
+    QString error;
+  };
+  void refillModels();
+  void onFinished();
+  void showResult();
+  void showOverlay();
+  std::unique_ptr<PhysicalModel> chosenBase(std::vector<Effect>* effects) const;
+
+  Workspace* workspace_;
+  QComboBox* base_;
+  QPushButton* find_;
+  QPushButton* cancel_;
+  QPushButton* add_;
+  QProgressBar* progress_;
+  QLabel* stage_;
+  QLabel* verdict_;
+  QLabel* evidence_;
+  QLabel* where_;
+  QLabel* comparison_;
+  QTableWidget* table_;
+  QCustomPlot* residualTime_;
+  QCustomPlot* residualSpectrum_;
+  QCustomPlot* overlay_;
+  QFutureWatcher<Outcome> watcher_;
+  std::shared_ptr<std::atomic<bool>> cancelFlag_;
+  std::shared_ptr<DiscoveryResult> result_;
+  DiscoveryOptions options_;
+  QString baseName_;
+  bool added_ = false;
+};
+
+}  // namespace flexarm
