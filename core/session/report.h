@@ -53,6 +53,9 @@ struct Report {
   nlohmann::json toJson() const;
 };
 
+// Keeps at most n points of a series, evenly strided, for plots.
+void thinSeries(std::vector<double>& x, std::vector<double>& y, std::size_t n);
+
 // Fixed-point text with `decimals` digits, as reports print fit % ("87.31").
 std::string formatFixed(double v, int decimals);
 // Text with `digits` significant digits, as reports print parameters ("0.005347").
