@@ -304,15 +304,15 @@ std::vector<ReportPlot> bodeWithBand(const FrequencyResponse& r, const std::stri
     std::vector<double> lower;  // a lower bound at or below zero has no place on a log axis
     for (std::size_t i = 0; i < r.magnitudeLower.size(); ++i)
       lower.push_back(r.magnitudeLower[i] > 0.0 ? r.magnitudeLower[i] : r.magnitude[i] * 1e-3);
-    mag.series.push_back({"upper " + band, r.omega, r.magnitudeUpper, true});
-    mag.series.push_back({"lower " + band, r.omega, lower, true});
+    mag.series.push_back({"upper " + band, r.omega, r.magnitudeUpper, true, 1});
+    mag.series.push_back({"lower " + band, r.omega, lower, true, 1});
     std::vector<double> lo, hi;
     for (std::size_t i = 0; i < r.phaseLower.size(); ++i) {
       lo.push_back(r.phaseLower[i] * deg);
       hi.push_back(r.phaseUpper[i] * deg);
     }
-    ph.series.push_back({"upper " + band, r.omega, hi, true});
-    ph.series.push_back({"lower " + band, r.omega, lo, true});
+    ph.series.push_back({"upper " + band, r.omega, hi, true, 1});
+    ph.series.push_back({"lower " + band, r.omega, lo, true, 1});
   }
   return {mag, ph};
 }
@@ -325,7 +325,9 @@ ReportSeries stepSeries(const std::string& name, const std::vector<int>& lags,
 }
 
 ReportSeries constantSeries(const std::string& name, const std::vector<int>& lags, double v) {
-  return stepSeries(name, lags, std::vector<double>(lags.size(), v), true);
+  ReportSeries s = stepSeries(name, lags, std::vector<double>(lags.size(), v), true);
+  s.color = 1;
+  return s;
 }
 
 class FitsPart : public SessionPart {
@@ -405,11 +407,11 @@ class FitsPart : public SessionPart {
     if (r.physical()) {
       std::string free;
       for (const auto& p : r.start->parameters())
-        if (p.free) free += (free.empty() ? "" : ", ") + p.name;
+        if (p.free) free += (free.empty() ? "" : ", ") + p.name + " from " + formatSignificant(p.value);
       structure = r.start->structureName() + " grey-box model (5.3), prediction-error fit (5.7) in " +
                   (r.noiseModel == NoiseModel::OutputError ? "output-error form (K = 0)"
                                                            : "innovations form (K estimated)") +
-                  "; free parameters " + free + "; start values as in the table's model list entry" +
+                  "; free parameters (start values) " + free + "; the others held as listed" +
                   (r.randomStarts > 0 ? "; " + std::to_string(r.randomStarts) +
                                             " random starts and two at the SPA notches and peaks (seed " +
                                             std::to_string(r.seed) + ")"

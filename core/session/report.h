@@ -20,6 +20,7 @@ struct ReportSeries {
   std::string name;
   std::vector<double> x, y;
   bool dashed = false;
+  int color = -1;  // palette index; -1: by the series' position (bounds share a colour)
 };
 
 struct ReportPlot {
