@@ -99,6 +99,8 @@ std::unique_ptr<QCustomPlot> makePlot(const ReportPlot& p) {
   if (p.logX) logAxis(plot->xAxis);
   if (p.logY) logAxis(plot->yAxis);
   plot->legend->setVisible(p.series.size() > 1);
+  if (p.legendBottomLeft)
+    plot->axisRect()->insetLayout()->setInsetAlignment(0, Qt::AlignBottom | Qt::AlignLeft);
   plot->legend->setFont(QFont("sans", 8));
   plot->rescaleAxes();
   return plot;

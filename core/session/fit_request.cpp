@@ -2,6 +2,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 
 #include "core/ident/evaluation.h"
@@ -301,9 +302,9 @@ std::vector<ReportPlot> bodeWithBand(const FrequencyResponse& r, const std::stri
   ph.series.push_back({name, r.omega, phase, false});
   if (r.hasBands()) {
     const std::string band = formatFixed(100.0 * r.level, 0) + " % bound";
-    std::vector<double> lower;  // a lower bound at or below zero has no place on a log axis
-    for (std::size_t i = 0; i < r.magnitudeLower.size(); ++i)
-      lower.push_back(r.magnitudeLower[i] > 0.0 ? r.magnitudeLower[i] : r.magnitude[i] * 1e-3);
+    // A lower bound at or below zero has no place on a log axis: the curve has a gap there.
+    std::vector<double> lower;
+    for (double v : r.magnitudeLower) lower.push_back(v > 0.0 ? v : std::numeric_limits<double>::quiet_NaN());
     mag.series.push_back({"upper " + band, r.omega, r.magnitudeUpper, true, 1});
     mag.series.push_back({"lower " + band, r.omega, lower, true, 1});
     std::vector<double> lo, hi;
@@ -314,6 +315,7 @@ std::vector<ReportPlot> bodeWithBand(const FrequencyResponse& r, const std::stri
     ph.series.push_back({"upper " + band, r.omega, hi, true, 1});
     ph.series.push_back({"lower " + band, r.omega, lo, true, 1});
   }
+  mag.legendBottomLeft = ph.legendBottomLeft = true;
   return {mag, ph};
 }
 

@@ -27,6 +27,7 @@ struct ReportPlot {
   std::string title, xLabel, yLabel;
   bool logX = false, logY = false;
   std::vector<ReportSeries> series;
+  bool legendBottomLeft = false;  // where the curves leave room (Bode plots); else top right
 };
 
 struct ReportSection {
