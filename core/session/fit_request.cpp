@@ -391,11 +391,22 @@ class FitsPart : public SessionPart {
                            std::to_string(n) + " samples, " + sig->note + "), Hann lag window M = " +
                            std::to_string(m) + ", 99 % band from (6.62).");
     if (sig->closedLoop) s.paragraphs.push_back(kClosedLoopBiasWarning);
+    std::size_t undefined = 0;
+    for (std::size_t i = 0; i < e.response.omega.size(); ++i)
+      undefined += !std::isfinite(e.response.magnitude[i]) || !std::isfinite(e.response.phase[i]);
+    if (undefined > 0)
+      s.paragraphs.push_back("The estimate is undefined at " + std::to_string(undefined) + " of " +
+                             std::to_string(e.response.omega.size()) +
+                             " frequencies; the plots leave gaps there.");
     const auto np = notchesAndPeaks(e.response, 3.0);
     s.paragraphs.push_back("Notches: " + joinedFrequencies(np.notches) + ". Peaks: " +
                            joinedFrequencies(np.peaks) + ".");
     s.plots = bodeWithBand(e.response, "SPA", "SPA of the estimation data");
-    s.values = {{"samples", n}, {"lag_window", m}, {"notches_rad_s", np.notches}, {"peaks_rad_s", np.peaks}};
+    s.values = {{"samples", n},
+                {"lag_window", m},
+                {"undefined_frequencies", undefined},
+                {"notches_rad_s", np.notches},
+                {"peaks_rad_s", np.peaks}};
     return s;
   }
 
