@@ -83,7 +83,7 @@ std::unique_ptr<QCustomPlot> makePlot(const ReportPlot& p) {
     const auto& s = p.series[i];
     QCPGraph* g = plot->addGraph();
     g->setName(QString::fromStdString(s.name));
-    QPen pen(kColors[i % 4], 1.4);
+    QPen pen(kColors[(s.color >= 0 ? static_cast<std::size_t>(s.color) : i) % 4], 1.4);
     if (s.dashed) pen.setStyle(Qt::DashLine);
     g->setPen(pen);
     g->setData(QVector<double>(s.x.begin(), s.x.end()), QVector<double>(s.y.begin(), s.y.end()), true);
@@ -99,6 +99,8 @@ std::unique_ptr<QCustomPlot> makePlot(const ReportPlot& p) {
   if (p.logX) logAxis(plot->xAxis);
   if (p.logY) logAxis(plot->yAxis);
   plot->legend->setVisible(p.series.size() > 1);
+  if (p.legendBottomLeft)
+    plot->axisRect()->insetLayout()->setInsetAlignment(0, Qt::AlignBottom | Qt::AlignLeft);
   plot->legend->setFont(QFont("sans", 8));
   plot->rescaleAxes();
   return plot;

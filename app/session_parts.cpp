@@ -1,8 +1,10 @@
 #include "app/session_parts.h"
 
 #include <QByteArray>
+#include <QVariant>
 
 #include "app/main_window.h"
+#include "core/session/fit_request.h"
 #include "core/session/model_json.h"
 #include "widgets/model_panel.h"
 #include "widgets/workspace.h"
@@ -35,6 +37,60 @@ void restoreModels(const json& section, MainWindow& w) {
   }
 }
 
+// The fits the Fit panel made, as requests a replay repeats; the SPA section comes with them.
+// A physical request whose estimate is not in the model list (a hand-written session) is
+// kept as read, so saving does not drop it; the window does not run the fit while opening.
+constexpr const char* kUnattachedFits = "flexarmUnattachedFits";
+
+json captureFits(const MainWindow& w) {
+  json requests = json::array();
+  for (const auto& m : w.workspace()->models())
+    if (m.fitRequest) requests.push_back(fitRequestToJson(*m.fitRequest));
+  const QByteArray kept = w.property(kUnattachedFits).toByteArray();
+  if (!kept.isEmpty())
+    for (const auto& j : json::parse(kept.toStdString(), nullptr, false))
+      requests.push_back(j);
+  if (requests.empty()) return nullptr;
+  return {{"nonparametric", true}, {"requests", requests}};
+}
+
+// Physical estimates come back with the model list: their requests are attached again. A
+// black-box estimate is not stored as such; it is estimated again from its request (a
+// polynomial fit of the session's data takes a fraction of a second).
+void restoreFits(const json& section, MainWindow& w) {
+  Workspace* ws = w.workspace();
+  json unattached = json::array();
+  for (const auto& j : section["requests"]) {
+    std::string why;
+    auto request = fitRequestFromJson(j, &why);
+    if (!request) continue;  // validated when the file was read
+    auto shared = std::make_shared<const FitRequest>(*request);
+    const QString name = QString::fromStdString(request->name);
+    bool attached = false;
+    for (std::size_t i = 0; i < ws->models().size() && !attached; ++i) {
+      ModelEntry e = ws->models()[i];
+      if (e.name != name || e.fitRequest) continue;
+      e.fitRequest = shared;
+      ws->setModelDirect(static_cast<int>(i), e);
+      attached = true;
+    }
+    if (attached) continue;
+    if (request->physical() || !ws->current()) {
+      unattached.push_back(j);
+      continue;
+    }
+    const FitRun run = runFitRequest(*request, *ws->current());
+    if (!run.summary.ok() || !run.polynomial) continue;
+    ModelEntry e;
+    e.name = name;
+    e.polynomial = run.polynomial;
+    e.fitRequest = shared;
+    ws->insertModelDirect(static_cast<int>(ws->models().size()), e);
+  }
+  w.setProperty(kUnattachedFits, unattached.empty() ? QByteArray()
+                                                     : QByteArray::fromStdString(unattached.dump()));
+}
+
 json captureView(const MainWindow& w) {
   return {{"window_state", w.saveState().toBase64().toStdString()},
           {"selected_model", w.modelPanel() ? w.modelPanel()->currentIndex() : -1}};
@@ -53,6 +109,7 @@ const std::vector<WindowSessionPart>& windowSessionParts() {
   // In the order of core sessionParts(); later capabilities add their pair here.
   static const std::vector<WindowSessionPart> kParts = {
       {"models", &captureModels, &restoreModels},
+      {"fits", &captureFits, &restoreFits},
       {"view", &captureView, &restoreView},
   };
   return kParts;

@@ -20,6 +20,7 @@
 #include "core/ident/blackbox.h"
 #include "core/ident/nonparametric.h"
 #include "core/models/physical_models.h"
+#include "core/session/fit_request.h"
 #include "widgets/ident_data.h"
 
 namespace flexarm {
@@ -43,7 +44,28 @@ struct Request {
   PemOptions pem;
   ClosedLoopMethod closedLoop = ClosedLoopMethod::TwoStage;
   int maxIterations = 100;
+  std::shared_ptr<FitRequest> record;  // the request as a session stores it
 };
+
+// The request a session stores for this fit: the same start, options and ranges.
+std::shared_ptr<FitRequest> recordOf(const Request& req, const Workspace& ws, int decimation) {
+  auto r = std::make_shared<FitRequest>();
+  if (req.physical) {
+    r->start = clonePhysical(*req.model);
+    r->noiseModel = req.pem.noiseModel;
+    r->randomStarts = req.pem.randomStarts;
+    r->seed = req.pem.seed;
+  } else {
+    r->structure = req.structure;
+    r->orders = req.orders;
+  }
+  r->decimation = decimation;
+  r->maxIterations = req.maxIterations;
+  r->closedLoop = req.closedLoop;
+  if (auto e = ws.range(RangeKind::Estimation)) r->estimation = SecondsRange{e->start, e->end};
+  if (auto v = ws.range(RangeKind::Validation)) r->validation = SecondsRange{v->start, v->end};
+  return r;
+}
 
 }  // namespace
 
@@ -388,101 +410,55 @@ void FitPanel::estimate() {
     summary_->setText(why);
     return;
   }
+  req.record = recordOf(req, *workspace_, decimation_->value());
   table_->setRowCount(0);
   summary_->setText(tr("Estimating on %1 samples (%2)...")
                         .arg(data->estimation.size())
                         .arg(data->note));
   startProgress();
   const auto progress = progressCallback();
-  watcher_.setFuture(QtConcurrent::run([req, sig = std::move(*data), progress]() {
+  // The fit runs as a session replays it (core/session/fit_request.h), so a saved session
+  // reproduces the numbers shown here.
+  watcher_.setFuture(QtConcurrent::run([record = req.record, name = req.name,
+                                        source = *workspace_->current(), progress]() {
     Outcome out;
-    out.note = sig.note;
-    const auto b = static_cast<Eigen::Index>(sig.estimation.begin);
-    const auto n = static_cast<Eigen::Index>(sig.estimation.size());
-    const Eigen::VectorXd u = sig.u.segment(b, n), y = sig.y.segment(b, n);
-    const double T = sig.sampleTime;
+    out.request = record;
+    FitRun run;
     try {
-      if (req.physical) {
-        PemOptions po = req.pem;
-        if (po.randomStarts > 0) {  // two more starts matching the SPA notches and peaks
-          const NonparametricEstimate sp = spa(u, y, T);
-          const auto np = notchesAndPeaks(sp.response, 3.0);
-          po.targetNotches = np.notches;
-          po.targetPeaks = np.peaks;
-          if (!np.notches.empty() || !np.peaks.empty()) po.notchPeakStarts = 2;
-        }
-        ClosedLoopPemOptions co;
-        co.pem = po;
-        co.method = req.closedLoop == ClosedLoopMethod::TwoStage && sig.r.size() == sig.u.size() &&
-                            po.noiseModel == NoiseModel::OutputError
-                        ? ClosedLoopMethod::TwoStage
-                        : ClosedLoopMethod::Direct;
-        const Eigen::VectorXd r0 =
-            co.method == ClosedLoopMethod::TwoStage ? Eigen::VectorXd(sig.r.segment(b, n))
-                                                    : Eigen::VectorXd();
-        ClosedLoopPemResult cl = pemClosedLoop(*req.model, u, y, r0, T, co, progress);
-        if (cl.method == ClosedLoopMethod::TwoStage && cl.projection.ok)
-          out.note += QObject::tr(", two-stage closed-loop fit: the reference explains %1 % of "
-                                  "the input, intervals allow coloured errors")
-                          .arg(cl.projection.fitPercent, 0, 'f', 1);
-        else if (sig.r.size() > 0)
-          out.note += QObject::tr(", direct fit of closed-loop data");
-        PemResult r = std::move(cl.pem);
-        out.summary = r.summary;
-        for (const auto& p : r.parameters)
-          out.rows.push_back({QString::fromStdString(p.name), QString::fromStdString(p.unit),
-                              p.value, p.std, p.lower, p.upper, p.free});
-        auto estimated = clonePhysical(*r.model);
-        out.entry.model = estimated;
-        const int pf = static_cast<int>(r.freeIndices.size());
-        if (r.covariance.rows() >= pf && pf > 0) {
-          out.entry.covariance = r.covariance.topLeftCorner(pf, pf);
-          out.entry.covarianceIndices = r.freeIndices;
-        }
-        out.entry.name = req.name;
-        out.estimate = estimated;
-        out.u = u;
-        out.y = y;
-        out.sampleTime = T;
-      } else {
-        PolyEstimateOptions po;
-        po.maxIterations = req.maxIterations;
-        PolyEstimate r = estimatePolynomial(u, y, req.structure, req.orders, T, po, progress);
-        out.summary = r.summary;
-        const auto names = r.model.parameterNames();
-        const Eigen::VectorXd th = r.model.parameterVector(), sd = r.model.standardDeviations();
-        const double z = twoSidedNormalQuantile(0.99);
-        for (std::size_t i = 0; i < names.size(); ++i) {
-          const double s = sd.size() ? sd[static_cast<Eigen::Index>(i)] : 0.0;
-          const double v = th[static_cast<Eigen::Index>(i)];
-          out.rows.push_back({QString::fromStdString(names[i]), QString(), v, s, v - z * s,
-                              v + z * s, true});
-        }
-        out.entry.polynomial = std::make_shared<PolynomialModel>(r.model);
-        out.entry.name = QString::fromStdString(r.model.name());
-      }
+      run = runFitRequest(*record, source, progress);
     } catch (const std::exception& e) {
       out.error = QString::fromStdString(e.what());
       return out;
     }
-    if (out.summary.termination == Termination::Cancelled ||
-        out.summary.termination == Termination::Failed)
+    out.note = QString::fromStdString(run.data.note);
+    out.summary = run.summary;
+    if (!run.summary.ok()) {
+      if (out.summary.message.empty()) out.error = QString::fromStdString(run.message);
       return out;
-    QString reason;
-    if (auto sim = simulateEntry(out.entry, u, T, &reason))
-      out.fitEstimation = fitPercent(y, *sim);
-    if (!sig.validation.empty()) {  // simulated from the log's first sample (no transient)
-      if (auto sim = simulateEntry(out.entry, sig.u, T, &reason)) {
-        out.hasValidation = true;
-        out.fitValidation = fitPercent(sig.y, *sim, static_cast<Eigen::Index>(sig.validation.begin),
-                                       static_cast<Eigen::Index>(sig.validation.end));
-      }
     }
-    const double wmin = 2.0 * M_PI / (static_cast<double>(n) * T);
-    const auto fr = responseOf(out.entry, logGrid(wmin, M_PI / T, 2000), 0.99);
-    const auto np = notchesAndPeaks(fr, 1.0);
-    out.notches = np.notches;
-    out.peaks = np.peaks;
+    for (const auto& p : run.parameters)
+      out.rows.push_back({QString::fromStdString(p.name), QString::fromStdString(p.unit), p.value,
+                          p.std, p.lower, p.upper, p.free});
+    if (run.physical) {
+      out.entry.model = run.physical;
+      out.entry.covariance = run.covariance;
+      out.entry.covarianceIndices = run.freeIndices;
+      out.entry.name = name;
+      out.estimate = run.physical;
+      const auto b = static_cast<Eigen::Index>(run.data.estimation.begin);
+      const auto n = static_cast<Eigen::Index>(run.data.estimation.size());
+      out.u = run.data.u.segment(b, n);
+      out.y = run.data.y.segment(b, n);
+      out.sampleTime = run.data.sampleTime;
+    } else {
+      out.entry.polynomial = run.polynomial;
+      out.entry.name = QString::fromStdString(run.polynomial->name());
+    }
+    out.fitEstimation = run.fitEstimation;
+    out.hasValidation = run.fitValidation.has_value();
+    out.fitValidation = run.fitValidation.value_or(0.0);
+    out.notches = run.notches;
+    out.peaks = run.peaks;
     return out;
   }));
   updateControls();  // Cancel on, Estimate off while the future runs
@@ -541,6 +517,8 @@ void FitPanel::onFinished() {
   };
   while (taken(name)) name = out.entry.name + tr(" estimate %1").arg(++k);
   out.entry.name = name;
+  out.request->name = name.toStdString();
+  out.entry.fitRequest = out.request;
   lines << tr("Added to the model list as \"%1\".").arg(name);
   summary_->setText(lines.join("\n"));
   if (out.estimate) last_ = out;  // the study runs on the latest physical estimate

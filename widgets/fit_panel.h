@@ -79,6 +79,7 @@ class FitPanel : public QWidget {
     double fitEstimation = 0, fitValidation = 0;
     bool hasValidation = false;
     std::vector<double> notches, peaks;
+    std::shared_ptr<FitRequest> request;  // what was asked, kept with the estimate
     // What the sensitivity study needs (physical estimates only).
     std::shared_ptr<const ParametricModel> estimate;
     Eigen::VectorXd u, y;

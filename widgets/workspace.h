@@ -18,6 +18,8 @@ class QUndoStack;
 
 namespace flexarm {
 
+struct FitRequest;  // core/session/fit_request.h
+
 enum class RangeKind { Estimation, Validation };
 
 struct TimeRange {
@@ -38,6 +40,9 @@ struct ModelEntry {
   // edit of the parameters clears it.
   Eigen::MatrixXd covariance;
   std::vector<int> covarianceIndices;
+  // For an estimate of the Fit panel: what was asked (structure, start values, free
+  // parameters, options, ranges), so a session can store and replay the fit.
+  std::shared_ptr<const FitRequest> fitRequest;
 };
 
 class Workspace : public QObject {

@@ -5,6 +5,18 @@
 
 namespace flexarm {
 
+void thinSeries(std::vector<double>& x, std::vector<double>& y, std::size_t n) {
+  if (x.size() <= n || n == 0) return;
+  const std::size_t step = (x.size() + n - 1) / n;
+  std::size_t k = 0;
+  for (std::size_t i = 0; i < x.size(); i += step, ++k) {
+    x[k] = x[i];
+    y[k] = y[i];
+  }
+  x.resize(k);
+  y.resize(k);
+}
+
 std::string formatFixed(double v, int decimals) {
   if (!std::isfinite(v)) return "n/a";
   char buf[64];

@@ -20,12 +20,14 @@ struct ReportSeries {
   std::string name;
   std::vector<double> x, y;
   bool dashed = false;
+  int color = -1;  // palette index; -1: by the series' position (bounds share a colour)
 };
 
 struct ReportPlot {
   std::string title, xLabel, yLabel;
   bool logX = false, logY = false;
   std::vector<ReportSeries> series;
+  bool legendBottomLeft = false;  // where the curves leave room (Bode plots); else top right
 };
 
 struct ReportSection {
@@ -52,6 +54,9 @@ struct Report {
   // Provenance, warnings and every section's title and values (no plot data).
   nlohmann::json toJson() const;
 };
+
+// Keeps at most n points of a series, evenly strided, for plots.
+void thinSeries(std::vector<double>& x, std::vector<double>& y, std::size_t n);
 
 // Fixed-point text with `decimals` digits, as reports print fit % ("87.31").
 std::string formatFixed(double v, int decimals);

@@ -10,6 +10,7 @@
 #include "core/ident/evaluation.h"
 #include "core/models/analysis.h"
 #include "core/models/nonlinear_plant.h"
+#include "core/session/fit_request.h"
 #include "core/session/model_json.h"
 #include "core/session/session_part.h"
 #include "core/signal/preprocess.h"
@@ -21,19 +22,6 @@ using nlohmann::json;
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;
-
-// At most n points of a series, evenly strided, for plots.
-void thin(std::vector<double>& x, std::vector<double>& y, std::size_t n) {
-  if (x.size() <= n) return;
-  const std::size_t step = (x.size() + n - 1) / n;
-  std::size_t k = 0;
-  for (std::size_t i = 0; i < x.size(); i += step, ++k) {
-    x[k] = x[i];
-    y[k] = y[i];
-  }
-  x.resize(k);
-  y.resize(k);
-}
 
 // The model list: each model's parameters (value, unit, free flag), effects, notch and peak
 // frequencies (5.4), Bode plot, and its simulation fit % (5.2) on the estimation and
@@ -175,8 +163,8 @@ class ModelsPart : public SessionPart {
     sim.x = meas.x;
     sim.y.assign(simulated.begin() + static_cast<std::ptrdiff_t>(plotRange->begin),
                  simulated.begin() + static_cast<std::ptrdiff_t>(plotRange->end));
-    thin(meas.x, meas.y, 3000);
-    thin(sim.x, sim.y, 3000);
+    thinSeries(meas.x, meas.y, 3000);
+    thinSeries(sim.x, sim.y, 3000);
     s.plots.push_back(ReportPlot{"Measured and simulated motor velocity, " + spec.name, "time (s)",
                                  "motor velocity (rad/s)", false, false, {meas, sim}});
   }
@@ -200,6 +188,7 @@ const std::vector<std::shared_ptr<const SessionPart>>& sessionParts() {
   // Report order. Identification, discovery, LQG and later capabilities add their part here.
   static const std::vector<std::shared_ptr<const SessionPart>> kParts = {
       std::make_shared<ModelsPart>(),
+      makeFitsPart(),
       std::make_shared<ViewPart>(),
   };
   return kParts;

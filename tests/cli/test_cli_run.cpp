@@ -25,7 +25,11 @@ std::string pdfText(const std::string& pdf) {
   const std::string txt = pdf + ".txt";
   const std::string cmd = "pdftotext -layout '" + pdf + "' '" + txt + "'";
   EXPECT_EQ(std::system(cmd.c_str()), 0) << cmd;
-  return readAll(txt);
+  // The PDF's font sets "fi" and "fl" as ligatures; read them as letters.
+  std::string text = readAll(txt);
+  for (const auto& [lig, letters] : {std::pair<std::string, std::string>{"\xef\xac\x81", "fi"}, {"\xef\xac\x82", "fl"}})
+    for (std::size_t at; (at = text.find(lig)) != std::string::npos;) text.replace(at, lig.size(), letters);
+  return text;
 }
 
 }  // namespace
@@ -39,7 +43,9 @@ TEST(CliRun, JsonNamesVersionLogChecksumAndEveryModel) {
   EXPECT_EQ(j["logs"][0]["sha256"], session["logs"][0]["sha256"]);
   std::vector<std::string> titles;
   for (const auto& s : j["sections"]) titles.push_back(s["title"]);
-  EXPECT_EQ(titles, (std::vector<std::string>{"Data", "Model three-mass", "Model two-mass"}));
+  EXPECT_EQ(titles, (std::vector<std::string>{"Data", "Model three-mass", "Model two-mass",
+                                              "Non-parametric estimate (SPA)",
+                                              "Fit three-mass estimate"}));
   EXPECT_EQ(j["sections"][0]["values"]["rate_hz"].get<double>(), 200.0);
 }
 
@@ -54,7 +60,7 @@ TEST(CliRun, PdfTextHasTitlesParametersChecksumAndTheJsonFitPercent) {
   ASSERT_FALSE(text.empty());
   EXPECT_NE(text.find("FlexArm " FLEXARM_VERSION), std::string::npos);
   EXPECT_NE(text.find(j["logs"][0]["sha256"].get<std::string>()), std::string::npos);
-  int fits = 0;
+  int fits = 0, stds = 0;
   for (const auto& s : j["sections"]) {
     EXPECT_NE(text.find(s["title"].get<std::string>()), std::string::npos) << s["title"];
     if (!s["values"].contains("parameters")) continue;
@@ -66,8 +72,28 @@ TEST(CliRun, PdfTextHasTitlesParametersChecksumAndTheJsonFitPercent) {
       EXPECT_NE(text.find(buf), std::string::npos) << key << " " << buf;
       ++fits;
     }
+    if (!s["values"].contains("std")) continue;
+    // An estimate's table row: the name, its value and its std as printed (4 and 3 digits).
+    for (const auto& [name, sd] : s["values"]["std"].items()) {
+      if (sd.get<double>() == 0.0) continue;  // fixed
+      char value[32], sdText[32];
+      std::snprintf(value, sizeof value, "%.6g", s["values"]["parameters"][name].get<double>());
+      std::snprintf(sdText, sizeof sdText, "%.3g", sd.get<double>());
+      const std::regex row(name + R"(\s+)" + std::regex_replace(value, std::regex(R"([.+])"), R"(\$&)") +
+                           R"(\s+)" + std::regex_replace(sdText, std::regex(R"([.+])"), R"(\$&)") + R"(\s)");
+      EXPECT_TRUE(std::regex_search(text, row)) << name << " " << value << " +- " << sdText;
+      ++stds;
+    }
   }
-  EXPECT_EQ(fits, 4);
+  EXPECT_EQ(fits, 6);  // two models and the estimate, each on both ranges
+  EXPECT_EQ(stds, 5);  // the estimate's free parameters
+  for (const char* title : {"Estimated parameters (value +- std, 99 % interval)", "Loss and fit % (5.2)",
+                            "Notches and peaks of the estimate (5.4)", "Residual tests on the validation range",
+                            "Bode magnitude, three-mass estimate with its 99 % band",
+                            "Measured and simulated output on the validation range",
+                            "Residual autocorrelation", "Cross-correlation of residuals and input",
+                            "Bode magnitude, SPA of the estimation data"})
+    EXPECT_NE(text.find(title), std::string::npos) << title;
 }
 
 TEST(CliRun, HtmlIsSelfContained) {
@@ -87,7 +113,9 @@ TEST(CliRun, HtmlIsSelfContained) {
     EXPECT_EQ((*it)[1].str().rfind("data:image/png", 0), 0u) << (*it)[1].str();
     ++images;
   }
-  EXPECT_GE(images, 6);  // Bode magnitude, phase and compare plot of each of the two models
+  // Bode magnitude, phase and compare plot of each of the two models; the SPA's Bode plots;
+  // the estimate's Bode, compare and two correlation plots.
+  EXPECT_GE(images, 6 + 2 + 5);
 }
 #else
 TEST(CliRun, ReportsAreRefusedWithoutTheGui) {

@@ -1,0 +1,233 @@
+// The session part "fits": requests survive their JSON form, malformed ones are refused with
+// a sentence, and replaying the sample session identifies the three-mass arm of the chirp
+// log (Table 5.7 p6 truth) with 99 % intervals (5.7), fit % (5.2), notches and peaks (5.4)
+// and residual tests, the same on every replay.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <map>
+
+#include "core/models/analysis.h"
+#include "core/session/fit_request.h"
+#include "core/session/replay.h"
+#include "core/session/session.h"
+
+using namespace flexarm;
+using nlohmann::json;
+
+namespace {
+
+const std::string kSample = std::string(FLEXARM_SAMPLE_DIR) + "/sample_session.json";
+const std::string kTruth =
+    std::string(FLEXARM_SAMPLE_DIR) + "/three_mass_estimation_chirp.truth.json";
+
+const json* section(const json& report, const std::string& title) {
+  for (const auto& s : report["sections"])
+    if (s["title"] == title) return &s["values"];
+  return nullptr;
+}
+
+std::map<std::string, double> truth() {
+  std::ifstream in(kTruth);
+  const json t = json::parse(in);
+  std::map<std::string, double> out;
+  for (const auto& p : t["model"]["parameters"]) out[p["name"]] = p["value"].get<double>();
+  return out;
+}
+
+FitRequest blackBoxRequest() {
+  FitRequest r;
+  r.name = "oe[4 4 1]";
+  r.structure = PolyStructure::Oe;
+  r.orders.na = 0;
+  r.orders.nb = 4;
+  r.orders.nf = 4;
+  r.orders.nk = 1;
+  r.decimation = 2;
+  r.estimation = SecondsRange{0.5, 12.0};
+  return r;
+}
+
+}  // namespace
+
+TEST(FitRequest, JsonRoundTripKeepsEveryField) {
+  FitRequest p;
+  p.name = "three-mass estimate";
+  auto start = makeModel("three-mass");
+  for (const auto& q : start->parameters()) start->setFree(q.name, q.name == "k_g" || q.name == "J_a");
+  start->setParameter("k_g", 123456.0);
+  p.start = std::move(start);
+  p.noiseModel = NoiseModel::Innovations;
+  p.randomStarts = 3;
+  p.seed = 7;
+  p.decimation = 5;
+  p.maxIterations = 40;
+  p.estimation = SecondsRange{0.5, 12.0};
+  p.validation = SecondsRange{12.0, 17.5};
+  std::string why;
+  auto back = fitRequestFromJson(fitRequestToJson(p), &why);
+  ASSERT_TRUE(back) << why;
+  EXPECT_EQ(fitRequestToJson(*back).dump(), fitRequestToJson(p).dump());
+  EXPECT_TRUE(back->physical());
+  EXPECT_EQ(back->start->value("k_g"), 123456.0);
+  EXPECT_EQ(back->noiseModel, NoiseModel::Innovations);
+  EXPECT_EQ(back->seed, 7u);
+  EXPECT_EQ(*back->validation, (SecondsRange{12.0, 17.5}));
+
+  auto bb = fitRequestFromJson(fitRequestToJson(blackBoxRequest()), &why);
+  ASSERT_TRUE(bb) << why;
+  EXPECT_FALSE(bb->physical());
+  EXPECT_EQ(bb->orders.nf, 4);
+  EXPECT_FALSE(bb->validation.has_value());
+}
+
+TEST(FitRequest, MalformedRequestsAreRefusedWithASentence) {
+  json j = fitRequestToJson(blackBoxRequest());
+  std::string why;
+  json bad = j;
+  bad["structure"] = "narx";
+  EXPECT_FALSE(fitRequestFromJson(bad, &why));
+  EXPECT_NE(why.find("arx, armax, oe or bj"), std::string::npos) << why;
+  bad = j;
+  bad["decimation"] = 0;
+  EXPECT_FALSE(fitRequestFromJson(bad, &why));
+  EXPECT_NE(why.find("decimation"), std::string::npos) << why;
+  bad = j;
+  bad["estimation_s"] = {12.0, 0.5};
+  EXPECT_FALSE(fitRequestFromJson(bad, &why));
+  EXPECT_NE(why.find("start < end"), std::string::npos) << why;
+  bad = j;
+  bad["orders"]["nb"] = 0;  // no input term
+  EXPECT_FALSE(fitRequestFromJson(bad, &why));
+  EXPECT_NE(why.find("orders"), std::string::npos) << why;
+
+  // A physical request without a free parameter is refused, and so is a session holding it.
+  FitRequest p;
+  p.name = "fixed";
+  auto start = makeModel("two-mass");
+  for (const auto& q : start->parameters()) start->setFree(q.name, false);
+  p.start = std::move(start);
+  EXPECT_FALSE(fitRequestFromJson(fitRequestToJson(p), &why));
+  EXPECT_NE(why.find("free parameter"), std::string::npos) << why;
+  auto loaded = loadSession(kSample);
+  ASSERT_TRUE(loaded.ok) << loaded.message;
+  loaded.session.parts["fits"]["requests"].push_back(fitRequestToJson(p));
+  const auto parsed = parseSession(toJsonText(loaded.session));
+  EXPECT_FALSE(parsed.ok);
+  EXPECT_NE(parsed.message.find("fits"), std::string::npos) << parsed.message;
+}
+
+TEST(FitsPart, SampleSessionIdentifiesTheThreeMassArm) {
+  auto loaded = loadSession(kSample);
+  ASSERT_TRUE(loaded.ok) << loaded.message;
+  ReplayResult r = replaySession(loaded.session, kSample);
+  ASSERT_EQ(r.termination, Termination::Converged) << r.message;
+  const json j = r.report.toJson();
+  const json* fit = section(j, "Fit three-mass estimate");
+  ASSERT_NE(fit, nullptr) << j.dump(1);
+  EXPECT_EQ((*fit)["termination"], "converged");
+  const auto t = truth();
+  // The free parameters start 12-32 % off the truth. The log is closed loop and decimated to
+  // 200 Hz, so the output-error estimate is biased by the noise fed back into the input
+  // (4.43): on this log J_m and J_g land 14-16 % off (random starts find the same minimum),
+  // far beyond their 99 % intervals; the springs and J_a within 10 %.
+  for (const char* p : {"J_m", "J_g", "J_a", "k_g", "k_a"}) {
+    const double v = (*fit)["parameters"][p].get<double>(), s = (*fit)["std"][p].get<double>();
+    EXPECT_GT(s, 0.0) << p;
+    const double tol = std::string(p) == "J_m" || std::string(p) == "J_g" ? 0.20 : 0.10;
+    EXPECT_NEAR(v / t.at(p), 1.0, tol) << p << " = " << v << " +- " << s;
+  }
+  for (const char* p : {"f_m", "d_g", "d_a"}) {  // held at their start values
+    EXPECT_EQ((*fit)["std"][p].get<double>(), 0.0) << p;
+    EXPECT_EQ((*fit)["parameters"][p].get<double>(), t.at(p)) << p;
+  }
+  EXPECT_GT((*fit)["fit_estimation_percent"].get<double>(), 75.0);
+  EXPECT_GT((*fit)["fit_validation_percent"].get<double>(), 75.0);
+  EXPECT_GT((*fit)["loss"].get<double>(), 0.0);
+  // Three masses: two anti-resonances and two resonances (5.4), each within 10 % of the
+  // truth's, which the resonances determine better than single parameters.
+  const StateSpace truthSys = makeModel("three-mass")->stateSpace();
+  const auto truthNotches = notchFrequencies(truthSys), truthPeaks = peakFrequencies(truthSys);
+  ASSERT_EQ((*fit)["notches_rad_s"].size(), truthNotches.size());
+  ASSERT_EQ((*fit)["peaks_rad_s"].size(), truthPeaks.size());
+  ASSERT_EQ(truthPeaks.size(), 2u);
+  for (std::size_t i = 0; i < 2; ++i) {
+    EXPECT_NEAR((*fit)["notches_rad_s"][i].get<double>() / truthNotches[i].frequency, 1.0, 0.10) << i;
+    EXPECT_NEAR((*fit)["peaks_rad_s"][i].get<double>() / truthPeaks[i].frequency, 1.0, 0.10) << i;
+  }
+  // Closed-loop output error leaves coloured residuals: the tests say so.
+  EXPECT_FALSE((*fit)["residuals"]["white"].get<bool>());
+
+  // The SPA of the estimation range (0.5-12 s at 200 Hz) with SITB's lag window min(N/10, 30).
+  const json* np = section(j, "Non-parametric estimate (SPA)");
+  ASSERT_NE(np, nullptr);
+  const json* data = section(j, "Data");
+  ASSERT_NE(data, nullptr);
+  EXPECT_EQ((*np)["samples"], (*data)["ranges"]["estimation"]["samples"]);
+  EXPECT_EQ((*np)["lag_window"].get<int>(), 30);
+
+  // The report's parameter table shows value, std and the 99 % interval (z = 2.576).
+  const ReportSection* rs = nullptr;
+  for (const auto& s : r.report.sections)
+    if (s.title == "Fit three-mass estimate") rs = &s;
+  ASSERT_NE(rs, nullptr);
+  const auto& rows = rs->tables.at(0).rows;
+  int checked = 0;
+  for (const auto& row : rows) {
+    if (row[2] == "fixed") continue;
+    const double v = std::stod(row[1]), s = std::stod(row[2]);
+    const double lo = std::stod(row[3]), hi = std::stod(row[4]);
+    EXPECT_NEAR((hi - lo) / 2.0, 2.576 * s, 0.01 * s + 1e-5 * std::abs(v)) << row[0];
+    ++checked;
+  }
+  EXPECT_EQ(checked, 5);
+  // Bode magnitude with its band, phase, compare, and two correlation plots.
+  ASSERT_EQ(rs->plots.size(), 5u);
+  EXPECT_EQ(rs->plots[0].series.size(), 3u);
+}
+
+TEST(FitsPart, BlackBoxRequestIsReplayedAtItsDecimatedRate) {
+  auto loaded = loadSession(kSample);
+  ASSERT_TRUE(loaded.ok) << loaded.message;
+  Session s = loaded.session;
+  FitRequest bb = blackBoxRequest();
+  bb.validation = SecondsRange{12.0, 17.5};
+  s.parts["fits"]["requests"] = json::array({fitRequestToJson(bb)});
+  s.parts["fits"]["nonparametric"] = false;
+  ReplayResult r = replaySession(s, kSample);
+  ASSERT_EQ(r.termination, Termination::Converged) << r.message;
+  const json j = r.report.toJson();
+  EXPECT_EQ(section(j, "Non-parametric estimate (SPA)"), nullptr);
+  const json* fit = section(j, "Fit oe[4 4 1]");
+  ASSERT_NE(fit, nullptr);
+  EXPECT_EQ((*fit)["parameters"].size(), 8u);  // b1..b4, f1..f4
+  EXPECT_GT((*fit)["fit_validation_percent"].get<double>(), 50.0);
+  // The same request on the same data gives the same numbers.
+  auto prepared = prepareSession(s, kSample);
+  ASSERT_TRUE(prepared.ok) << prepared.message;
+  const FitRun run = runFitRequest(bb, prepared.logs[0].data);
+  ASSERT_TRUE(run.polynomial);
+  EXPECT_NEAR(run.polynomial->sampleTime, 0.01, 1e-12);  // 200 Hz decimated by 2
+  EXPECT_EQ(run.fitValidation.value(), (*fit)["fit_validation_percent"].get<double>());
+}
+
+TEST(FitsPart, DataFailuresBecomeSentences) {
+  auto loaded = loadSession(kSample);
+  ASSERT_TRUE(loaded.ok) << loaded.message;
+  Session s = loaded.session;
+  FitRequest bb = blackBoxRequest();
+  bb.estimation = SecondsRange{100.0, 200.0};  // beyond the log's 18 s
+  s.parts["fits"]["requests"] = json::array({fitRequestToJson(bb)});
+  ReplayResult r = replaySession(s, kSample);
+  ASSERT_EQ(r.termination, Termination::Converged) << r.message;
+  for (const auto& sec : r.report.sections)
+    if (sec.title == "Fit oe[4 4 1]") {
+      ASSERT_FALSE(sec.paragraphs.empty());
+      EXPECT_NE(sec.paragraphs.back().find("No fit: the estimation range holds only"), std::string::npos)
+          << sec.paragraphs.back();
+      return;
+    }
+  FAIL() << "no fit section";
+}
