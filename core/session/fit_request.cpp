@@ -130,6 +130,8 @@ std::optional<FitRequest> fitRequestFromJson(const json& j, std::string* why) {
                           "\" or \"" + toString(NoiseModel::Innovations) + "\"");
       r.noiseModel = *m;
     }
+    // Sessions written before fits stored their closed-loop method ran direct fits.
+    r.closedLoop = ClosedLoopMethod::Direct;
     if (j.contains("closed_loop")) {
       auto m = j["closed_loop"].is_string() ? closedLoopMethodFromString(j["closed_loop"].get<std::string>())
                                             : std::nullopt;
