@@ -48,8 +48,13 @@ std::vector<std::string> splitComma(const std::string& text) {
   return out;
 }
 
-// Decimates every channel when asked (anti-alias FIR of the preprocess module).
-bool prepareData(IdData& data, int decimation, std::ostream& err, const std::string& verb) {
+// Physical models give the motor velocity: a log whose output is the motor angle gets the
+// velocity by differentiation first, as the seed does (Section 5.2). Then decimates every
+// channel when asked (anti-alias FIR of the preprocess module).
+bool prepareData(IdData& data, int decimation, std::ostream& err, const std::string& verb,
+                 bool velocityOutput) {
+  if (velocityOutput && data.output() && data.output()->name == columns::kMotorAngle)
+    data = addDerivative(data);
   if (decimation > 1) {
     DecimateOptions d;
     d.factor = decimation;
@@ -262,7 +267,8 @@ int prepareAndFit(ArgParser& args, const std::string& verb, FitOutcome& out, std
     err << "flexarm: " << args.positional()[0] << ": the log has no input or no output channel\n";
     return kExitBadInput;
   }
-  if (!prepareData(*data, static_cast<int>(decimation), err, verb)) return kExitUsage;
+  if (!prepareData(*data, static_cast<int>(decimation), err, verb, out.spec.physical))
+    return kExitUsage;
   SampleRange est{0, data->samples()};
   if (auto r = args.value("range")) {
     if (!parseTimeRange(*r, *data, est, &why)) {
@@ -292,7 +298,8 @@ int prepareAndFit(ArgParser& args, const std::string& verb, FitOutcome& out, std
   if (auto vlog = args.value("validation-log")) {
     auto vdata = loadLog(*vlog, *readOptions, err);
     if (!vdata) return kExitBadInput;
-    if (!prepareData(*vdata, static_cast<int>(decimation), err, verb)) return kExitUsage;
+    if (!prepareData(*vdata, static_cast<int>(decimation), err, verb, out.spec.physical))
+      return kExitUsage;
     if (std::abs(vdata->sampleTime - data->sampleTime) > 1e-9 * data->sampleTime) {
       err << "flexarm: " << *vlog << ": its sample time differs from the estimation log's\n";
       return kExitBadInput;

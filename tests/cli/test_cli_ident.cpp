@@ -224,3 +224,27 @@ TEST(CliIdent, BadRequestsExitWithUsageBadInputOrNumericalCodes) {
   EXPECT_EQ(r.code, 4) << r.out << r.err;
   EXPECT_NE(r.err.find("fit failed"), std::string::npos) << r.err;
 }
+
+// A physical model gives the motor velocity: the chirp sample log, whose output is the motor
+// angle, is differentiated first (Section 5.2) and the two-stage closed-loop fit recovers the
+// truth of its sidecar (Table 5.7 p6) inside the 99 % intervals (z = 2.576).
+TEST(CliIdent, PhysicalFitOfTheAngleLogDifferentiatesAndRecoversTheTruth) {
+  auto r = runFlexarm({"fit", std::string(FLEXARM_SAMPLE_DIR) + "/three_mass_estimation_chirp.csv",
+                       "--model", "three-mass", "--free", "J_m,J_a,k_g,k_a", "--json"});
+  ASSERT_EQ(r.code, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["closed_loop_method"], "two-stage");
+  EXPECT_GT(j["fit_percent"].get<double>(), 70.0);
+  const auto truth = nlohmann::json::parse(
+      readAll(std::string(FLEXARM_SAMPLE_DIR) + "/three_mass_estimation_chirp.truth.json"));
+  int checked = 0;
+  for (const auto& p : truth["model"]["parameters"]) {
+    const std::string name = p["name"];
+    if (name != "J_m" && name != "J_a" && name != "k_g" && name != "k_a") continue;
+    const double v = j["parameters"][name].get<double>(), s = j["std"][name].get<double>();
+    EXPECT_GT(s, 0.0) << name;
+    EXPECT_LE(std::abs(v - p["value"].get<double>()), 2.576 * s) << name << " = " << v << " +- " << s;
+    ++checked;
+  }
+  EXPECT_EQ(checked, 4);
+}
