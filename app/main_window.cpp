@@ -27,6 +27,7 @@
 #include <sstream>
 
 #include "app/cli/cli.h"
+#include "app/recent_files.h"
 #include "app/session_controller.h"
 #include "core/io/ranges.h"
 #include "widgets/arm_panel.h"
@@ -327,17 +328,10 @@ void MainWindow::exportData() {
     statusBar()->showMessage(tr("Wrote %1 (%2 samples)").arg(path).arg(d.samples()), 6000);
 }
 
-QStringList MainWindow::recentFiles() const {
-  return QSettings().value("recentFiles").toStringList();
-}
+QStringList MainWindow::recentFiles() const { return recentList("recentFiles"); }
 
 void MainWindow::addRecent(const QString& path) {
-  QStringList list = recentFiles();
-  const QString abs = QFileInfo(path).absoluteFilePath();
-  list.removeAll(abs);
-  list.prepend(abs);
-  while (list.size() > kMaxRecent) list.removeLast();
-  QSettings().setValue("recentFiles", list);
+  addToRecentList("recentFiles", path, kMaxRecent);
   rebuildRecentMenu();
 }
 

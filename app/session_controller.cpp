@@ -1,5 +1,7 @@
 #include "app/session_controller.h"
 
+#include "app/recent_files.h"
+
 #include <QAction>
 #include <QFile>
 #include <QFileDialog>
@@ -347,17 +349,10 @@ void SessionController::markDirty() {
   if (!restoring_) dirty_ = true;
 }
 
-QStringList SessionController::recentSessions() const {
-  return QSettings().value("sessions/recent").toStringList();
-}
+QStringList SessionController::recentSessions() const { return recentList("sessions/recent"); }
 
 void SessionController::addRecent(const QString& path) {
-  QStringList list = recentSessions();
-  const QString abs = QFileInfo(path).absoluteFilePath();
-  list.removeAll(abs);
-  list.prepend(abs);
-  while (list.size() > kMaxRecentSessions) list.removeLast();
-  QSettings().setValue("sessions/recent", list);
+  addToRecentList("sessions/recent", path, kMaxRecentSessions);
   rebuildRecent();
 }
 
