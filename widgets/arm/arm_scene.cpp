@@ -91,25 +91,21 @@ ArmScene::ArmScene()
   shoulderActor->SetUserTransform(shoulderT);
   renderer_->AddActor(shoulderActor);
 
-  // Lower arm: a box from the shoulder upwards.
-  auto lower = vtkSmartPointer<vtkCubeSource>::New();
-  lower->SetXLength(0.14);
-  lower->SetYLength(0.16);
-  lower->SetZLength(0.6);
-  lower->SetCenter(0, 0, 0.3);
-  auto lowerActor = makeActor(lower, 0.93, 0.45, 0.1);
-  lowerActor->SetUserTransform(lowerArm_);
-  renderer_->AddActor(lowerActor);
-
-  // Upper arm: horizontal box from the elbow forwards.
-  auto upper = vtkSmartPointer<vtkCubeSource>::New();
-  upper->SetXLength(0.72);
-  upper->SetYLength(0.12);
-  upper->SetZLength(0.12);
-  upper->SetCenter(0.3, 0, 0);
-  auto upperActor = makeActor(upper, 0.95, 0.55, 0.15);
-  upperActor->SetUserTransform(upperArm_);
-  renderer_->AddActor(upperActor);
+  // Links are boxes placed by their joint's transform: the lower arm stands on the shoulder,
+  // the upper arm reaches forwards from the elbow.
+  auto addLink = [this](double lx, double ly, double lz, double cx, double cz, double r,
+                        double g, double b, vtkTransform* joint) {
+    auto box = vtkSmartPointer<vtkCubeSource>::New();
+    box->SetXLength(lx);
+    box->SetYLength(ly);
+    box->SetZLength(lz);
+    box->SetCenter(cx, 0, cz);
+    auto actor = makeActor(box, r, g, b);
+    actor->SetUserTransform(joint);
+    renderer_->AddActor(actor);
+  };
+  addLink(0.14, 0.16, 0.6, 0, 0.3, 0.93, 0.45, 0.1, lowerArm_);
+  addLink(0.72, 0.12, 0.12, 0.3, 0, 0.95, 0.55, 0.15, upperArm_);
 
   // Tool: a cone pointing down at the end of the upper arm.
   auto tool = vtkSmartPointer<vtkConeSource>::New();
