@@ -7,15 +7,30 @@
 
 #include "core/ident/evaluation.h"
 #include "core/ident/levenberg_marquardt.h"
+#include "core/models/physical_models.h"
 
 namespace flexarm {
 
 const char* toString(ClosedLoopMethod m) {
-  return m == ClosedLoopMethod::Direct ? "direct" : "two-stage";
+  switch (m) {
+    case ClosedLoopMethod::Direct: return "direct";
+    case ClosedLoopMethod::TwoStage: return "two-stage";
+    case ClosedLoopMethod::Indirect: return "indirect";
+  }
+  return "direct";
 }
 std::optional<ClosedLoopMethod> closedLoopMethodFromString(std::string_view s) {
-  if (s == "direct") return ClosedLoopMethod::Direct;
-  if (s == "two-stage") return ClosedLoopMethod::TwoStage;
+  for (auto m : {ClosedLoopMethod::Direct, ClosedLoopMethod::TwoStage, ClosedLoopMethod::Indirect})
+    if (s == toString(m)) return m;
+  return std::nullopt;
+}
+
+const char* toString(LoopOutput o) {
+  return o == LoopOutput::MotorAngle ? "motor-angle" : "motor-velocity";
+}
+std::optional<LoopOutput> loopOutputFromString(std::string_view s) {
+  for (auto o : {LoopOutput::MotorAngle, LoopOutput::MotorVelocity})
+    if (s == toString(o)) return o;
   return std::nullopt;
 }
 
@@ -33,7 +48,11 @@ bool ReferenceProjectionOptions::isValid(std::string* why) const {
 }
 
 bool ClosedLoopPemOptions::isValid(std::string* why) const {
-  return projection.isValid(why) && pem.isValid(why);
+  if (method == ClosedLoopMethod::Indirect && pem.noiseModel != NoiseModel::OutputError) {
+    if (why) *why = "the indirect method fits output error; it excludes the innovations form";
+    return false;
+  }
+  return projection.isValid(why) && controller.isValid(why) && pem.isValid(why);
 }
 
 namespace {
@@ -190,6 +209,174 @@ void addStage1Uncertainty(PemResult& est, const ReferenceProjection& proj,
 
 }  // namespace
 
+namespace {
+
+// The closed loop of simulateLoop as one discrete state space in z = [x; a_{k-1}; I_{k-1}]:
+// z+ = Acl z + Bcl r, output Ccl z, with, for each free parameter, dAcl, dBcl, dCcl from the
+// plant's sampled derivatives (the controller does not depend on theta).
+struct LoopMatrices {
+  Eigen::MatrixXd A, B, C;
+  std::vector<Eigen::MatrixXd> dA, dB, dC;
+};
+
+LoopMatrices loopMatrices(const ParametricModel& model, const ControllerOptions& ctl, double T,
+                          const std::vector<int>& free, bool withGradient, LoopOutput output) {
+  std::string why;
+  if (!ctl.isValid(&why)) throw std::invalid_argument("closed loop: " + why);
+  if (std::abs(T * ctl.rateHz - 1.0) > 1e-6)
+    throw std::invalid_argument("closed loop: the sample time must be the controller's period");
+  if (const auto* pm = dynamic_cast<const PhysicalModel*>(&model);
+      pm && pm->options().output != ModelOutput::MotorAngle)
+    throw std::invalid_argument("closed loop: the model's output must be the motor angle");
+  const SampledModel s = sampleZoh(model, T, free, withGradient);
+  if (s.D(0, 0) != 0.0)
+    throw std::invalid_argument("closed loop: the model's output must be the motor angle (D = 0)");
+  const Eigen::Index n = s.Ad.rows();
+  // u = g e + h I_{k-1}, e = kp r - (kp + 1/T) C x + a_{k-1} / T.
+  const double g = ctl.kv * (ctl.ti > 0.0 ? 1.0 + T / ctl.ti : 1.0);
+  const double h = ctl.ti > 0.0 ? ctl.kv / ctl.ti : 0.0;
+  const double kc = ctl.kp + 1.0 / T;
+  // One set of blocks, for the values (constant = true) or for a derivative along theta_j
+  // (the controller's constants drop out; BdC is Bd c or its derivative dBd c + Bd dc).
+  auto build = [&](const Eigen::MatrixXd& Ad, const Eigen::VectorXd& Bd, const Eigen::RowVectorXd& c,
+                   const Eigen::MatrixXd& BdC, bool constant, Eigen::MatrixXd& A,
+                   Eigen::VectorXd& B, Eigen::RowVectorXd& C) {
+    A = Eigen::MatrixXd::Zero(n + 2, n + 2);
+    A.topLeftCorner(n, n) = Ad - g * kc * BdC;
+    A.block(0, n, n, 1) = Bd * (g / T);
+    A.block(0, n + 1, n, 1) = Bd * h;
+    A.block(n, 0, 1, n) = c;
+    A.block(n + 1, 0, 1, n) = -(T * ctl.kp + 1.0) * c;
+    B = Eigen::VectorXd::Zero(n + 2);
+    B.head(n) = Bd * (g * ctl.kp);
+    C = Eigen::RowVectorXd::Zero(n + 2);
+    C.head(n) = output == LoopOutput::MotorAngle ? Eigen::RowVectorXd(c) : Eigen::RowVectorXd(c / T);
+    if (constant) {
+      A(n + 1, n) = A(n + 1, n + 1) = 1.0;
+      B[n + 1] = T * ctl.kp;
+      if (output == LoopOutput::MotorVelocity) C[n] = -1.0 / T;
+    }
+  };
+  LoopMatrices L;
+  Eigen::VectorXd B;
+  Eigen::RowVectorXd C;
+  const Eigen::VectorXd bd = s.Bd.col(0);
+  const Eigen::RowVectorXd c = s.C.row(0);
+  build(s.Ad, bd, c, bd * c, true, L.A, B, C);
+  L.B = B;
+  L.C = C;
+  for (std::size_t j = 0; j < s.dAd.size(); ++j) {
+    Eigen::MatrixXd dA;
+    const Eigen::VectorXd dbd = s.dBd[j].col(0);
+    const Eigen::RowVectorXd dc = s.dC[j].row(0);
+    build(s.dAd[j], dbd, dc, dbd * c + bd * dc, false, dA, B, C);
+    L.dA.push_back(dA);
+    L.dB.push_back(B);
+    L.dC.push_back(C);
+  }
+  return L;
+}
+
+// Output error of the closed loop driven by r against the measured angle y (both relative to
+// the angle at rest), with psi from the loop's sensitivity system (6.27).
+PemEvaluation evaluateLoop(const ParametricModel& model, const ControllerOptions& ctl,
+                           const Eigen::VectorXd& r, const Eigen::VectorXd& y, double T,
+                           const std::vector<int>& free, bool withGradient, LoopOutput output) {
+  if (r.size() != y.size())
+    throw std::invalid_argument("closed loop: reference and output differ in length");
+  const LoopMatrices L = loopMatrices(model, ctl, T, free, withGradient, output);
+  const Eigen::Index m = L.A.rows(), N = y.size();
+  const int p = withGradient ? static_cast<int>(free.size()) : 0;
+  PemEvaluation ev;
+  ev.stable = L.A.eigenvalues().cwiseAbs().maxCoeff() < 1.0;
+  ev.eps.resize(N);
+  if (withGradient) ev.psi.resize(N, p);
+  Eigen::VectorXd z = Eigen::VectorXd::Zero(m);
+  Eigen::MatrixXd Z = Eigen::MatrixXd::Zero(m, p), force(m, p);
+  const Eigen::VectorXd b = L.B.col(0);
+  const Eigen::RowVectorXd c = L.C.row(0);
+  for (Eigen::Index t = 0; t < N; ++t) {
+    const double measured = output == LoopOutput::MotorAngle
+                                ? y[t]
+                                : (y[t] - (t > 0 ? y[t - 1] : y[0])) / T;
+    ev.eps[t] = measured - c.dot(z);
+    if (withGradient) {
+      ev.psi.row(t).noalias() = c * Z;
+      for (int j = 0; j < p; ++j) {
+        ev.psi(t, j) += L.dC[static_cast<std::size_t>(j)].row(0).dot(z);
+        force.col(j).noalias() = L.dA[static_cast<std::size_t>(j)] * z +
+                                 L.dB[static_cast<std::size_t>(j)].col(0) * r[t];
+      }
+      Z = L.A * Z + force;
+    }
+    z = L.A * z + b * r[t];
+  }
+  return ev;
+}
+
+// The model as the loop needs it: a physical model's output switched to the motor angle.
+std::unique_ptr<ParametricModel> angleOutputModel(const ParametricModel& model) {
+  auto copy = model.clone();
+  if (auto* pm = dynamic_cast<PhysicalModel*>(copy.get())) {
+    ModelOptions mo = pm->options();
+    mo.output = ModelOutput::MotorAngle;
+    mo.armAcceleration = false;
+    pm->setOptions(mo);
+  }
+  return copy;
+}
+
+ClosedLoopPemResult indirect(const ParametricModel& model, const Eigen::VectorXd& y,
+                             const Eigen::VectorXd& r, double T, const ClosedLoopPemOptions& options,
+                             const ProgressCallback& progress) {
+  if (r.size() != y.size())
+    throw std::invalid_argument("pemClosedLoop: the indirect method needs a reference as long as the output");
+  ClosedLoopPemResult out;
+  out.method = ClosedLoopMethod::Indirect;
+  const std::string head = "indirect closed-loop fit";
+  if (std::abs(T * options.controller.rateHz - 1.0) > 1e-6) {
+    char buf[200];
+    std::snprintf(buf, sizeof buf,
+                  "%s: the controller runs at %g Hz but the data are sampled at %g Hz; the loop "
+                  "is only known at the controller's rate (fit the log undecimated)",
+                  head.c_str(), options.controller.rateHz, 1.0 / T);
+    out.pem.model = model.clone();
+    out.pem.sampleTime = T;
+    out.pem.summary.message = buf;
+    return out;
+  }
+  // The loop starts at rest at the first measured angle; the controller sees only r - a.
+  const double rest = y.size() ? y[0] : 0.0;
+  const Eigen::VectorXd yRel = y.array() - rest, rRel = r.array() - rest;
+  const auto work = angleOutputModel(model);
+  PemOptions po = options.pem;
+  po.noiseModel = NoiseModel::OutputError;
+  po.covariance = CovarianceKind::Sandwich;
+  const ControllerOptions ctl = options.controller;
+  const LoopOutput output = options.loopOutput;
+  po.predictor = [ctl, output](const ParametricModel& m, const Eigen::VectorXd& ref,
+                               const Eigen::VectorXd& angle, double Ts,
+                               const std::vector<int>& free, bool withGradient) {
+    return evaluateLoop(m, ctl, ref, angle, Ts, free, withGradient, output);
+  };
+  out.pem = pem(*work, rRel, yRel, T, po, progress);
+  // Back to the caller's output (e.g. the motor velocity) for Bode plots and simulation.
+  const auto* original = dynamic_cast<const PhysicalModel*>(&model);
+  if (auto* estimate = dynamic_cast<PhysicalModel*>(out.pem.model.get()); original && estimate)
+    estimate->setOptions(original->options());
+  out.pem.summary.message = head + " (" + toString(output) + " of the loop driven by the reference)" +
+                            (out.pem.summary.message.empty() ? "" : "; ") + out.pem.summary.message;
+  return out;
+}
+
+}  // namespace
+
+Eigen::VectorXd simulateLoop(const ParametricModel& model, const ControllerOptions& controller,
+                             const Eigen::VectorXd& r, double T, LoopOutput output) {
+  return -evaluateLoop(model, controller, r, Eigen::VectorXd::Zero(r.size()), T, {}, false, output)
+              .eps;
+}
+
 ClosedLoopPemResult pemClosedLoop(const ParametricModel& model, const Eigen::VectorXd& u,
                                   const Eigen::VectorXd& y, const Eigen::VectorXd& r,
                                   double T, const ClosedLoopPemOptions& options,
@@ -202,6 +389,7 @@ ClosedLoopPemResult pemClosedLoop(const ParametricModel& model, const Eigen::Vec
     out.pem = pem(model, u, y, T, options.pem, progress);
     return out;
   }
+  if (options.method == ClosedLoopMethod::Indirect) return indirect(model, y, r, T, options, progress);
   if (r.size() != u.size())
     throw std::invalid_argument("pemClosedLoop: the two-stage method needs a reference as long as the input");
   out.projection = projectOnReference(u, r, T, options.projection);

@@ -60,6 +60,8 @@ bool PemOptions::isValid(std::string* why) const {
     return fail("starts from notches and peaks need target notch or peak frequencies");
   if (!(level > 0.0 && level < 1.0)) return fail("the level must lie strictly between 0 and 1");
   if (covarianceLags < 0) return fail("covarianceLags must not be negative");
+  if (predictor && noiseModel != NoiseModel::OutputError)
+    return fail("a custom predictor is output error: it excludes the innovations form");
   return true;
 }
 
@@ -143,20 +145,17 @@ StateSpaceDerivative completeDerivative(StateSpaceDerivative d, const StateSpace
   return d;
 }
 
-struct Sampled {
-  Eigen::MatrixXd Ad, Bd, C, D;
-  std::vector<Eigen::MatrixXd> dAd, dBd, dC, dD;  // per free parameter
-};
+}  // namespace
 
-Sampled sample(const ParametricModel& model, double T, const std::vector<int>& free,
-               bool withGradient) {
+SampledModel sampleZoh(const ParametricModel& model, double T, const std::vector<int>& free,
+                       bool withGradient) {
   const StateSpace ss = model.stateSpace();
   std::string why;
   if (!ss.isValid(&why)) throw std::invalid_argument("grey-box model: " + why);
   if (ss.inputs() != 1 || ss.outputs() != 1)
     throw std::invalid_argument("grey-box estimation handles one input and one output");
   const Eigen::Index n = ss.states(), m = 1;
-  Sampled s;
+  SampledModel s;
   std::vector<Eigen::MatrixXd> dMs;
   std::vector<StateSpaceDerivative> der;
   if (withGradient)
@@ -179,6 +178,8 @@ Sampled sample(const ParametricModel& model, double T, const std::vector<int>& f
   }
   return s;
 }
+
+namespace {
 
 double spectralRadius(const Eigen::MatrixXd& A) {
   if (A.size() == 0) return 0.0;
@@ -210,7 +211,7 @@ PemEvaluation evaluatePredictor(const ParametricModel& model, const Eigen::Vecto
                                 bool gradientOfK) {
   if (u.size() != y.size())
     throw std::invalid_argument("input and output must have the same number of samples");
-  const Sampled s = sample(model, T, free, withGradient);
+  const SampledModel s = sampleZoh(model, T, free, withGradient);
   const Eigen::Index n = s.Ad.rows(), N = y.size();
   const Eigen::VectorXd K = K0.size() ? K0 : Eigen::VectorXd::Zero(n);
   if (K.size() != n) throw std::invalid_argument("the gain K must have one entry per state");
@@ -392,7 +393,9 @@ PemResult pem(const ParametricModel& model0, const Eigen::VectorXd& u, const Eig
     setPhi(phi, K);
     PemEvaluation ev;
     try {
-      ev = evaluatePredictor(*work, K, u, y, T, tr.free, psi != nullptr, innovations);
+      ev = options.predictor
+               ? options.predictor(*work, u, y, T, tr.free, psi != nullptr)
+               : evaluatePredictor(*work, K, u, y, T, tr.free, psi != nullptr, innovations);
     } catch (const std::invalid_argument&) {
       return false;  // the model rejects these values (e.g. a zero inertia)
     }

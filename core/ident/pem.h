@@ -6,6 +6,7 @@
 // estimated as extra parameters: x(t+1) = Ad x + Bd u + K eps(t), yhat = C x + D u.
 // The gradient psi (4.20) comes from the sensitivity system (6.27) of the ZOH-sampled model,
 // with d(Ad, Bd)/dtheta from the exact derivative of the matrix exponential.
+#include <functional>
 #include <memory>
 #include <optional>
 #include <string>
@@ -33,6 +34,25 @@ std::optional<ParameterScaling> parameterScalingFromString(std::string_view s);
 
 // Ad = e^{A T}, Bd = int_0^T e^{A s} ds B of a continuous model (zero-order hold).
 StateSpace discretizeZoh(const StateSpace& continuous, double sampleTime);
+
+// The ZOH-sampled matrices of a one-input, one-output parametric model and, on request, their
+// derivatives along each parameter of `free` (indices into parameters()), from the exact
+// derivative of the matrix exponential: the ingredients of the sensitivity system (6.27).
+struct SampledModel {
+  Eigen::MatrixXd Ad, Bd, C, D;
+  std::vector<Eigen::MatrixXd> dAd, dBd, dC, dD;  // one per free parameter
+};
+SampledModel sampleZoh(const ParametricModel& model, double sampleTime,
+                       const std::vector<int>& free, bool withGradient);
+
+struct PemEvaluation;
+// An output-error predictor in place of the open-loop simulation: the prediction errors and,
+// when asked, psi = -d eps / d theta_free (physical units, columns in `free` order), e.g. of
+// a closed loop driven by a reference. Must throw std::invalid_argument for values the model
+// rejects.
+using OutputErrorPredictor = std::function<PemEvaluation(
+    const ParametricModel& model, const Eigen::VectorXd& u, const Eigen::VectorXd& y,
+    double sampleTime, const std::vector<int>& free, bool withGradient)>;
 
 // How the covariance of the estimate is formed: lambda R^{-1} assuming white prediction
 // errors (4.37), or the sandwich R^{-1} Q R^{-1} that also holds for coloured errors
@@ -66,6 +86,9 @@ struct PemOptions {
   // Lag window M of the sandwich (Bartlett weights over |tau| <= M); 0: a tenth of the
   // record (automaticCovarianceLags).
   int covarianceLags = 0;
+  // When set, the loss is formed with this predictor instead of the ZOH simulation of the
+  // model from u (output error only).
+  OutputErrorPredictor predictor;
   bool isValid(std::string* why) const;
 };
 

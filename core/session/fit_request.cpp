@@ -135,8 +135,10 @@ std::optional<FitRequest> fitRequestFromJson(const json& j, std::string* why) {
     if (j.contains("closed_loop")) {
       auto m = j["closed_loop"].is_string() ? closedLoopMethodFromString(j["closed_loop"].get<std::string>())
                                             : std::nullopt;
-      if (!m) return fail(where + "closed_loop must be \"" + toString(ClosedLoopMethod::TwoStage) +
-                          "\" or \"" + toString(ClosedLoopMethod::Direct) + "\"");
+      // The indirect method runs from the command line only (it needs the log's controller).
+      if (!m || *m == ClosedLoopMethod::Indirect)
+        return fail(where + "closed_loop must be \"" + toString(ClosedLoopMethod::TwoStage) +
+                    "\" or \"" + toString(ClosedLoopMethod::Direct) + "\"");
       r.closedLoop = *m;
     }
     int seed = 1;
