@@ -2,6 +2,7 @@
 #include "app/cli/verb_fit.h"
 
 #include <cmath>
+#include <cstdlib>
 #include <nlohmann/json.hpp>
 #include <ostream>
 #include <sstream>
@@ -142,11 +143,16 @@ const char* fitOptionsHelp() {
          "  --starts N            physical models: N random starts besides the nominal one,\n"
          "                        plus two whose notches and peaks match the SPA estimate\n"
          "  --seed N              random seed for the starts (default 1)\n"
-         "  --closed-loop M       physical models: auto|direct|two-stage. two-stage fits output\n"
-         "                        error to the part of the input the reference explains (an\n"
-         "                        FIR of the reference channel), consistent in closed loop,\n"
-         "                        with a covariance that allows coloured errors; auto (default)\n"
-         "                        uses it when the log has a reference and no --noise-model\n"
+         "  --closed-loop M       physical models: auto|direct|two-stage|indirect. two-stage\n"
+         "                        fits output error to the part of the input the reference\n"
+         "                        explains (an FIR of the reference channel), consistent in\n"
+         "                        closed loop, with a covariance that allows coloured errors;\n"
+         "                        auto (default) uses it when the log has a reference and no\n"
+         "                        --noise-model. indirect fits the whole loop (the log's\n"
+         "                        controller from its metadata controller_kp, controller_kv,\n"
+         "                        controller_ti, controller_rate_hz) from the reference to the\n"
+         "                        measured angle, from the log's first sample to the end of\n"
+         "                        the estimation range, at the log's own rate\n"
          "  --decimate N          decimate by N with the anti-alias FIR before fitting\n"
          "  --range A:B           estimation data from A to B seconds (default: the log's\n"
          "                        stored estimation range, else everything)\n"
@@ -247,11 +253,18 @@ int prepareAndFit(ArgParser& args, const std::string& verb, FitOutcome& out, std
   if (auto m = args.value("closed-loop"); m && *m != "auto") {
     askedMethod = closedLoopMethodFromString(*m);
     if (!askedMethod) {
-      err << pre << "--closed-loop expects auto, direct or two-stage, not '" << *m << "'\n";
+      err << pre << "--closed-loop expects auto, direct, two-stage or indirect, not '" << *m
+          << "'\n";
       return kExitUsage;
     }
-    if (*askedMethod == ClosedLoopMethod::TwoStage && args.flag("noise-model")) {
-      err << pre << "--closed-loop two-stage fits output error; it excludes --noise-model\n";
+    if (*askedMethod != ClosedLoopMethod::Direct && args.flag("noise-model")) {
+      err << pre << "--closed-loop " << toString(*askedMethod)
+          << " fits output error; it excludes --noise-model\n";
+      return kExitUsage;
+    }
+    if (*askedMethod == ClosedLoopMethod::Indirect && decimation > 1) {
+      err << pre << "--closed-loop indirect runs the controller at its own rate; it excludes "
+                    "--decimate\n";
       return kExitUsage;
     }
   }
@@ -266,6 +279,46 @@ int prepareAndFit(ArgParser& args, const std::string& verb, FitOutcome& out, std
   if (!data->input() || !data->output()) {
     err << "flexarm: " << args.positional()[0] << ": the log has no input or no output channel\n";
     return kExitBadInput;
+  }
+  // The indirect method closes the logged controller around the model: it needs the measured
+  // angle and the reference as logged, and the controller from the log's metadata.
+  Eigen::VectorXd loopAngle, loopReference;
+  ControllerOptions loopController;
+  if (askedMethod == ClosedLoopMethod::Indirect) {
+    const Channel* angle = data->channel(columns::kMotorAngle);
+    const Channel* ref = data->withRole(ChannelRole::Reference);
+    if (!angle || !ref) {
+      err << "flexarm: " << args.positional()[0] << ": --closed-loop indirect needs the "
+          << columns::kMotorAngle << " and reference channels, and the log lacks "
+          << (angle ? "the reference" : columns::kMotorAngle) << "\n";
+      return kExitBadInput;
+    }
+    const std::pair<const char*, double*> keys[] = {
+        {"controller_rate_hz", &loopController.rateHz}, {"controller_kp", &loopController.kp},
+        {"controller_kv", &loopController.kv}, {"controller_ti", &loopController.ti}};
+    for (const auto& [key, target] : keys) {
+      const std::string text = data->meta(key);
+      char* end = nullptr;
+      const double v = text.empty() ? NAN : std::strtod(text.c_str(), &end);
+      if (text.empty() || end != text.c_str() + text.size() || !std::isfinite(v)) {
+        err << "flexarm: " << args.positional()[0] << ": --closed-loop indirect needs the "
+            << "controller, and the log's metadata key " << key
+            << (text.empty() ? " is missing" : " is not a number") << " (logs written by "
+            << "flexarm simulate carry controller_rate_hz, controller_kp, controller_kv and "
+               "controller_ti)\n";
+        return kExitBadInput;
+      }
+      *target = v;
+    }
+    if (!loopController.isValid(&why)) {
+      err << "flexarm: " << args.positional()[0] << ": the controller in the metadata: " << why
+          << "\n";
+      return kExitBadInput;
+    }
+    loopAngle = Eigen::Map<const Eigen::VectorXd>(angle->values.data(),
+                                                  static_cast<Eigen::Index>(angle->values.size()));
+    loopReference = Eigen::Map<const Eigen::VectorXd>(ref->values.data(),
+                                                      static_cast<Eigen::Index>(ref->values.size()));
   }
   if (!prepareData(*data, static_cast<int>(decimation), err, verb, out.spec.physical))
     return kExitUsage;
@@ -420,9 +473,16 @@ int prepareAndFit(ArgParser& args, const std::string& verb, FitOutcome& out, std
     co.method = askedMethod.value_or(rEst.size() && !args.flag("noise-model")
                                          ? ClosedLoopMethod::TwoStage
                                          : ClosedLoopMethod::Direct);
+    co.controller = loopController;
     try {
-      ClosedLoopPemResult cl = pemClosedLoop(*physical, out.uEst, out.yEst, rEst,
-                                             out.sampleTime, co);
+      // The indirect loop starts at rest at the log's first sample: it runs from there to the
+      // end of the estimation range.
+      const Eigen::Index loopEnd = static_cast<Eigen::Index>(est.end);
+      ClosedLoopPemResult cl =
+          co.method == ClosedLoopMethod::Indirect
+              ? pemClosedLoop(*physical, {}, loopAngle.head(loopEnd), loopReference.head(loopEnd),
+                              out.sampleTime, co)
+              : pemClosedLoop(*physical, out.uEst, out.yEst, rEst, out.sampleTime, co);
       out.closedLoopMethod = cl.method;
       if (cl.method == ClosedLoopMethod::TwoStage && cl.projection.ok)
         out.referenceFit = cl.projection.fitPercent;
@@ -463,7 +523,7 @@ int runFit(const std::vector<std::string>& argv, std::ostream& out, std::ostream
     warnings.push_back("the model's G is unstable, so its simulated output diverges and the "
                        "fit % is undefined; it can still predict one step ahead");
   }
-  if (fit.closedLoop && fit.closedLoopMethod != ClosedLoopMethod::TwoStage)
+  if (fit.closedLoop && fit.closedLoopMethod == ClosedLoopMethod::Direct)
     warnings.push_back("the log was recorded in closed loop: only models with a flexible, "
                        "independently parameterized noise model (BJ) are free of bias (4.43)");
   auto optJson = [](const std::optional<double>& v) {

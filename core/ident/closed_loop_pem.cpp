@@ -338,7 +338,7 @@ ClosedLoopPemResult indirect(const ParametricModel& model, const Eigen::VectorXd
     char buf[200];
     std::snprintf(buf, sizeof buf,
                   "%s: the controller runs at %g Hz but the data are sampled at %g Hz; the loop "
-                  "is only known at the controller's rate (fit the log undecimated)",
+                  "is only known at the controller's rate, so it needs the log at that rate",
                   head.c_str(), options.controller.rateHz, 1.0 / T);
     out.pem.model = model.clone();
     out.pem.sampleTime = T;
@@ -364,7 +364,8 @@ ClosedLoopPemResult indirect(const ParametricModel& model, const Eigen::VectorXd
   const auto* original = dynamic_cast<const PhysicalModel*>(&model);
   if (auto* estimate = dynamic_cast<PhysicalModel*>(out.pem.model.get()); original && estimate)
     estimate->setOptions(original->options());
-  out.pem.summary.message = head + " (" + toString(output) + " of the loop driven by the reference)" +
+  out.pem.summary.message = head + " (the known controller around the model, " +
+                            toString(output) + " from the reference)" +
                             (out.pem.summary.message.empty() ? "" : "; ") + out.pem.summary.message;
   return out;
 }

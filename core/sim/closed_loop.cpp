@@ -2,7 +2,9 @@
 
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <stdexcept>
+#include <utility>
 
 #include "core/models/nonlinear_plant.h"
 #include "core/sim/random.h"
@@ -168,8 +170,15 @@ SimulationResult simulateClosedLoop(const PhysicalModel& model, const std::vecto
   char buf[64];
   std::snprintf(buf, sizeof buf, "%.12g", model.value("r"));
   d.setMeta("gear_ratio", buf);
-  std::snprintf(buf, sizeof buf, "%.12g", o.controller.rateHz);
-  d.setMeta("controller_rate_hz", buf);
+  // The controller, so that the loop can be closed around a model (the indirect method).
+  const std::pair<const char*, double> controller[] = {{"controller_rate_hz", o.controller.rateHz},
+                                                       {"controller_kp", o.controller.kp},
+                                                       {"controller_kv", o.controller.kv},
+                                                       {"controller_ti", o.controller.ti}};
+  for (const auto& [key, value] : controller) {
+    std::snprintf(buf, sizeof buf, "%.12g", value);
+    d.setMeta(key, buf);
+  }
   result.termination = Termination::Converged;
   result.message = "simulated " + std::to_string(samples) + " samples";
   result.controllerTicks = ticks;

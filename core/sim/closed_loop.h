@@ -3,8 +3,10 @@
 // any effects, under a cascaded controller (P position loop, PI velocity loop) running at the
 // controller rate, with torque-reference noise, a load disturbance on the arm and an encoder
 // of finite resolution on the motor angle. The excitation is added to the position reference
-// phi_ref; the log holds what the seed measured: phi_ref, the torque reference u and the
-// measured motor angle (plus, on request, the true motor velocity and arm acceleration).
+// phi_ref; the log holds what the seed measured: phi_ref, the torque reference u (before the
+// torque noise) and the measured motor angle (plus, on request, the true motor velocity and
+// arm acceleration), and its metadata the controller (controller_rate_hz, controller_kp,
+// controller_kv, controller_ti).
 #include <cstdint>
 #include <string>
 #include <vector>
