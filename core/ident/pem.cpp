@@ -186,6 +186,64 @@ double spectralRadius(const Eigen::MatrixXd& A) {
   return A.eigenvalues().cwiseAbs().maxCoeff();
 }
 
+// The predictor's recursion over the samples, filling r.eps and r.psi. The per-sample work
+// is a handful of products of small matrices: they are stacked so that one product serves
+// every parameter (DA x holds dAd_j x for all j), evaluated coefficient-wise (lazyProduct: no
+// blocking set-up for 5 x 5 matrices), and written into buffers allocated once.
+void predictorLoop(const SampledModel& s, const Eigen::VectorXd& K, const Eigen::VectorXd& u,
+                    const Eigen::VectorXd& y, int pf, int p, bool withGradient, PemEvaluation& r) {
+  using Vec = Eigen::VectorXd;
+  using Mat = Eigen::MatrixXd;
+  const Eigen::Index n = s.Ad.rows(), samples = y.size();
+  const Mat& Ad = s.Ad;
+  const Vec bd = s.Bd.col(0);
+  const Eigen::RowVectorXd c = s.C.row(0);
+  const double dd = s.D(0, 0);
+  Mat DA(n * pf, n);
+  Mat DB(n, pf);
+  Mat DC(pf, n);
+  Eigen::VectorXd dDu(pf);
+  bool outputDerivative = false;  // some dC or dD is not zero
+  if (withGradient)
+    for (int j = 0; j < pf; ++j) {
+      DA.middleRows(j * n, n) = s.dAd[j];
+      DB.col(j) = s.dBd[j].col(0);
+      DC.row(j) = s.dC[j].row(0);
+      dDu[j] = s.dD[j](0, 0);
+      outputDerivative = outputDerivative || !s.dC[j].isZero(0.0) || dDu[j] != 0.0;
+    }
+  const bool hasK = !K.isZero(0.0);
+  Vec x = Vec::Zero(n), xNext(n);
+  Eigen::VectorXd fx(n * pf);
+  Mat X = Mat::Zero(n, p);  // d x / d theta, the sensitivity states
+  Mat force = Mat::Zero(n, p), AX(n, p);
+  Eigen::RowVectorXd dy(p);
+  for (Eigen::Index t = 0; t < samples; ++t) {
+    const double ut = u[t];
+    const double e = y[t] - (c.dot(x) + dd * ut);
+    r.eps[t] = e;
+    if (withGradient) {
+      // (6.27) sampled: dyhat = C X + dC x + dD u; X+ = Ad X + dAd x + dBd u - K dyhat (+ eps e_j).
+      dy.noalias() = c.lazyProduct(X);
+      if (outputDerivative) dy.head(pf) += (DC.lazyProduct(x)).transpose() + dDu.transpose() * ut;
+      fx.noalias() = DA.lazyProduct(x);
+      force.leftCols(pf) = Eigen::Map<const Mat>(fx.data(), n, pf) + DB * ut;
+      for (int j = pf; j < p; ++j) {
+        force.col(j).setZero();
+        force(j - pf, j) = e;
+      }
+      r.psi.row(t) = dy;
+      if (hasK) force.noalias() -= K * dy;
+      AX.noalias() = Ad.lazyProduct(X);
+      X = AX + force;
+    }
+    xNext.noalias() = Ad.lazyProduct(x);
+    xNext += bd * ut;
+    if (hasK) xNext += K * e;
+    x.swap(xNext);
+  }
+}
+
 }  // namespace
 
 StateSpace discretizeZoh(const StateSpace& c, double T) {
@@ -222,34 +280,7 @@ PemEvaluation evaluatePredictor(const ParametricModel& model, const Eigen::Vecto
   const int p = withGradient ? pf + (gradientOfK ? static_cast<int>(n) : 0) : 0;
   r.eps.resize(N);
   if (withGradient) r.psi.resize(N, p);
-  Eigen::VectorXd x = Eigen::VectorXd::Zero(n);
-  Eigen::MatrixXd X = Eigen::MatrixXd::Zero(n, p);  // d x / d theta, the sensitivity states
-  Eigen::MatrixXd force(n, p);
-  Eigen::RowVectorXd dy(p);
-  const Eigen::RowVectorXd c = s.C.row(0);
-  const Eigen::VectorXd bd = s.Bd.col(0);
-  const double dd = s.D(0, 0);
-  for (Eigen::Index t = 0; t < N; ++t) {
-    const double ut = u[t];
-    const double e = y[t] - (c.dot(x) + dd * ut);
-    r.eps[t] = e;
-    if (withGradient) {
-      // (6.27) sampled: dyhat = C X + dC x + dD u; X+ = Ad X + dAd x + dBd u - K dyhat (+ eps e_j).
-      dy.noalias() = c * X;
-      for (int j = 0; j < pf; ++j) {
-        dy[j] += s.dC[j].row(0).dot(x) + s.dD[j](0, 0) * ut;
-        force.col(j).noalias() = s.dAd[j] * x + s.dBd[j].col(0) * ut;
-      }
-      for (int j = pf; j < p; ++j) {
-        force.col(j).setZero();
-        force(j - pf, j) = e;
-      }
-      r.psi.row(t) = dy;
-      force.noalias() -= K * dy;
-      X = s.Ad * X + force;
-    }
-    x = s.Ad * x + bd * ut + K * e;
-  }
+  predictorLoop(s, K, u, y, pf, p, withGradient, r);
   return r;
 }
 
