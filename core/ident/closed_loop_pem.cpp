@@ -212,14 +212,9 @@ void addStage1Uncertainty(PemResult& est, const ReferenceProjection& proj,
 namespace {
 
 // The closed loop of simulateLoop as one discrete state space in z = [x; a_{k-1}; I_{k-1}]:
-// z+ = Acl z + Bcl r, output Ccl z, with, for each free parameter, dAcl, dBcl, dCcl from the
-// plant's sampled derivatives (the controller does not depend on theta).
-struct LoopMatrices {
-  Eigen::MatrixXd A, B, C;
-  std::vector<Eigen::MatrixXd> dA, dB, dC;
-};
-
-LoopMatrices loopMatrices(const ParametricModel& model, const ControllerOptions& ctl, double T,
+// z+ = Acl z + Bcl r, output Ccl z (D = 0), with, for each free parameter, dAcl, dBcl, dCcl
+// from the plant's sampled derivatives (the controller does not depend on theta).
+SampledModel loopMatrices(const ParametricModel& model, const ControllerOptions& ctl, double T,
                           const std::vector<int>& free, bool withGradient, LoopOutput output) {
   std::string why;
   if (!ctl.isValid(&why)) throw std::invalid_argument("closed loop: " + why);
@@ -257,22 +252,24 @@ LoopMatrices loopMatrices(const ParametricModel& model, const ControllerOptions&
       if (output == LoopOutput::MotorVelocity) C[n] = -1.0 / T;
     }
   };
-  LoopMatrices L;
+  SampledModel L;
   Eigen::VectorXd B;
   Eigen::RowVectorXd C;
   const Eigen::VectorXd bd = s.Bd.col(0);
   const Eigen::RowVectorXd c = s.C.row(0);
-  build(s.Ad, bd, c, bd * c, true, L.A, B, C);
-  L.B = B;
+  build(s.Ad, bd, c, bd * c, true, L.Ad, B, C);
+  L.Bd = B;
   L.C = C;
+  L.D = Eigen::MatrixXd::Zero(1, 1);
   for (std::size_t j = 0; j < s.dAd.size(); ++j) {
     Eigen::MatrixXd dA;
     const Eigen::VectorXd dbd = s.dBd[j].col(0);
     const Eigen::RowVectorXd dc = s.dC[j].row(0);
     build(s.dAd[j], dbd, dc, dbd * c + bd * dc, false, dA, B, C);
-    L.dA.push_back(dA);
-    L.dB.push_back(B);
+    L.dAd.push_back(dA);
+    L.dBd.push_back(B);
     L.dC.push_back(C);
+    L.dD.push_back(Eigen::MatrixXd::Zero(1, 1));
   }
   return L;
 }
@@ -284,34 +281,11 @@ PemEvaluation evaluateLoop(const ParametricModel& model, const ControllerOptions
                            const std::vector<int>& free, bool withGradient, LoopOutput output) {
   if (r.size() != y.size())
     throw std::invalid_argument("closed loop: reference and output differ in length");
-  const LoopMatrices L = loopMatrices(model, ctl, T, free, withGradient, output);
-  const Eigen::Index m = L.A.rows(), N = y.size();
-  const int p = withGradient ? static_cast<int>(free.size()) : 0;
-  PemEvaluation ev;
-  ev.stable = L.A.eigenvalues().cwiseAbs().maxCoeff() < 1.0;
-  ev.eps.resize(N);
-  if (withGradient) ev.psi.resize(N, p);
-  Eigen::VectorXd z = Eigen::VectorXd::Zero(m);
-  Eigen::MatrixXd Z = Eigen::MatrixXd::Zero(m, p), force(m, p);
-  const Eigen::VectorXd b = L.B.col(0);
-  const Eigen::RowVectorXd c = L.C.row(0);
-  for (Eigen::Index t = 0; t < N; ++t) {
-    const double measured = output == LoopOutput::MotorAngle
-                                ? y[t]
-                                : (y[t] - (t > 0 ? y[t - 1] : y[0])) / T;
-    ev.eps[t] = measured - c.dot(z);
-    if (withGradient) {
-      ev.psi.row(t).noalias() = c * Z;
-      for (int j = 0; j < p; ++j) {
-        ev.psi(t, j) += L.dC[static_cast<std::size_t>(j)].row(0).dot(z);
-        force.col(j).noalias() = L.dA[static_cast<std::size_t>(j)] * z +
-                                 L.dB[static_cast<std::size_t>(j)].col(0) * r[t];
-      }
-      Z = L.A * Z + force;
-    }
-    z = L.A * z + b * r[t];
-  }
-  return ev;
+  Eigen::VectorXd measured = y;
+  if (output == LoopOutput::MotorVelocity)
+    for (Eigen::Index t = 0; t < y.size(); ++t) measured[t] = (y[t] - (t > 0 ? y[t - 1] : y[0])) / T;
+  return evaluateSampled(loopMatrices(model, ctl, T, free, withGradient, output), r, measured,
+                         withGradient);
 }
 
 // The model as the loop needs it: a physical model's output switched to the motor angle.

@@ -284,6 +284,19 @@ PemEvaluation evaluatePredictor(const ParametricModel& model, const Eigen::Vecto
   return r;
 }
 
+PemEvaluation evaluateSampled(const SampledModel& s, const Eigen::VectorXd& u,
+                              const Eigen::VectorXd& y, bool withGradient) {
+  if (u.size() != y.size())
+    throw std::invalid_argument("input and output must have the same number of samples");
+  PemEvaluation r;
+  r.stable = spectralRadius(s.Ad) < 1.0;
+  const int p = withGradient ? static_cast<int>(s.dAd.size()) : 0;
+  r.eps.resize(y.size());
+  if (withGradient) r.psi.resize(y.size(), p);
+  predictorLoop(s, Eigen::VectorXd::Zero(s.Ad.rows()), u, y, p, p, withGradient, r);
+  return r;
+}
+
 Eigen::VectorXd predictionErrors(const ParametricModel& model, const Eigen::VectorXd& K,
                                  const Eigen::VectorXd& u, const Eigen::VectorXd& y, double T) {
   return evaluatePredictor(model, K, u, y, T, {}, false, false).eps;

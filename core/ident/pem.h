@@ -46,6 +46,12 @@ SampledModel sampleZoh(const ParametricModel& model, double sampleTime,
                        const std::vector<int>& free, bool withGradient);
 
 struct PemEvaluation;
+// Output errors y - yhat of a sampled model driven by u from zero state and, when asked,
+// psi = -d eps / d theta from its sampled derivatives (the sensitivity system (6.27)), e.g.
+// of a closed loop assembled from a sampled plant. stable: the spectral radius of Ad is < 1.
+PemEvaluation evaluateSampled(const SampledModel& sampled, const Eigen::VectorXd& u,
+                              const Eigen::VectorXd& y, bool withGradient);
+
 // An output-error predictor in place of the open-loop simulation: the prediction errors and,
 // when asked, psi = -d eps / d theta_free (physical units, columns in `free` order), e.g. of
 // a closed loop driven by a reference. Must throw std::invalid_argument for values the model
