@@ -274,20 +274,6 @@ SampledModel loopMatrices(const ParametricModel& model, const ControllerOptions&
   return L;
 }
 
-// Output error of the closed loop driven by r against the measured angle y (both relative to
-// the angle at rest), with psi from the loop's sensitivity system (6.27).
-PemEvaluation evaluateLoop(const ParametricModel& model, const ControllerOptions& ctl,
-                           const Eigen::VectorXd& r, const Eigen::VectorXd& y, double T,
-                           const std::vector<int>& free, bool withGradient, LoopOutput output) {
-  if (r.size() != y.size())
-    throw std::invalid_argument("closed loop: reference and output differ in length");
-  Eigen::VectorXd measured = y;
-  if (output == LoopOutput::MotorVelocity)
-    for (Eigen::Index t = 0; t < y.size(); ++t) measured[t] = (y[t] - (t > 0 ? y[t - 1] : y[0])) / T;
-  return evaluateSampled(loopMatrices(model, ctl, T, free, withGradient, output), r, measured,
-                         withGradient);
-}
-
 // The model as the loop needs it: a physical model's output switched to the motor angle.
 std::unique_ptr<ParametricModel> angleOutputModel(const ParametricModel& model) {
   auto copy = model.clone();
@@ -345,6 +331,18 @@ ClosedLoopPemResult indirect(const ParametricModel& model, const Eigen::VectorXd
 }
 
 }  // namespace
+
+PemEvaluation evaluateLoop(const ParametricModel& model, const ControllerOptions& ctl,
+                           const Eigen::VectorXd& r, const Eigen::VectorXd& y, double T,
+                           const std::vector<int>& free, bool withGradient, LoopOutput output) {
+  if (r.size() != y.size())
+    throw std::invalid_argument("closed loop: reference and output differ in length");
+  Eigen::VectorXd measured = y;
+  if (output == LoopOutput::MotorVelocity)
+    for (Eigen::Index t = 0; t < y.size(); ++t) measured[t] = (y[t] - (t > 0 ? y[t - 1] : y[0])) / T;
+  return evaluateSampled(loopMatrices(model, ctl, T, free, withGradient, output), r, measured,
+                         withGradient);
+}
 
 Eigen::VectorXd simulateLoop(const ParametricModel& model, const ControllerOptions& controller,
                              const Eigen::VectorXd& r, double T, LoopOutput output) {

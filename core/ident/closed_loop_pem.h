@@ -89,6 +89,14 @@ Eigen::VectorXd simulateLoop(const ParametricModel& model, const ControllerOptio
                              const Eigen::VectorXd& r, double sampleTime,
                              LoopOutput output = LoopOutput::MotorAngle);
 
+// Output errors of that loop against the measured angle y (relative to the angle at rest, as
+// r) compared as `output`, and, when asked, psi = -d eps / d theta for the parameters `free`
+// (indices into parameters()) from the loop's sensitivity system (6.27). Throws like
+// simulateLoop.
+PemEvaluation evaluateLoop(const ParametricModel& model, const ControllerOptions& controller,
+                           const Eigen::VectorXd& r, const Eigen::VectorXd& y, double sampleTime,
+                           const std::vector<int>& free, bool withGradient, LoopOutput output);
+
 struct ClosedLoopPemOptions {
   ClosedLoopMethod method = ClosedLoopMethod::TwoStage;
   ReferenceProjectionOptions projection;
