@@ -61,14 +61,17 @@ LoopLog simulateLog(std::uint64_t seed) {
   return l;
 }
 
-// The simulator's loop without torque noise, load disturbance or encoder quantization.
-SimulationOptions noiseFree(double durationS) {
+// The simulator's loop around the three-mass truth (default controller) without torque
+// noise, load disturbance or encoder quantization.
+SimulationResult simulateNoiseFree(double durationS) {
   SimulationOptions o;
   o.durationS = durationS;
   o.disturbance.torqueNoiseStd = 0.0;
   o.disturbance.loadTorqueStd = 0.0;
   o.disturbance.encoderCountsPerRev = 0;
-  return o;
+  SimulationResult sim = simulateClosedLoop(*makeModel("three-mass"), {}, o);
+  EXPECT_EQ(sim.termination, Termination::Converged) << sim.message;
+  return sim;
 }
 
 // Starting point away from the truth: every free parameter off by 10-30 %.
@@ -183,14 +186,13 @@ TEST(ClosedLoopPem, IndirectRecoversTheThreeMassTruthInsideHonestIntervalsAcross
 // simulator integrates the plant by Runge-Kutta between ticks), and the logged torque, held
 // over each tick, drives the plant to the logged angle.
 TEST(ClosedLoopPem, LoopSimulationReproducesTheNoiseFreeSimulator) {
-  const SimulationOptions o = noiseFree(4.0);
+  const ControllerOptions controller;
   const auto truth = makeModel("three-mass");
-  const SimulationResult sim = simulateClosedLoop(*truth, {}, o);
-  ASSERT_EQ(sim.termination, Termination::Converged) << sim.message;
+  const SimulationResult sim = simulateNoiseFree(4.0);
   const Eigen::VectorXd angle = raw(sim.data.channel(columns::kMotorAngle)->values);
   const Eigen::VectorXd ref = raw(sim.data.withRole(ChannelRole::Reference)->values);
   auto angleModel = makeModel("three-mass", {ModelOutput::MotorAngle, false});
-  const Eigen::VectorXd a = simulateLoop(*angleModel, o.controller, ref, sim.data.sampleTime,
+  const Eigen::VectorXd a = simulateLoop(*angleModel, controller, ref, sim.data.sampleTime,
                                          LoopOutput::MotorAngle);
   EXPECT_LT((a - angle).norm(), 1e-6 * angle.norm()) << (a - angle).cwiseAbs().maxCoeff();
   const Eigen::VectorXd open = simulate(*angleModel, raw(sim.data.input()->values), sim.data.sampleTime);
@@ -200,17 +202,17 @@ TEST(ClosedLoopPem, LoopSimulationReproducesTheNoiseFreeSimulator) {
   late.tail(a.size() - 1) = a.head(a.size() - 1);
   EXPECT_GT((late - angle).norm(), 1e-3 * angle.norm());
   // Other gains give another loop.
-  ControllerOptions other = o.controller;
+  ControllerOptions other = controller;
   other.kv *= 1.1;
   EXPECT_GT((simulateLoop(*angleModel, other, ref, sim.data.sampleTime, LoopOutput::MotorAngle) -
              angle).norm(), 1e-3 * angle.norm());
   // The velocity output is the angle's backward difference.
-  const Eigen::VectorXd v = simulateLoop(*angleModel, o.controller, ref, sim.data.sampleTime,
+  const Eigen::VectorXd v = simulateLoop(*angleModel, controller, ref, sim.data.sampleTime,
                                          LoopOutput::MotorVelocity);
   EXPECT_NEAR(v[100], (a[100] - a[99]) / sim.data.sampleTime, 1e-9 * std::abs(v[100]) + 1e-12);
   // Misuse: a velocity-output model has no angle for the controller; a decimated rate.
-  EXPECT_THROW(simulateLoop(*truth, o.controller, ref, sim.data.sampleTime), std::invalid_argument);
-  EXPECT_THROW(simulateLoop(*angleModel, o.controller, ref, 2.0 * sim.data.sampleTime),
+  EXPECT_THROW(simulateLoop(*truth, controller, ref, sim.data.sampleTime), std::invalid_argument);
+  EXPECT_THROW(simulateLoop(*angleModel, controller, ref, 2.0 * sim.data.sampleTime),
                std::invalid_argument);
 }
 
@@ -218,10 +220,8 @@ TEST(ClosedLoopPem, LoopSimulationReproducesTheNoiseFreeSimulator) {
 // loop, with the plant's exact ZOH derivatives) agrees with central differences of the
 // simulated loop for every three-mass parameter, for both outputs.
 TEST(ClosedLoopPem, LoopGradientMatchesCentralDifferences) {
-  const SimulationOptions o = noiseFree(1.0);
-  const auto truth = makeModel("three-mass");
-  const SimulationResult sim = simulateClosedLoop(*truth, {}, o);
-  ASSERT_EQ(sim.termination, Termination::Converged) << sim.message;
+  const ControllerOptions controller;
+  const SimulationResult sim = simulateNoiseFree(1.0);
   const Eigen::VectorXd ref = raw(sim.data.withRole(ChannelRole::Reference)->values);
   const double T = sim.data.sampleTime;
   auto model = makeModel("three-mass", {ModelOutput::MotorAngle, false});
@@ -229,7 +229,7 @@ TEST(ClosedLoopPem, LoopGradientMatchesCentralDifferences) {
   for (const char* name : {"J_m", "J_g", "J_a", "f_m", "k_g", "k_a", "d_g", "d_a"})
     free.push_back(model->indexOf(name));
   for (LoopOutput output : {LoopOutput::MotorAngle, LoopOutput::MotorVelocity}) {
-    const PemEvaluation ev = evaluateLoop(*model, o.controller, ref, Eigen::VectorXd::Zero(ref.size()),
+    const PemEvaluation ev = evaluateLoop(*model, controller, ref, Eigen::VectorXd::Zero(ref.size()),
                                           T, free, true, output);
     ASSERT_EQ(ev.psi.cols(), 8);
     EXPECT_TRUE(ev.stable);
@@ -239,7 +239,7 @@ TEST(ClosedLoopPem, LoopGradientMatchesCentralDifferences) {
       auto at = [&](double value) {
         auto m = model->clone();
         m->setParameter(info.name, value);
-        return simulateLoop(*m, o.controller, ref, T, output);
+        return simulateLoop(*m, controller, ref, T, output);
       };
       const Eigen::VectorXd numeric = (at(v + h) - at(v - h)) / (2.0 * h);
       EXPECT_LT((ev.psi.col(j) - numeric).norm(), 1e-5 * numeric.norm())
@@ -282,9 +282,7 @@ TEST(ClosedLoopPem, DirectOutputErrorMissesTheTruthOnTheSameLogs) {
 // Stage 1 alone: on a noise-free loop, u is an exact linear function of r and the FIR with
 // its spline tail reproduces it.
 TEST(ClosedLoopPem, StageOneReproducesANoiseFreeInput) {
-  const SimulationOptions o = noiseFree(6.0);
-  const SimulationResult sim = simulateClosedLoop(*makeModel("three-mass"), {}, o);
-  ASSERT_EQ(sim.termination, Termination::Converged) << sim.message;
+  const SimulationResult sim = simulateNoiseFree(6.0);
   const Eigen::VectorXd u = centred(sim.data.input()->values);
   const Eigen::VectorXd r = centred(sim.data.withRole(ChannelRole::Reference)->values);
   const ReferenceProjection p = projectOnReference(u, r, sim.data.sampleTime);
