@@ -208,6 +208,10 @@ TEST(CliIdent, BadRequestsExitWithUsageBadInputOrNumericalCodes) {
   r = runFlexarm({"fit", kChirp, "--model", "three-mass", "--fix", "k_g"});
   EXPECT_EQ(r.code, 2);
   EXPECT_NE(r.err.find("NAME=VALUE"), std::string::npos) << r.err;
+  // A value outside the parameter's bounds is refused with the bounds, not an abort.
+  r = runFlexarm({"fit", kChirp, "--model", "three-mass", "--fix", "J_m=-1"});
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("J_m = -1 is outside its bounds"), std::string::npos) << r.err;
   r = runFlexarm({"fit", kChirp, "--model", "three-mass", "--closed-loop", "indirect"});
   EXPECT_EQ(r.code, 2);
   EXPECT_NE(r.err.find("auto, direct or two-stage"), std::string::npos) << r.err;
