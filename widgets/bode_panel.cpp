@@ -173,6 +173,7 @@ void BodePanel::refresh() {
         notes << tr("%1: %2").arg(name, QString::fromStdString(e.message));
         return;
       }
+      if (e.omittedFrequencies > 0) notes << tr("%1: %2").arg(name, QString::fromStdString(e.message));
       BodeCurve c = toCurve(name, color, e.response);
       c.points = true;
       c.magnitudeLow.clear();  // points only: the SPA region is drawn for models

@@ -1,6 +1,7 @@
 #include "app/cli/cli.h"
 
 #include <ostream>
+#include <stdexcept>
 
 namespace flexarm::cli {
 
@@ -59,8 +60,21 @@ int runCommandLine(const std::vector<std::string>& args, std::ostream& out, std:
     out << "flexarm " << FLEXARM_VERSION << "\n";
     return kExitOk;
   }
-  for (const auto& v : verbs())
-    if (args[0] == v.name) return v.run({args.begin() + 1, args.end()}, out, err);
+  for (const auto& v : verbs()) {
+    if (args[0] != v.name) continue;
+    // Each verb checks its arguments and reports data problems itself; a value a core
+    // function still refuses (std::invalid_argument: a parameter outside its bounds, ...) is
+    // a usage error, anything else a numerical failure, both with a sentence, never an abort.
+    try {
+      return v.run({args.begin() + 1, args.end()}, out, err);
+    } catch (const std::invalid_argument& e) {
+      err << "flexarm " << v.name << ": " << e.what() << "\n";
+      return kExitUsage;
+    } catch (const std::exception& e) {
+      err << "flexarm " << v.name << ": " << e.what() << "\n";
+      return kExitNumerical;
+    }
+  }
   err << "flexarm: unknown verb '" << args[0] << "' (flexarm --help lists the verbs)\n";
   return kExitUsage;
 }

@@ -23,7 +23,9 @@ const char* kBodeHelp =
     "  --model etfe[:W]      ETFE (4.24) smoothed over W bins (4.25)\n"
     "  --out FILE            the CSV file to write (required)\n"
     "  --level P             confidence level of the bands (default 0.99)\n"
-    "  --points N            number of frequencies, logarithmically spaced (default 500)\n"
+    "  --points N            number of frequencies, logarithmically spaced (default 500);\n"
+    "                        SPA leaves out those where the input has no power (counted\n"
+    "                        as omitted_frequencies)\n"
     "  --wmin W --wmax W     frequency range in rad/s (default 2 pi/(N T) .. pi/T)\n";
 
 }  // namespace
@@ -66,6 +68,8 @@ int runBode(const std::vector<std::string>& argv, std::ostream& out, std::ostrea
     return kExitUsage;
   }
   const auto fr = fit.response(logGrid(wmin, wmax, static_cast<int>(points)), level);
+  // SPA leaves out frequencies where the input has no power.
+  const long omitted = points - static_cast<long>(fr.omega.size());
   std::ostringstream csv;
   csv << std::setprecision(10);
   csv << "omega_rad_s,frequency_hz,magnitude,magnitude_db,phase_deg,magnitude_lower,"
@@ -97,13 +101,18 @@ int runBode(const std::vector<std::string>& argv, std::ostream& out, std::ostrea
                         {"bands", fr.hasBands()},
                         {"notches_rad_s", np.notches},
                         {"peaks_rad_s", np.peaks},
-                        {"warning", fit.spec.nonparametric ? fit.nonparametric.warning : ""}};
+                        {"warning", fit.spec.nonparametric ? fit.nonparametric.warning : ""},
+                        {"omitted_frequencies", omitted}};
     out << j.dump(2) << "\n";
   } else {
     out << "wrote " << *outPath << ": " << fr.omega.size() << " frequencies of " << name
         << (fr.hasBands() ? " with bands" : "") << "\n";
     if (fit.spec.nonparametric && !fit.nonparametric.warning.empty())
       out << "warning: " << fit.nonparametric.warning << "\n";
+    if (omitted > 0)
+      out << "note: left out " << omitted << " of " << points
+          << " frequencies where the smoothed input spectrum is not positive (the input has "
+             "no power there)\n";
   }
   return kExitOk;
 }

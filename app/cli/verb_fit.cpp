@@ -451,7 +451,12 @@ int prepareAndFit(ArgParser& args, const std::string& verb, FitOutcome& out, std
             << name << "'\n";
         return kExitUsage;
       }
-      physical->setParameter(name, v);
+      try {
+        physical->setParameter(name, v);
+      } catch (const std::invalid_argument& e) {
+        err << pre << "--fix " << e.what() << "\n";
+        return kExitUsage;
+      }
       physical->setFree(name, false);
     }
     PemOptions po;

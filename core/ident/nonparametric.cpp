@@ -1,8 +1,10 @@
 #include "core/ident/nonparametric.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <complex>
+#include <cstdio>
 #include <stdexcept>
 
 #include <fftw3.h>
@@ -184,7 +186,11 @@ NonparametricEstimate spa(const Eigen::VectorXd& u, const Eigen::VectorXd& y, do
   if (omega.empty())
     for (int k = 1; k <= 128; ++k) omega.push_back(M_PI / ts * k / 128.0);
   std::vector<Eigen::Matrix2d> covs;
-  bool undefined = false;
+  // The lag window's spectral window has negative side lobes, so where the input has no power
+  // the smoothed Phi_u can come out zero or negative: G is undefined there and the frequency
+  // is left out of the estimate (counted and named in the message).
+  int undefined = 0;
+  double undefinedLow = INFINITY, undefinedHigh = 0.0;
   for (double w : omega) {
     const double wt = w * ts;
     double phiU = ru[0] * win[0], phiY = ry[0] * win[0];
@@ -196,13 +202,13 @@ NonparametricEstimate spa(const Eigen::VectorXd& u, const Eigen::VectorXd& y, do
       phiYU += win[tau] * (ryu[M + tau] * std::polar(1.0, -wt * tau) +
                            ryu[M - tau] * std::polar(1.0, wt * tau));
     }
-    r.response.omega.push_back(w);
     if (!(phiU > 0.0)) {
-      undefined = true;
-      r.response.value.push_back({NAN, NAN});
-      covs.push_back(Eigen::Matrix2d::Constant(NAN));
+      ++undefined;
+      undefinedLow = std::min(undefinedLow, w);
+      undefinedHigh = std::max(undefinedHigh, w);
       continue;
     }
+    r.response.omega.push_back(w);
     const std::complex<double> G = phiYU / phiU;
     r.response.value.push_back(G);
     const double phiV = std::max(0.0, phiY - std::norm(phiYU) / phiU);
@@ -214,8 +220,20 @@ NonparametricEstimate spa(const Eigen::VectorXd& u, const Eigen::VectorXd& y, do
   r.termination = Termination::Converged;
   r.message = std::string("SPA with a ") + toString(options.window) + " lag window of width " +
               std::to_string(M);
-  if (undefined)
-    r.message += "; the smoothed input spectrum is not positive at some frequencies (NaN)";
+  r.omittedFrequencies = undefined;
+  if (undefined > 0) {
+    char range[96];
+    std::snprintf(range, sizeof range, "%.4g-%.4g rad/s", undefinedLow, undefinedHigh);
+    r.message += "; left out " + std::to_string(undefined) + " of " +
+                 std::to_string(omega.size()) + " frequencies (" + range +
+                 ") where the smoothed input spectrum is not positive: the input has no "
+                 "power there";
+  }
+  if (r.response.omega.empty()) {
+    r.termination = Termination::Failed;
+    r.message = "SPA: the smoothed input spectrum is not positive at any frequency (is the "
+                "input constant?)";
+  }
   r.seconds = std::chrono::duration<double>(Clock::now() - t0).count();
   return r;
 }

@@ -26,6 +26,7 @@ struct NonparametricEstimate {
   FrequencyResponse response;  // bands only for SPA
   bool closedLoopBias = false; // true when the data carry a reference channel (4.30)
   std::string warning;         // kClosedLoopBiasWarning when closedLoopBias
+  int omittedFrequencies = 0;  // SPA: requested frequencies left out (no input power there)
   Termination termination = Termination::Failed;
   std::string message;
   double seconds = 0.0;

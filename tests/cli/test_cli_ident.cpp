@@ -3,6 +3,7 @@
 // with its band columns, and the exit codes of bad requests.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -178,6 +179,21 @@ TEST(CliIdent, BodeWritesMagnitudePhaseAndBandLimits) {
   EXPECT_EQ(line.substr(line.size() - 4), ",,,,");
 }
 
+// The chirp sweeps up to 80 Hz of a 2 kHz log: above it SPA has no estimate. The CSV holds
+// only the frequencies where it exists (no NaN) and the verb says how many it left out.
+TEST(CliIdent, SpaLeavesOutFrequenciesWithoutInputPower) {
+  const std::string out = (scratchDir() / "bode_spa_chirp.csv").string();
+  const auto r = runFlexarm({"bode", velocityLog(), "--model", "spa", "--out", out});
+  ASSERT_EQ(r.code, 0) << r.err;
+  const auto at = r.out.find("note: left out ");
+  ASSERT_NE(at, std::string::npos) << r.out;
+  const long omitted = std::stol(r.out.substr(at + 15));
+  EXPECT_GT(omitted, 0);
+  const std::string csv = readAll(out);
+  EXPECT_EQ(csv.find("nan"), std::string::npos);
+  EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 1 + 500 - omitted);  // header + rows
+}
+
 TEST(CliIdent, BadRequestsExitWithUsageBadInputOrNumericalCodes) {
   // 2: usage.
   auto r = runFlexarm(daisy({"fit", "--model", "oe:6,6"}));
@@ -192,6 +208,10 @@ TEST(CliIdent, BadRequestsExitWithUsageBadInputOrNumericalCodes) {
   r = runFlexarm({"fit", kChirp, "--model", "three-mass", "--fix", "k_g"});
   EXPECT_EQ(r.code, 2);
   EXPECT_NE(r.err.find("NAME=VALUE"), std::string::npos) << r.err;
+  // A value outside the parameter's bounds is refused with the bounds, not an abort.
+  r = runFlexarm({"fit", kChirp, "--model", "three-mass", "--fix", "J_m=-1"});
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("J_m = -1 is outside its bounds"), std::string::npos) << r.err;
   r = runFlexarm({"fit", kChirp, "--model", "three-mass", "--closed-loop", "joint"});
   EXPECT_EQ(r.code, 2);
   EXPECT_NE(r.err.find("auto, direct, two-stage or indirect"), std::string::npos) << r.err;

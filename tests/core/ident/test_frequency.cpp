@@ -7,6 +7,8 @@
 #include "core/ident/blackbox.h"
 #include "core/ident/evaluation.h"
 #include "core/ident/nonparametric.h"
+#include "core/io/log_io.h"
+#include "core/signal/preprocess.h"
 #include "sim_helpers.h"
 
 namespace flexarm {
@@ -173,6 +175,39 @@ TEST(Roots, NotchesAndPeaksOfAKnownResonance) {
   ASSERT_EQ(nr.peaks.size(), 1u);
   EXPECT_NEAR(nr.notches[0], std::hypot(std::log(0.97), 0.3) / T, 1e-6);
   EXPECT_NEAR(nr.peaks[0], std::hypot(std::log(0.98), 0.6) / T, 1e-6);
+}
+
+}  // namespace
+}  // namespace flexarm
+
+namespace flexarm {
+namespace {
+
+// The sample chirp sweeps 0.05-80 Hz of a 2 kHz log: above the sweep the input has no power
+// and the Hann lag window's negative side lobes make the smoothed Phi_u negative there. SPA
+// leaves those frequencies out and says so, instead of returning NaN.
+TEST(Spa, LeavesOutFrequenciesWithoutInputPowerAndSaysSo) {
+  const auto read =
+      readLog(std::string(FLEXARM_SAMPLE_DIR) + "/three_mass_estimation_chirp.csv");
+  ASSERT_TRUE(read.ok) << read.error.problem;
+  const IdData d = addDerivative(read.data);
+  const auto r = spa(d);
+  ASSERT_EQ(r.termination, Termination::Converged) << r.message;
+  EXPECT_GT(r.omittedFrequencies, 0);
+  EXPECT_EQ(r.response.omega.size() + static_cast<std::size_t>(r.omittedFrequencies), 128u);
+  EXPECT_NE(r.message.find("left out " + std::to_string(r.omittedFrequencies)), std::string::npos)
+      << r.message;
+  for (std::size_t i = 0; i < r.response.omega.size(); ++i) {
+    ASSERT_TRUE(std::isfinite(r.response.magnitude[i])) << r.response.omega[i];
+    ASSERT_TRUE(std::isfinite(r.response.phase[i])) << r.response.omega[i];
+    ASSERT_TRUE(std::isfinite(r.response.magnitudeUpper[i])) << r.response.omega[i];
+  }
+  // An input without power has no estimate at all: a failure with a sentence, not NaN.
+  Eigen::VectorXd u = Eigen::VectorXd::Zero(1000), y = Eigen::VectorXd::LinSpaced(1000, 0, 1);
+  const auto none = spa(u, y, 0.01);
+  EXPECT_EQ(none.termination, Termination::Failed);
+  EXPECT_TRUE(none.response.omega.empty());
+  EXPECT_FALSE(none.message.empty());
 }
 
 }  // namespace
