@@ -179,8 +179,12 @@ ReplayResult replaySession(const Session& session, const std::string& sessionPat
   r.report.warnings = prepared.warnings;
   r.report.sections.push_back(dataSection(session, prepared));
   std::vector<std::pair<std::string, const IdData*>> logs;
-  for (const auto& l : prepared.logs) logs.emplace_back(l.name, &l.data);
-  ReplayContext context{session, prepared.logs.front().data, logs, options.progress};
+  std::vector<std::pair<std::string, const IdData*>> rawLogs;
+  for (const auto& l : prepared.logs) {
+    logs.emplace_back(l.name, &l.data);
+    rawLogs.emplace_back(l.name, &l.raw);
+  }
+  ReplayContext context{session, prepared.logs.front().data, logs, options.progress, &rawLogs};
   const auto& parts = sessionParts();
   for (std::size_t i = 0; i < parts.size(); ++i) {
     const std::string key = parts[i]->key();

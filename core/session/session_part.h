@@ -24,6 +24,9 @@ struct ReplayContext {
   const IdData& data;
   const std::vector<std::pair<std::string, const IdData*>>& logs;  // by LogReference::name
   ProgressCallback progress;
+  // Every log as read, before preprocessing and without ranges (by name); null when the
+  // caller has none.
+  const std::vector<std::pair<std::string, const IdData*>>* rawLogs = nullptr;
 };
 
 class SessionPart {
