@@ -68,11 +68,14 @@ PreparedSession prepareSession(const Session& session, const std::string& sessio
       out.message = "log '" + ref.name + "': preprocessing failed: " + e.what();
       return out;
     }
+    // The ranges belong to the analysed (first) log; parts name their own ranges on the others.
+    const bool analysed = out.logs.empty();
     auto apply = [&](const std::optional<SecondsRange>& r, std::optional<SampleRange>& target,
                      const char* what) {
       target.reset();
       if (!r) return;
       SampleRange s = log.data.rangeForTimes(r->start, r->end);
+      if (s.empty() && !analysed) return;
       if (s.empty())
         out.warnings.push_back(std::string("the ") + what + " range " + formatSignificant(r->start) +
                                "-" + formatSignificant(r->end) + " s lies outside log '" +

@@ -97,10 +97,10 @@ TEST(CliRun, PdfTextHasTitlesParametersChecksumAndTheJsonFitPercent) {
                             "Bode magnitude, SPA of the estimation data"})
     EXPECT_NE(text.find(title), std::string::npos) << title;
 
-  // Discovery on the Coulomb-friction log names the effect that generated it, with the
+  // Discovery on the torque-ripple log names the effect that generated it, with the
   // numbers of --json as printed: fit % with 2 decimals, residual RMS with 4 digits.
   const nlohmann::json truth =
-      nlohmann::json::parse(readAll(std::string(FLEXARM_SAMPLE_DIR) + "/effect_coulomb_friction.truth.json"));
+      nlohmann::json::parse(readAll(std::string(FLEXARM_SAMPLE_DIR) + "/effect_torque_ripple.truth.json"));
   const std::string hidden = truth["effects"][0]["name"];
   const nlohmann::json* discovery = nullptr;
   const nlohmann::json* lqg = nullptr;

@@ -37,7 +37,7 @@ using namespace flexarm;
 namespace {
 
 const QString kSampleLog = QString(FLEXARM_SAMPLE_DIR) + "/three_mass_estimation_chirp.csv";
-const QString kCoulombLog = QString(FLEXARM_SAMPLE_DIR) + "/effect_coulomb_friction.csv";
+const QString kRippleLog = QString(FLEXARM_SAMPLE_DIR) + "/effect_torque_ripple.csv";
 
 PreprocessOptions seedPreprocessing() {
   PreprocessOptions p;
@@ -324,18 +324,18 @@ class SessionTest : public QObject {
   void discoveryAndLqgAreSavedAndReopened() {
     std::unique_ptr<MainWindow> w(newWindow());
     QSignalSpy logged(w.get(), &MainWindow::logOpened);
-    w->openFile(kCoulombLog);
+    w->openFile(kRippleLog);
     QVERIFY(logged.wait(30000));
     w->workspace()->setRange(RangeKind::Estimation, {0.0, 6.0});
     w->workspace()->setRange(RangeKind::Validation, {6.0, 10.0});
     DiscoveryPanel* d = w->discoveryPanel();
-    d->options().candidates = {EffectKind::CoulombFriction, EffectKind::Backlash};
+    d->options().candidates = {EffectKind::CoulombFriction, EffectKind::TorqueRipple};
     d->baseModelBox()->setCurrentIndex(d->baseModelBox()->findText("three-mass (nominal)"));
     QSignalSpy done(d, &DiscoveryPanel::finished);
     QTest::mouseClick(d->findButton(), Qt::LeftButton);
     QVERIFY(done.wait(240000));
     QVERIFY2(d->hasResult(), qPrintable(d->verdictText()));
-    QVERIFY2(d->verdictText().contains("coulomb_friction"), qPrintable(d->verdictText()));
+    QVERIFY2(d->verdictText().contains("torque_ripple"), qPrintable(d->verdictText()));
     QTest::mouseClick(d->addButton(), Qt::LeftButton);
     LqgPanel* l = w->lqgPanel();
     l->applyPreset(LqgPanel::Preset::CaseII);
@@ -349,7 +349,7 @@ class SessionTest : public QObject {
     QVERIFY2(loaded.ok, loaded.message.c_str());
     QVERIFY(loaded.session.parts.contains("discovery"));
     QCOMPARE(loaded.session.parts["discovery"]["result"]["effect"].get<std::string>(),
-             std::string("coulomb_friction"));
+             std::string("torque_ripple"));
 
     std::unique_ptr<MainWindow> other(newWindow());
     QSignalSpy opened(other->sessionController(), &SessionController::sessionOpened);

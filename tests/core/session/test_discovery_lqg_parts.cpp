@@ -1,5 +1,5 @@
 // The session parts "discovery" and "lqg": a session that runs discovery on a log with a hidden
-// Coulomb friction (sample_logs/effect_coulomb_friction.truth.json) and holds the seed's LQG
+// torque ripple (sample_logs/effect_torque_ripple.truth.json) and holds the seed's LQG
 // case (ii) (R2 = 1e-8, an unstable regulator, Section 8.6) is saved, reopened and replayed:
 // the verdict names the hidden effect and both replays give the same numbers; damaged
 // sections are refused naming the part.
@@ -23,7 +23,7 @@ namespace {
 
 const std::string kDir = FLEXARM_SAMPLE_DIR;
 const std::string kChirp = kDir + "/three_mass_estimation_chirp.csv";
-const std::string kCoulomb = kDir + "/effect_coulomb_friction.csv";
+const std::string kRipple = kDir + "/effect_torque_ripple.csv";
 const char* kDiscoveryTitle = "Discovery: the missing effect";
 const char* kLqgTitle = "LQG design (chapter 8)";
 
@@ -34,33 +34,33 @@ const json* values(const json& report, const std::string& title) {
 }
 
 double truthOf(const std::string& parameter) {
-  std::ifstream in(kDir + "/effect_coulomb_friction.truth.json");
+  std::ifstream in(kDir + "/effect_torque_ripple.truth.json");
   const json t = json::parse(in);
   return t["effects"][0]["parameters"][parameter]["value"].get<double>();
 }
 
-DiscoveryRequest coulombRequest() {
+DiscoveryRequest rippleRequest() {
   DiscoveryRequest q;
   q.baseStructure = "three-mass";  // the logs' arm: Table 5.7 p6
   q.rawData = true;
-  q.estimation = {"coulomb", SecondsRange{0.0, 6.0}};
-  q.validation = DiscoveryDataRef{"coulomb", SecondsRange{6.0, 10.0}};
-  q.options.candidates = {EffectKind::CoulombFriction, EffectKind::Backlash, EffectKind::InputDelay};
+  q.estimation = {"ripple", SecondsRange{0.0, 6.0}};
+  q.validation = DiscoveryDataRef{"ripple", SecondsRange{6.0, 10.0}};
+  q.options.candidates = {EffectKind::CoulombFriction, EffectKind::Backlash, EffectKind::TorqueRipple};
   return q;
 }
 
-// The chirp log analysed, the Coulomb log for discovery, and the two parts.
+// The chirp log analysed, the ripple log for discovery, and the two parts.
 Session session(const std::string& path) {
   Session s;
   std::string why;
-  for (const auto& [name, file] : {std::pair{"estimation", kChirp}, std::pair{"coulomb", kCoulomb}}) {
+  for (const auto& [name, file] : {std::pair{"estimation", kChirp}, std::pair{"ripple", kRipple}}) {
     LogReference l;
     l.name = name;
     l.path = storedLogPath(path, file);
     l.sha256 = sha256OfFile(file, &why).value_or("");
     s.logs.push_back(l);
   }
-  s.parts["discovery"] = {{"request", discoveryRequestToJson(coulombRequest())}};
+  s.parts["discovery"] = {{"request", discoveryRequestToJson(rippleRequest())}};
   LqgRequest lqg;
   lqg.design = LqgOptions::seedCaseII();
   s.parts["lqg"] = lqgRequestToJson(lqg);
@@ -76,7 +76,7 @@ fs::path scratch() {
 }  // namespace
 
 TEST(DiscoveryPart, RequestAndResultSurviveTheirJson) {
-  DiscoveryRequest q = coulombRequest();
+  DiscoveryRequest q = rippleRequest();
   q.options.observerBandwidthHz = 0.5;
   q.options.threads = 1;
   std::string why;
@@ -145,7 +145,7 @@ TEST(SessionParts, DamagedDiscoveryAndLqgSectionsAreRefusedNamingThem) {
   EXPECT_NE(b.message.find("gremlins"), std::string::npos) << b.message;
 
   json badResult = j;
-  badResult["parts"]["discovery"]["result"] = {{"effect", "coulomb_friction"}};
+  badResult["parts"]["discovery"]["result"] = {{"effect", "torque_ripple"}};
   auto c = parseSession(badResult.dump());
   EXPECT_FALSE(c.ok);
   EXPECT_NE(c.message.find("discovery result"), std::string::npos) << c.message;
@@ -173,13 +173,15 @@ TEST(SessionParts, SaveReopenReplayGivesTheSameVerdictAndLqgNumbers) {
   const json a = first.report.toJson();
   const json* d = values(a, kDiscoveryTitle);
   ASSERT_NE(d, nullptr) << a.dump(1);
-  EXPECT_EQ((*d)["effect"], "coulomb_friction") << (*d)["evidence"];
+  EXPECT_EQ((*d)["effect"], "torque_ripple") << (*d)["evidence"];
   // The augmented model explains the validation data better than the base.
   EXPECT_LT((*d)["augmented"]["rms_validation"].get<double>(),
             0.9 * (*d)["base"]["rms_validation"].get<double>());
-  // F_c (N m) near the value that generated the log.
-  const double fc = (*d)["effect_parameters"]["F_c"]["value"].get<double>();
-  EXPECT_NEAR(fc, truthOf("F_c"), 0.5 * truthOf("F_c"));
+  // The ripple amplitude A (N m) within 3 std of the value that generated the log.
+  const double amplitude = (*d)["effect_parameters"]["A"]["value"].get<double>();
+  const double sd = (*d)["effect_parameters"]["A"]["std"].get<double>();
+  EXPECT_GT(sd, 0.0);
+  EXPECT_NEAR(amplitude, truthOf("A"), 3.0 * sd);
 
   const json* l = values(a, kLqgTitle);
   ASSERT_NE(l, nullptr);
@@ -204,7 +206,7 @@ TEST(SessionParts, SaveReopenReplayGivesTheSameVerdictAndLqgNumbers) {
 TEST(SessionParts, MissingLogOrModelBecomesASentence) {
   const std::string path = (scratch() / "missing.json").string();
   Session s = session(path);
-  DiscoveryRequest q = coulombRequest();
+  DiscoveryRequest q = rippleRequest();
   q.estimation.log = "tomorrow";
   s.parts["discovery"] = {{"request", discoveryRequestToJson(q)}};
   s.parts.erase("lqg");
@@ -216,7 +218,7 @@ TEST(SessionParts, MissingLogOrModelBecomesASentence) {
   EXPECT_TRUE((*d)["effect"].is_null());
   EXPECT_NE((*d)["message"].get<std::string>().find("tomorrow"), std::string::npos);
 
-  q = coulombRequest();
+  q = rippleRequest();
   q.baseStructure.clear();
   q.baseModel = "no such model";
   s.parts["discovery"] = {{"request", discoveryRequestToJson(q)}};
