@@ -25,9 +25,11 @@ std::string pdfText(const std::string& pdf) {
   const std::string txt = pdf + ".txt";
   const std::string cmd = "pdftotext -layout '" + pdf + "' '" + txt + "'";
   EXPECT_EQ(std::system(cmd.c_str()), 0) << cmd;
-  // The PDF's font sets "fi" and "fl" as ligatures; read them as letters.
+  // The PDF's font sets "ff", "fi", "fl", "ffi" and "ffl" as ligatures; read them as letters.
   std::string text = readAll(txt);
-  for (const auto& [lig, letters] : {std::pair<std::string, std::string>{"\xef\xac\x81", "fi"}, {"\xef\xac\x82", "fl"}})
+  for (const auto& [lig, letters] :
+       {std::pair<std::string, std::string>{"\xef\xac\x80", "ff"}, {"\xef\xac\x81", "fi"},
+        {"\xef\xac\x82", "fl"}, {"\xef\xac\x83", "ffi"}, {"\xef\xac\x84", "ffl"}})
     for (std::size_t at; (at = text.find(lig)) != std::string::npos;) text.replace(at, lig.size(), letters);
   return text;
 }
