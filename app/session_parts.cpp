@@ -102,21 +102,33 @@ void restoreFits(const json& section, MainWindow& w) {
 }
 
 // The Discovery panel's last request and the summary of its result; restoring shows the
-// stored result without running anything.
+// stored result without running anything. A request saved without a result is kept as read
+// (the window does not run discovery while opening) until the panel makes a result.
+constexpr const char* kKeptDiscovery = "flexarmKeptDiscovery";
+
 json captureDiscovery(const MainWindow& w) {
   const DiscoveryPanel* panel = w.discoveryPanel();
-  if (!panel || !panel->lastRequest() || !panel->result()) return nullptr;
-  return {{"request", discoveryRequestToJson(*panel->lastRequest())},
-          {"result", discoveryResultToJson(*panel->result())}};
+  if (panel && panel->lastRequest() && panel->result())
+    return {{"request", discoveryRequestToJson(*panel->lastRequest())},
+            {"result", discoveryResultToJson(*panel->result())}};
+  const QByteArray kept = w.property(kKeptDiscovery).toByteArray();
+  return kept.isEmpty() ? json(nullptr) : json::parse(kept.toStdString(), nullptr, false);
+}
+
+void resetDiscovery(MainWindow& w) {
+  w.setProperty(kKeptDiscovery, QByteArray());
+  if (w.discoveryPanel()) w.discoveryPanel()->clearResult();
 }
 
 void restoreDiscovery(const json& section, MainWindow& w) {
+  resetDiscovery(w);
   std::string why;
   auto request = discoveryRequestFromJson(section["request"], &why);
-  if (!w.discoveryPanel() || !request || !section.contains("result") || !section["result"].is_object())
-    return;
-  if (auto result = discoveryResultFromJson(section["result"], &why))
-    w.discoveryPanel()->showStored(*request, *result);
+  std::optional<DiscoveryResult> result;
+  if (section.contains("result") && section["result"].is_object())
+    result = discoveryResultFromJson(section["result"], &why);
+  if (w.discoveryPanel() && request && result) w.discoveryPanel()->showStored(*request, *result);
+  else w.setProperty(kKeptDiscovery, QByteArray::fromStdString(section.dump()));
 }
 
 // The LQG panel's design: parameters and where they came from, weights, saturation.
@@ -135,6 +147,11 @@ void restoreLqg(const json& section, MainWindow& w) {
   std::string why;
   if (auto r = lqgRequestFromJson(section, &why); r && w.lqgPanel())
     w.lqgPanel()->setDesign(r->design, r->saturationLimit, QString::fromStdString(r->source));
+}
+
+// A session without a design opens with the seed's case (i) on Table 8.1.
+void resetLqg(MainWindow& w) {
+  if (w.lqgPanel()) w.lqgPanel()->setDesign(LqgOptions::seedCaseI(), 0.0, w.lqgPanel()->tableSourceText());
 }
 
 json captureView(const MainWindow& w) {
@@ -156,8 +173,8 @@ const std::vector<WindowSessionPart>& windowSessionParts() {
   static const std::vector<WindowSessionPart> kParts = {
       {"models", &captureModels, &restoreModels},
       {"fits", &captureFits, &restoreFits},
-      {"discovery", &captureDiscovery, &restoreDiscovery},
-      {"lqg", &captureLqg, &restoreLqg},
+      {"discovery", &captureDiscovery, &restoreDiscovery, &resetDiscovery},
+      {"lqg", &captureLqg, &restoreLqg, &resetLqg},
       {"view", &captureView, &restoreView},
   };
   return kParts;

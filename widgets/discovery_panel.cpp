@@ -193,6 +193,30 @@ std::unique_ptr<PhysicalModel> DiscoveryPanel::chosenBase(std::vector<Effect>* e
   return makeModel(v.toString().toStdString());
 }
 
+void DiscoveryPanel::clearResult() {
+  if (watcher_.isRunning()) cancel();
+  ++run_;
+  request_.reset();
+  result_.reset();
+  added_ = false;
+  find_->setEnabled(true);
+  add_->setEnabled(false);
+  cancel_->setVisible(false);
+  progress_->setVisible(false);
+  verdict_->setText(tr("Choose a base model and press \"Find missing effect\"."));
+  for (QLabel* l : {evidence_, where_, comparison_, stage_}) l->clear();
+  table_->setRowCount(0);
+  clearPlots();
+}
+
+void DiscoveryPanel::clearPlots() {
+  for (QCustomPlot* p : {residualTime_, residualSpectrum_, overlay_}) {
+    for (int g = 0; g < p->graphCount(); ++g) p->graph(g)->data()->clear();
+    p->clearItems();
+    p->replot();
+  }
+}
+
 QString DiscoveryPanel::verdictText() const { return verdict_->text(); }
 QString DiscoveryPanel::evidenceText() const { return evidence_->text(); }
 QString DiscoveryPanel::comparisonText() const { return comparison_->text(); }
@@ -377,11 +401,7 @@ void DiscoveryPanel::showResult() {
   // has no traces).
   const auto& e = r.estimation;
   if (e.time.size() < 8) {
-    for (QCustomPlot* p : {residualTime_, residualSpectrum_, overlay_}) {
-      for (int g = 0; g < p->graphCount(); ++g) p->graph(g)->data()->clear();
-      p->clearItems();
-      p->replot();
-    }
+    clearPlots();
     showComparison();
     return;
   }

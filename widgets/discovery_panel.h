@@ -51,6 +51,8 @@ class DiscoveryPanel : public QWidget {
   // no traces) without running anything; a run in progress is cancelled and its result
   // dropped. "Find missing effect" recomputes it with the plots.
   void showStored(const DiscoveryRequest& request, const DiscoveryResult& summary);
+  // Forgets the result (and drops a run in progress): the panel as before its first run.
+  void clearResult();
 
  public slots:
   void findMissingEffect();
@@ -73,6 +75,7 @@ class DiscoveryPanel : public QWidget {
   void showResult();
   void showOverlay();
   void showComparison();  // fit % and residual RMS before (and after adding) in words
+  void clearPlots();
   std::unique_ptr<PhysicalModel> chosenBase(std::vector<Effect>* effects) const;
 
   Workspace* workspace_;

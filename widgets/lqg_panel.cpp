@@ -476,6 +476,7 @@ void LqgPanel::setDesign(const LqgOptions& o, double saturationLimit, const QStr
 }
 
 QString LqgPanel::sourceText() const { return source_->currentText(); }
+QString LqgPanel::tableSourceText() const { return source_->itemText(0); }
 
 void LqgPanel::requestUpdate() {
   if (quiet_) return;

@@ -53,6 +53,8 @@ class LqgPanel : public QWidget {
   void setDesign(const LqgOptions& design, double saturationLimit, const QString& source);
   // Where the parameters come from, in words ("Table 8.1 (seed)", "model: ...").
   QString sourceText() const;
+  // The words of the first source, the seed's Table 8.1.
+  QString tableSourceText() const;
   // Selects the plant source: 0 is Table 8.1, i > 0 the workspace's model i - 1.
   void selectSource(int index);
   // Keeps the current design overlaid in every plot; unpin removes it.

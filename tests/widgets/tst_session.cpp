@@ -383,6 +383,25 @@ class SessionTest : public QObject {
     }
     QTest::qWait(100);
     test::saveShot(d2->grab().toImage(), "session-discovery-restored");
+
+    // A session without a discovery run shows none, and so does not save this one again.
+    QSignalSpy reopened(other->sessionController(), &SessionController::sessionOpened);
+    other->sessionController()->open(saved_);
+    QVERIFY(reopened.wait(30000));
+    QVERIFY(!d2->hasResult());
+    QCOMPARE(d2->candidatesTable()->rowCount(), 0);
+    QVERIFY(!stateOf(*other, saved_)["parts"].contains("discovery"));
+    QTRY_VERIFY_WITH_TIMEOUT(!l2->isComputing(), 20000);
+    QCOMPARE(l2->options().r2(0), window_->lqgPanel()->options().r2(0));
+
+    // The sample session's stored discovery result is shown as it opens.
+    QSignalSpy sample(other->sessionController(), &SessionController::sessionOpened);
+    other->sessionController()->open(QString(FLEXARM_SAMPLE_DIR) + "/sample_session.json");
+    QVERIFY(sample.wait(30000));
+    QVERIFY(!d2->isBusy());
+    QVERIFY2(d2->verdictText().contains("torque_ripple"), qPrintable(d2->verdictText()));
+    QCOMPARE(d2->candidatesTable()->rowCount(), 3);
+    QCOMPARE(l2->options().r2(0), 1e-6);  // the seed's case (i)
   }
 
   void cleanupTestCase() { delete window_; }
