@@ -260,13 +260,9 @@ class DiscoveryPart : public SessionPart {
       val = pickData(*request->validation, request->rawData, context, &why);
       if (!val) return fail("validation data: " + why);
     }
-    auto progress = [&](double f, const std::string&) {
-      return reportProgress(context.progress, std::min(1.0, f), "discovery") ? ProgressAction::Abort
-                                                                              : ProgressAction::Continue;
-    };
     DiscoveryResult r;
     try {
-      r = discoverMissingEffect(*base, *est, val ? &*val : nullptr, request->options, progress);
+      r = discoverMissingEffect(*base, *est, val ? &*val : nullptr, request->options, context.progress);
     } catch (const std::invalid_argument& e) {
       return fail(e.what());
     }

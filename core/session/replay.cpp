@@ -192,9 +192,16 @@ ReplayResult replaySession(const Session& session, const std::string& sessionPat
   for (std::size_t i = 0; i < parts.size(); ++i) {
     const std::string key = parts[i]->key();
     if (!session.parts.contains(key)) continue;
-    if (reportProgress(options.progress, 0.1 + 0.9 * static_cast<double>(i) / parts.size(), key))
-      return finish(Termination::Cancelled, "cancelled");
-    parts[i]->replay(session.parts[key], context, r.report);
+    const double lo = 0.1 + 0.9 * static_cast<double>(i) / parts.size();
+    const double hi = 0.1 + 0.9 * static_cast<double>(i + 1) / parts.size();
+    if (reportProgress(options.progress, lo, key)) return finish(Termination::Cancelled, "cancelled");
+    // The part reports 0..1 of its own work; the caller sees it within the part's share.
+    ReplayContext partContext = context;
+    partContext.progress = [&options, lo, hi](double f, const std::string& stage) {
+      return options.progress ? options.progress(lo + (hi - lo) * std::clamp(f, 0.0, 1.0), stage)
+                              : ProgressAction::Continue;
+    };
+    parts[i]->replay(session.parts[key], partContext, r.report);
   }
   return finish(Termination::Converged, "replayed " + std::to_string(r.report.sections.size()) +
                                             " report sections");
