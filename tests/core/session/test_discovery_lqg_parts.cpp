@@ -11,6 +11,7 @@
 
 #include "core/session/discovery_part.h"
 #include "core/session/lqg_part.h"
+#include "core/session/model_json.h"
 #include "core/session/replay.h"
 #include "core/session/session.h"
 #include "core/session/sha256.h"
@@ -49,7 +50,8 @@ DiscoveryRequest rippleRequest() {
   return q;
 }
 
-// The chirp log analysed, the ripple log for discovery, and the two parts.
+// The chirp log analysed, the ripple log for discovery, and the two parts; discovery starts
+// from the model list's nominal three-mass arm, named "arm".
 Session session(const std::string& path) {
   Session s;
   std::string why;
@@ -60,7 +62,11 @@ Session session(const std::string& path) {
     l.sha256 = sha256OfFile(file, &why).value_or("");
     s.logs.push_back(l);
   }
-  s.parts["discovery"] = {{"request", discoveryRequestToJson(rippleRequest())}};
+  s.parts["models"] = json::array({modelToJson("arm", *makeModel("three-mass"), {})});
+  DiscoveryRequest q = rippleRequest();
+  q.baseStructure.clear();
+  q.baseModel = "arm";
+  s.parts["discovery"] = {{"request", discoveryRequestToJson(q)}};
   LqgRequest lqg;
   lqg.design = LqgOptions::seedCaseII();
   s.parts["lqg"] = lqgRequestToJson(lqg);
@@ -132,7 +138,7 @@ TEST(SessionParts, DamagedDiscoveryAndLqgSectionsAreRefusedNamingThem) {
   const std::string path = (scratch() / "damaged.json").string();
   json j = json::parse(toJsonText(session(path)));
   json noBase = j;
-  noBase["parts"]["discovery"]["request"].erase("base_structure");
+  noBase["parts"]["discovery"]["request"].erase("base_model");
   auto a = parseSession(noBase.dump());
   EXPECT_FALSE(a.ok);
   EXPECT_NE(a.message.find("discovery"), std::string::npos) << a.message;
@@ -174,6 +180,7 @@ TEST(SessionParts, SaveReopenReplayGivesTheSameVerdictAndLqgNumbers) {
   const json* d = values(a, kDiscoveryTitle);
   ASSERT_NE(d, nullptr) << a.dump(1);
   EXPECT_EQ((*d)["effect"], "torque_ripple") << (*d)["evidence"];
+  EXPECT_EQ((*d)["base_model"], "arm");
   // The augmented model explains the validation data better than the base.
   EXPECT_LT((*d)["augmented"]["rms_validation"].get<double>(),
             0.9 * (*d)["base"]["rms_validation"].get<double>());
