@@ -81,12 +81,25 @@ std::unique_ptr<QCustomPlot> makePlot(const ReportPlot& p) {
                                    QColor(148, 103, 189)};
   for (std::size_t i = 0; i < p.series.size(); ++i) {
     const auto& s = p.series[i];
-    QCPGraph* g = plot->addGraph();
-    g->setName(QString::fromStdString(s.name));
     QPen pen(kColors[(s.color >= 0 ? static_cast<std::size_t>(s.color) : i) % 4], 1.4);
     if (s.dashed) pen.setStyle(Qt::DashLine);
-    g->setPen(pen);
-    g->setData(QVector<double>(s.x.begin(), s.x.end()), QVector<double>(s.y.begin(), s.y.end()), true);
+    const QVector<double> x(s.x.begin(), s.x.end()), y(s.y.begin(), s.y.end());
+    QCPAbstractPlottable* item = nullptr;
+    if (p.parametric) {
+      auto* c = new QCPCurve(plot->xAxis, plot->yAxis);
+      c->setData(x, y);
+      if (x.size() == 1) {  // a single point (e.g. -1 in a Nyquist plot) as a marker
+        c->setLineStyle(QCPCurve::lsNone);
+        c->setScatterStyle(QCPScatterStyle(QCPScatterStyle::ssCross, pen.color(), 9));
+      }
+      item = c;
+    } else {
+      auto* g = plot->addGraph();
+      g->setData(x, y, true);
+      item = g;
+    }
+    item->setName(QString::fromStdString(s.name));
+    item->setPen(pen);
   }
   plot->xAxis->setLabel(QString::fromStdString(p.xLabel));
   plot->yAxis->setLabel(QString::fromStdString(p.yLabel));
@@ -103,6 +116,8 @@ std::unique_ptr<QCustomPlot> makePlot(const ReportPlot& p) {
     plot->axisRect()->insetLayout()->setInsetAlignment(0, Qt::AlignBottom | Qt::AlignLeft);
   plot->legend->setFont(QFont("sans", 8));
   plot->rescaleAxes();
+  if (p.xRange) plot->xAxis->setRange(p.xRange->first, p.xRange->second);
+  if (p.yRange) plot->yAxis->setRange(p.yRange->first, p.yRange->second);
   return plot;
 }
 

@@ -235,8 +235,10 @@ void SessionController::onOpened() {
   };
   workspace_->setRangeDirect(RangeKind::Estimation, toTime(s.estimation));
   workspace_->setRangeDirect(RangeKind::Validation, toTime(s.validation));
-  for (const auto& part : windowSessionParts())
+  for (const auto& part : windowSessionParts()) {
     if (s.parts.contains(part.key)) part.restore(s.parts[part.key], *window_);
+    else if (part.reset) part.reset(*window_);
+  }
   workspace_->undoStack()->clear();
   restoring_ = false;
   logSha256_ = log.sha256;

@@ -4,8 +4,12 @@
 #include <QVariant>
 
 #include "app/main_window.h"
+#include "core/session/discovery_part.h"
 #include "core/session/fit_request.h"
+#include "core/session/lqg_part.h"
 #include "core/session/model_json.h"
+#include "widgets/discovery_panel.h"
+#include "widgets/lqg_panel.h"
 #include "widgets/model_panel.h"
 #include "widgets/workspace.h"
 
@@ -44,8 +48,12 @@ constexpr const char* kUnattachedFits = "flexarmUnattachedFits";
 
 json captureFits(const MainWindow& w) {
   json requests = json::array();
-  for (const auto& m : w.workspace()->models())
-    if (m.fitRequest) requests.push_back(fitRequestToJson(*m.fitRequest));
+  for (const auto& m : w.workspace()->models()) {
+    if (!m.fitRequest) continue;
+    json request = fitRequestToJson(*m.fitRequest);
+    if (m.polynomial) request["estimate"] = polynomialEstimateToJson(*m.polynomial);
+    requests.push_back(request);
+  }
   const QByteArray kept = w.property(kUnattachedFits).toByteArray();
   if (!kept.isEmpty())
     for (const auto& j : json::parse(kept.toStdString(), nullptr, false))
@@ -55,8 +63,9 @@ json captureFits(const MainWindow& w) {
 }
 
 // Physical estimates come back with the model list: their requests are attached again. A
-// black-box estimate is not stored as such; it is estimated again from its request (a
-// polynomial fit of the session's data takes a fraction of a second).
+// black-box estimate comes back from the estimate stored with its request, so opening a
+// session estimates nothing; a request without one (a hand-written session) is kept as read
+// and replayed only by `flexarm run`.
 void restoreFits(const json& section, MainWindow& w) {
   Workspace* ws = w.workspace();
   json unattached = json::array();
@@ -75,20 +84,74 @@ void restoreFits(const json& section, MainWindow& w) {
       attached = true;
     }
     if (attached) continue;
-    if (request->physical() || !ws->current()) {
+    std::optional<PolynomialModel> estimate;
+    if (!request->physical() && j.contains("estimate"))
+      estimate = polynomialEstimateFromJson(j["estimate"], *request, &why);
+    if (!estimate) {
       unattached.push_back(j);
       continue;
     }
-    const FitRun run = runFitRequest(*request, *ws->current());
-    if (!run.summary.ok() || !run.polynomial) continue;
     ModelEntry e;
     e.name = name;
-    e.polynomial = run.polynomial;
+    e.polynomial = std::make_shared<const PolynomialModel>(std::move(*estimate));
     e.fitRequest = shared;
     ws->insertModelDirect(static_cast<int>(ws->models().size()), e);
   }
   w.setProperty(kUnattachedFits, unattached.empty() ? QByteArray()
                                                      : QByteArray::fromStdString(unattached.dump()));
+}
+
+// The Discovery panel's last request and the summary of its result; restoring shows the
+// stored result without running anything. A request saved without a result is kept as read
+// (the window does not run discovery while opening) until the panel makes a result.
+constexpr const char* kKeptDiscovery = "flexarmKeptDiscovery";
+
+json captureDiscovery(const MainWindow& w) {
+  const DiscoveryPanel* panel = w.discoveryPanel();
+  if (panel && panel->lastRequest() && panel->result())
+    return {{"request", discoveryRequestToJson(*panel->lastRequest())},
+            {"result", discoveryResultToJson(*panel->result())}};
+  const QByteArray kept = w.property(kKeptDiscovery).toByteArray();
+  return kept.isEmpty() ? json(nullptr) : json::parse(kept.toStdString(), nullptr, false);
+}
+
+void resetDiscovery(MainWindow& w) {
+  w.setProperty(kKeptDiscovery, QByteArray());
+  if (w.discoveryPanel()) w.discoveryPanel()->clearResult();
+}
+
+void restoreDiscovery(const json& section, MainWindow& w) {
+  resetDiscovery(w);
+  std::string why;
+  auto request = discoveryRequestFromJson(section["request"], &why);
+  std::optional<DiscoveryResult> result;
+  if (section.contains("result") && section["result"].is_object())
+    result = discoveryResultFromJson(section["result"], &why);
+  if (w.discoveryPanel() && request && result) w.discoveryPanel()->showStored(*request, *result);
+  else w.setProperty(kKeptDiscovery, QByteArray::fromStdString(section.dump()));
+}
+
+// The LQG panel's design: parameters and where they came from, weights, saturation.
+json captureLqg(const MainWindow& w) {
+  const LqgPanel* panel = w.lqgPanel();
+  if (!panel) return nullptr;
+  LqgRequest r;
+  r.source = panel->sourceText().toStdString();
+  r.design = panel->options();
+  r.saturationLimit = panel->analysisOptions().saturationLimit;
+  r.taBandwidth = panel->analysisOptions().taBandwidth;
+  return lqgRequestToJson(r);
+}
+
+void restoreLqg(const json& section, MainWindow& w) {
+  std::string why;
+  if (auto r = lqgRequestFromJson(section, &why); r && w.lqgPanel())
+    w.lqgPanel()->setDesign(r->design, r->saturationLimit, QString::fromStdString(r->source));
+}
+
+// A session without a design opens with the seed's case (i) on Table 8.1.
+void resetLqg(MainWindow& w) {
+  if (w.lqgPanel()) w.lqgPanel()->setDesign(LqgOptions::seedCaseI(), 0.0, w.lqgPanel()->tableSourceText());
 }
 
 json captureView(const MainWindow& w) {
@@ -110,6 +173,8 @@ const std::vector<WindowSessionPart>& windowSessionParts() {
   static const std::vector<WindowSessionPart> kParts = {
       {"models", &captureModels, &restoreModels},
       {"fits", &captureFits, &restoreFits},
+      {"discovery", &captureDiscovery, &restoreDiscovery, &resetDiscovery},
+      {"lqg", &captureLqg, &restoreLqg, &resetLqg},
       {"view", &captureView, &restoreView},
   };
   return kParts;

@@ -16,6 +16,9 @@ struct WindowSessionPart {
   nlohmann::json (*capture)(const MainWindow& window);
   // Applies a validated section. Called only after every fallible step of opening succeeded.
   void (*restore)(const nlohmann::json& section, MainWindow& window);
+  // Returns the window's side to its state without the section, when an opened session has
+  // none (so nothing of the previous session is shown or saved again); null: nothing to do.
+  void (*reset)(MainWindow& window) = nullptr;
 };
 
 const std::vector<WindowSessionPart>& windowSessionParts();

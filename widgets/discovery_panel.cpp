@@ -193,6 +193,30 @@ std::unique_ptr<PhysicalModel> DiscoveryPanel::chosenBase(std::vector<Effect>* e
   return makeModel(v.toString().toStdString());
 }
 
+void DiscoveryPanel::clearResult() {
+  if (watcher_.isRunning()) cancel();
+  ++run_;
+  request_.reset();
+  result_.reset();
+  added_ = false;
+  find_->setEnabled(true);
+  add_->setEnabled(false);
+  cancel_->setVisible(false);
+  progress_->setVisible(false);
+  verdict_->setText(tr("Choose a base model and press \"Find missing effect\"."));
+  for (QLabel* l : {evidence_, where_, comparison_, stage_}) l->clear();
+  table_->setRowCount(0);
+  clearPlots();
+}
+
+void DiscoveryPanel::clearPlots() {
+  for (QCustomPlot* p : {residualTime_, residualSpectrum_, overlay_}) {
+    for (int g = 0; g < p->graphCount(); ++g) p->graph(g)->data()->clear();
+    p->clearItems();
+    p->replot();
+  }
+}
+
 QString DiscoveryPanel::verdictText() const { return verdict_->text(); }
 QString DiscoveryPanel::evidenceText() const { return evidence_->text(); }
 QString DiscoveryPanel::comparisonText() const { return comparison_->text(); }
@@ -223,6 +247,20 @@ void DiscoveryPanel::findMissingEffect() {
   if (all.validationRange && !all.validationRange->empty())
     val = std::make_shared<IdData>(all.select(*all.validationRange));
   baseName_ = base_->currentText();
+  // The request as a session stores it: the workspace's log as preprocessed, its ranges.
+  DiscoveryRequest request;
+  if (base_->currentData().typeId() == QMetaType::Int) request.baseModel = base_->currentText().toStdString();
+  else request.baseStructure = base_->currentData().toString().toStdString();
+  auto seconds = [this](RangeKind k) -> std::optional<SecondsRange> {
+    const auto r = workspace_->range(k);
+    if (!r || !(r->start < r->end)) return std::nullopt;
+    return SecondsRange{r->start, r->end};
+  };
+  if (all.estimationRange && !all.estimationRange->empty()) request.estimation.range = seconds(RangeKind::Estimation);
+  if (val) request.validation = DiscoveryDataRef{"", seconds(RangeKind::Validation)};
+  request.options = options_;
+  pendingRequest_ = request;
+  const int run = ++run_;
   std::shared_ptr<const PhysicalModel> baseModel(std::move(base));
   cancelFlag_ = std::make_shared<std::atomic<bool>>(false);
   auto flag = cancelFlag_;
@@ -238,8 +276,9 @@ void DiscoveryPanel::findMissingEffect() {
   evidence_->clear();
   comparison_->clear();
   added_ = false;
-  watcher_.setFuture(QtConcurrent::run([est, val, baseModel, o, flag, self]() {
+  watcher_.setFuture(QtConcurrent::run([est, val, baseModel, o, flag, self, run]() {
     Outcome out;
+    out.run = run;
     try {
       auto progress = [flag, self](double f, const std::string& stage) {
         const QString text = QString::fromStdString(stage);
@@ -272,6 +311,10 @@ void DiscoveryPanel::onFinished() {
   find_->setEnabled(true);
   cancel_->setVisible(false);
   progress_->setVisible(false);
+  if (out.run != run_) {  // a stored result replaced this run while it ran
+    emit finished();
+    return;
+  }
   if (!out.error.isEmpty() || !out.result) {
     verdict_->setText(tr("Discovery failed: %1").arg(out.error));
     emit finished();
@@ -289,8 +332,29 @@ void DiscoveryPanel::onFinished() {
     return;
   }
   result_ = out.result;
+  request_ = pendingRequest_;
   showResult();
   emit finished();
+}
+
+void DiscoveryPanel::showStored(const DiscoveryRequest& request, const DiscoveryResult& summary) {
+  if (watcher_.isRunning()) cancel();
+  ++run_;
+  request_ = request;
+  result_ = std::make_shared<DiscoveryResult>(summary);
+  const int k = base_->findText(request.baseModel.empty()
+                                    ? tr("%1 (nominal)").arg(QString::fromStdString(request.baseStructure))
+                                    : QString::fromStdString(request.baseModel));
+  if (k >= 0) base_->setCurrentIndex(k);
+  baseName_ = base_->currentText();
+  added_ = false;
+  find_->setEnabled(true);
+  cancel_->setVisible(false);
+  progress_->setVisible(false);
+  showResult();
+  // The summary has no augmented model to add; a new run gives one.
+  add_->setEnabled(false);
+  stage_->setText(tr("Stored result of the session; \"Find missing effect\" recomputes it with its plots."));
 }
 
 void DiscoveryPanel::showResult() {
@@ -333,8 +397,14 @@ void DiscoveryPanel::showResult() {
   }
   table_->resizeColumnsToContents();
 
-  // Base residual in time and frequency, the model's resonances marked.
+  // Base residual in time and frequency, the model's resonances marked (a stored summary
+  // has no traces).
   const auto& e = r.estimation;
+  if (e.time.size() < 8) {
+    clearPlots();
+    showComparison();
+    return;
+  }
   const auto baseRes = difference(e.measured, e.base);
   residualTime_->graph(0)->setData(toQ(e.time), toQ(baseRes), true);
   residualTime_->graph(1)->data()->clear();
@@ -374,12 +444,19 @@ void DiscoveryPanel::showOverlay() {
                                             : tr("time (s), estimation data"));
   overlay_->rescaleAxes();
   overlay_->replot();
+  showComparison();
+}
+
+void DiscoveryPanel::showComparison() {
+  const DiscoveryResult& r = *result_;
+  // A stored summary shows the augmented scores at once: its model is not in the list.
+  const bool after = added_ || (r.effect && r.estimation.time.empty());
   QString text = tr("Base: fit %1 % (estimation)").arg(r.base.fitPercent, 0, 'f', 1);
   if (r.hasValidation)
     text += tr(", %1 % (validation), residual RMS %2 rad/s")
                 .arg(r.base.fitPercentValidation, 0, 'f', 1)
                 .arg(num(r.base.rmsValidation));
-  if (added_) {
+  if (after) {
     text += tr(".   Augmented: fit %1 % (estimation)").arg(r.augmented.fitPercent, 0, 'f', 1);
     if (r.hasValidation)
       text += tr(", %1 % (validation), residual RMS %2 rad/s (%3 % lower)")

@@ -11,6 +11,7 @@
 #include <memory>
 
 #include "core/discovery/discovery.h"
+#include "core/session/discovery_part.h"
 #include "widgets/workspace.h"
 
 class QComboBox;
@@ -43,6 +44,15 @@ class DiscoveryPanel : public QWidget {
   QCustomPlot* residualSpectrumPlot() const { return residualSpectrum_; }
   QCustomPlot* overlayPlot() const { return overlay_; }
   DiscoveryOptions& options() { return options_; }
+  // What the shown result was asked (base, data ranges, options); null before the first
+  // result.
+  const DiscoveryRequest* lastRequest() const { return request_ ? &*request_ : nullptr; }
+  // Shows a stored result (a session's summary: verdict, evidence, candidates and scores,
+  // no traces) without running anything; a run in progress is cancelled and its result
+  // dropped. "Find missing effect" recomputes it with the plots.
+  void showStored(const DiscoveryRequest& request, const DiscoveryResult& summary);
+  // Forgets the result (and drops a run in progress): the panel as before its first run.
+  void clearResult();
 
  public slots:
   void findMissingEffect();
@@ -58,11 +68,14 @@ class DiscoveryPanel : public QWidget {
   struct Outcome {
     std::shared_ptr<DiscoveryResult> result;
     QString error;
+    int run = 0;  // the run it answers
   };
   void refillModels();
   void onFinished();
   void showResult();
   void showOverlay();
+  void showComparison();  // fit % and residual RMS before (and after adding) in words
+  void clearPlots();
   std::unique_ptr<PhysicalModel> chosenBase(std::vector<Effect>* effects) const;
 
   Workspace* workspace_;
@@ -84,6 +97,8 @@ class DiscoveryPanel : public QWidget {
   std::shared_ptr<std::atomic<bool>> cancelFlag_;
   std::shared_ptr<DiscoveryResult> result_;
   DiscoveryOptions options_;
+  std::optional<DiscoveryRequest> request_, pendingRequest_;
+  int run_ = 0;  // increases with every run started and every stored result shown
   QString baseName_;
   bool added_ = false;
 };

@@ -451,6 +451,33 @@ void LqgPanel::applyPreset(Preset preset) {
   requestUpdate();
 }
 
+void LqgPanel::setDesign(const LqgOptions& o, double saturationLimit, const QString& source) {
+  quiet_ = true;
+  source_->blockSignals(true);
+  source_->setCurrentIndex(0);
+  for (int i = 1; i < source_->count(); ++i)
+    if (source_->itemText(i) == source) source_->setCurrentIndex(i);
+  source_->blockSignals(false);
+  reductionLabel_->setText(tr("Parameters as the session stored them (%1).").arg(source));
+  fillParameters(o.parameters);
+  for (int i = 0; i < 5 && i < o.q1.size() && i < o.r1.size(); ++i) {
+    weight(QString("q1_%1").arg(i + 1))->setValue(o.q1(i));
+    weight(QString("r1_%1").arg(i + 1))->setValue(o.r1(i));
+  }
+  weight("q2")->setValue(o.q2);
+  if (o.r2.size() > 0) weight("r2_1")->setValue(o.r2(0));
+  if (o.r2.size() > 1) weight("r2_2")->setValue(o.r2(1));
+  acceleration_->setChecked(o.measurement == LqgMeasurement::MotorAngleAndArmAcceleration);
+  saturation_->setChecked(saturationLimit > 0.0);
+  if (saturationLimit > 0.0) saturationLimit_->setText(QString::number(saturationLimit, 'g', 6));
+  updateMeasurementControls();
+  quiet_ = false;
+  requestUpdate();
+}
+
+QString LqgPanel::sourceText() const { return source_->currentText(); }
+QString LqgPanel::tableSourceText() const { return source_->itemText(0); }
+
 void LqgPanel::requestUpdate() {
   if (quiet_) return;
   const LqgOptions o = options();

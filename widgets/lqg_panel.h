@@ -48,6 +48,13 @@ class LqgPanel : public QWidget {
   LqgAnalysisOptions analysisOptions() const;
   // Sets the weights and measurement of a seed design (the plant parameters stay).
   void applyPreset(Preset preset);
+  // Shows a whole design (parameters, measurement, weights, saturation limit; 0: none) as a
+  // session restores it; `source` says where the parameters came from. Redesigns once.
+  void setDesign(const LqgOptions& design, double saturationLimit, const QString& source);
+  // Where the parameters come from, in words ("Table 8.1 (seed)", "model: ...").
+  QString sourceText() const;
+  // The words of the first source, the seed's Table 8.1.
+  QString tableSourceText() const;
   // Selects the plant source: 0 is Table 8.1, i > 0 the workspace's model i - 1.
   void selectSource(int index);
   // Keeps the current design overlaid in every plot; unpin removes it.

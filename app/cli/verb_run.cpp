@@ -16,8 +16,8 @@ ReportRenderer gRenderer = nullptr;
 const char* kRunHelp =
     "Usage: flexarm run SESSION.json [--log NAME=PATH ...] [--report OUT.pdf|OUT.html] [--json]\n\n"
     "Replays a saved session without a window: reads its logs (checking their SHA-256),\n"
-    "applies its preprocessing and ranges, recomputes every model's results and writes the\n"
-    "report. At least one of --report and --json is needed.\n\n"
+    "applies its preprocessing and ranges, recomputes every part (models, fits, discovery,\n"
+    "the LQG design) and writes the report. At least one of --report and --json is needed.\n\n"
     "  --log NAME=PATH       use PATH instead of the session's log NAME (repeatable), e.g.\n"
     "                        tomorrow's log of the same experiment\n"
     "  --report FILE         write the report: .pdf (vector plots) or .html (self-contained,\n"

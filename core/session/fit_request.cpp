@@ -25,23 +25,6 @@ std::shared_ptr<PhysicalModel> clonePhysicalModel(const ParametricModel& m) {
   return std::shared_ptr<PhysicalModel>(static_cast<PhysicalModel*>(c.release()));
 }
 
-json rangeJson(const std::optional<SecondsRange>& r) {
-  return r ? json::array({r->start, r->end}) : json(nullptr);
-}
-
-bool readRange(const json& j, const char* key, std::optional<SecondsRange>& out, std::string* why) {
-  out.reset();
-  if (!j.contains(key) || j[key].is_null()) return true;
-  const json& r = j[key];
-  if (!r.is_array() || r.size() != 2 || !r[0].is_number() || !r[1].is_number() ||
-      !(r[0].get<double>() < r[1].get<double>())) {
-    if (why) *why = std::string(key) + " must be [start, end] in seconds with start < end";
-    return false;
-  }
-  out = SecondsRange{r[0].get<double>(), r[1].get<double>()};
-  return true;
-}
-
 bool readInt(const json& j, const char* key, int lo, int hi, int& out, std::string* why) {
   if (!j.contains(key)) return true;  // the default
   if (!j[key].is_number_integer() || j[key].get<long long>() < lo || j[key].get<long long>() > hi) {
@@ -54,6 +37,24 @@ bool readInt(const json& j, const char* key, int lo, int hi, int& out, std::stri
 }
 
 }  // namespace
+
+json secondsRangeToJson(const std::optional<SecondsRange>& r) {
+  return r ? json::array({r->start, r->end}) : json(nullptr);
+}
+
+bool readSecondsRange(const json& j, const char* key, std::optional<SecondsRange>& out, std::string* why) {
+  out.reset();
+  if (!j.contains(key) || j[key].is_null()) return true;
+  const json& r = j[key];
+  if (!r.is_array() || r.size() != 2 || !r[0].is_number() || !r[1].is_number() ||
+      !(r[0].get<double>() < r[1].get<double>())) {
+    if (why) *why = std::string(key) + " must be [start, end] in seconds with start < end";
+    return false;
+  }
+  out = SecondsRange{r[0].get<double>(), r[1].get<double>()};
+  return true;
+}
+
 
 bool FitRequest::isValid(std::string* why) const {
   auto fail = [why](const std::string& w) {
@@ -82,8 +83,8 @@ json fitRequestToJson(const FitRequest& r) {
   json j = {{"name", r.name},
             {"decimation", r.decimation},
             {"max_iterations", r.maxIterations},
-            {"estimation_s", rangeJson(r.estimation)},
-            {"validation_s", rangeJson(r.validation)}};
+            {"estimation_s", secondsRangeToJson(r.estimation)},
+            {"validation_s", secondsRangeToJson(r.validation)}};
   if (r.physical()) {
     j["kind"] = "physical";
     j["start"] = modelToJson(r.name, *r.start, {});
@@ -115,8 +116,8 @@ std::optional<FitRequest> fitRequestFromJson(const json& j, std::string* why) {
   const std::string kind = j["kind"].get<std::string>();
   if (!readInt(j, "decimation", 1, 1000, r.decimation, &reason) ||
       !readInt(j, "max_iterations", 1, 100000, r.maxIterations, &reason) ||
-      !readRange(j, "estimation_s", r.estimation, &reason) ||
-      !readRange(j, "validation_s", r.validation, &reason))
+      !readSecondsRange(j, "estimation_s", r.estimation, &reason) ||
+      !readSecondsRange(j, "validation_s", r.validation, &reason))
     return fail(where + reason);
   if (kind == "physical") {
     if (!j.contains("start")) return fail(where + "a physical fit needs its start model");
@@ -163,6 +164,64 @@ std::optional<FitRequest> fitRequestFromJson(const json& j, std::string* why) {
   }
   if (!r.isValid(&reason)) return fail(where + reason);
   return r;
+}
+
+json polynomialEstimateToJson(const PolynomialModel& m) {
+  json theta = json::array(), cov = json::array();
+  const Eigen::VectorXd p = m.parameterVector();
+  for (Eigen::Index i = 0; i < p.size(); ++i) theta.push_back(p(i));
+  for (Eigen::Index i = 0; i < m.covariance.rows(); ++i) {
+    json row = json::array();
+    for (Eigen::Index k = 0; k < m.covariance.cols(); ++k) row.push_back(m.covariance(i, k));
+    cov.push_back(row);
+  }
+  return {{"parameters", theta},
+          {"sample_time", m.sampleTime},
+          {"noise_variance", m.noiseVariance},
+          {"covariance", m.covariance.size() ? cov : json(nullptr)}};
+}
+
+std::optional<PolynomialModel> polynomialEstimateFromJson(const json& j, const FitRequest& request,
+                                                          std::string* why) {
+  auto fail = [&](const std::string& text) -> std::optional<PolynomialModel> {
+    if (why) *why = "the estimate of fit '" + request.name + "': " + text;
+    return std::nullopt;
+  };
+  if (request.physical()) return fail("a physical fit keeps its estimate in the model list");
+  if (!j.is_object() || !j.contains("parameters") || !j["parameters"].is_array())
+    return fail("needs a list of parameters");
+  const int n = request.orders.parameters();
+  if (static_cast<int>(j["parameters"].size()) != n)
+    return fail("holds " + std::to_string(j["parameters"].size()) + " parameters, the orders give " +
+                std::to_string(n));
+  if (!j.contains("sample_time") || !j["sample_time"].is_number() || !(j["sample_time"].get<double>() > 0.0))
+    return fail("sample_time must be a positive number");
+  PolynomialModel m = PolynomialModel::zero(request.structure, request.orders, j["sample_time"].get<double>());
+  Eigen::VectorXd theta(n);
+  for (int i = 0; i < n; ++i) {
+    const json& v = j["parameters"][static_cast<std::size_t>(i)];
+    if (!v.is_number() || !std::isfinite(v.get<double>())) return fail("every parameter must be a finite number");
+    theta(i) = v.get<double>();
+  }
+  m.setParameterVector(theta);
+  if (j.contains("noise_variance")) {
+    if (!j["noise_variance"].is_number()) return fail("noise_variance must be a number");
+    m.noiseVariance = j["noise_variance"].get<double>();
+  }
+  if (j.contains("covariance") && !j["covariance"].is_null()) {
+    const json& c = j["covariance"];
+    if (!c.is_array() || static_cast<int>(c.size()) != n) return fail("covariance must be " + std::to_string(n) + " rows");
+    m.covariance.resize(n, n);
+    for (int i = 0; i < n; ++i) {
+      const json& row = c[static_cast<std::size_t>(i)];
+      if (!row.is_array() || static_cast<int>(row.size()) != n) return fail("covariance must be square");
+      for (int k = 0; k < n; ++k) {
+        if (!row[static_cast<std::size_t>(k)].is_number()) return fail("covariance entries must be numbers");
+        m.covariance(i, k) = row[static_cast<std::size_t>(k)].get<double>();
+      }
+    }
+  }
+  return m;
 }
 
 std::optional<FitSignals> fitSignals(const IdData& source, int decimation, bool velocityOutput,
@@ -383,8 +442,11 @@ class FitsPart : public SessionPart {
       if (why) *why = "requests must be a list of fits";
       return false;
     }
-    for (const auto& r : section["requests"])
-      if (!fitRequestFromJson(r, why)) return false;
+    for (const auto& r : section["requests"]) {
+      auto request = fitRequestFromJson(r, why);
+      if (!request) return false;
+      if (r.contains("estimate") && !polynomialEstimateFromJson(r["estimate"], *request, why)) return false;
+    }
     return true;
   }
 

@@ -45,6 +45,13 @@ struct FitRequest {
   bool isValid(std::string* why) const;
 };
 
+// A range in seconds as session JSON, [start, end] or null.
+nlohmann::json secondsRangeToJson(const std::optional<SecondsRange>& r);
+// Reads j[key] (absent or null: no range); false with a sentence unless [start, end] with
+// start < end.
+bool readSecondsRange(const nlohmann::json& j, const char* key, std::optional<SecondsRange>& out,
+                      std::string* why);
+
 nlohmann::json fitRequestToJson(const FitRequest& request);
 // The request described by j; nullopt with a sentence for a malformed one.
 std::optional<FitRequest> fitRequestFromJson(const nlohmann::json& j, std::string* why);
@@ -52,6 +59,15 @@ std::optional<FitRequest> fitRequestFromJson(const nlohmann::json& j, std::strin
 // Input u and output y of the whole data with the estimation data's means removed (Section
 // 5.2), decimated behind the anti-alias FIR when decimation > 1, the output turned into the
 // motor velocity (central differences) when velocityOutput and the log gives the angle.
+// A black-box estimate stored with its request, so that a reopened session shows it without
+// estimating again: {"parameters": [a.. b.. c.. d.. f..], "sample_time", "noise_variance",
+// "covariance": rows or null}.
+nlohmann::json polynomialEstimateToJson(const PolynomialModel& model);
+// The estimate of a black-box request (its structure and orders) from j; nullopt with a
+// sentence when j does not match the request.
+std::optional<PolynomialModel> polynomialEstimateFromJson(const nlohmann::json& j, const FitRequest& request,
+                                                          std::string* why);
+
 struct FitSignals {
   Eigen::VectorXd u, y;
   Eigen::VectorXd r;  // the reference channel prepared alike; empty when the log has none

@@ -68,11 +68,14 @@ PreparedSession prepareSession(const Session& session, const std::string& sessio
       out.message = "log '" + ref.name + "': preprocessing failed: " + e.what();
       return out;
     }
+    // The ranges belong to the analysed (first) log; parts name their own ranges on the others.
+    const bool analysed = out.logs.empty();
     auto apply = [&](const std::optional<SecondsRange>& r, std::optional<SampleRange>& target,
                      const char* what) {
       target.reset();
       if (!r) return;
       SampleRange s = log.data.rangeForTimes(r->start, r->end);
+      if (s.empty() && !analysed) return;
       if (s.empty())
         out.warnings.push_back(std::string("the ") + what + " range " + formatSignificant(r->start) +
                                "-" + formatSignificant(r->end) + " s lies outside log '" +
@@ -179,15 +182,26 @@ ReplayResult replaySession(const Session& session, const std::string& sessionPat
   r.report.warnings = prepared.warnings;
   r.report.sections.push_back(dataSection(session, prepared));
   std::vector<std::pair<std::string, const IdData*>> logs;
-  for (const auto& l : prepared.logs) logs.emplace_back(l.name, &l.data);
-  ReplayContext context{session, prepared.logs.front().data, logs, options.progress};
+  std::vector<std::pair<std::string, const IdData*>> rawLogs;
+  for (const auto& l : prepared.logs) {
+    logs.emplace_back(l.name, &l.data);
+    rawLogs.emplace_back(l.name, &l.raw);
+  }
+  ReplayContext context{session, prepared.logs.front().data, logs, options.progress, &rawLogs};
   const auto& parts = sessionParts();
   for (std::size_t i = 0; i < parts.size(); ++i) {
     const std::string key = parts[i]->key();
     if (!session.parts.contains(key)) continue;
-    if (reportProgress(options.progress, 0.1 + 0.9 * static_cast<double>(i) / parts.size(), key))
-      return finish(Termination::Cancelled, "cancelled");
-    parts[i]->replay(session.parts[key], context, r.report);
+    const double lo = 0.1 + 0.9 * static_cast<double>(i) / parts.size();
+    const double hi = 0.1 + 0.9 * static_cast<double>(i + 1) / parts.size();
+    if (reportProgress(options.progress, lo, key)) return finish(Termination::Cancelled, "cancelled");
+    // The part reports 0..1 of its own work; the caller sees it within the part's share.
+    ReplayContext partContext = context;
+    partContext.progress = [&options, lo, hi](double f, const std::string& stage) {
+      return options.progress ? options.progress(lo + (hi - lo) * std::clamp(f, 0.0, 1.0), stage)
+                              : ProgressAction::Continue;
+    };
+    parts[i]->replay(session.parts[key], partContext, r.report);
   }
   return finish(Termination::Converged, "replayed " + std::to_string(r.report.sections.size()) +
                                             " report sections");

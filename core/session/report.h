@@ -3,7 +3,9 @@
 // The replay fills it without Qt; the window and `flexarm run` render it to HTML or PDF
 // (app/report_writer.h), and `flexarm run --json` prints toJson(), so the numbers in the
 // document and in the JSON are the same values.
+#include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <nlohmann/json.hpp>
@@ -28,6 +30,10 @@ struct ReportPlot {
   bool logX = false, logY = false;
   std::vector<ReportSeries> series;
   bool legendBottomLeft = false;  // where the curves leave room (Bode plots); else top right
+  // Series are curves in the plane (x need not increase), e.g. a Nyquist curve.
+  bool parametric = false;
+  // Axis ranges to show; unset: every point.
+  std::optional<std::pair<double, double>> xRange = std::nullopt, yRange = std::nullopt;
 };
 
 struct ReportSection {

@@ -23,7 +23,10 @@ struct ReplayContext {
   const Session& session;
   const IdData& data;
   const std::vector<std::pair<std::string, const IdData*>>& logs;  // by LogReference::name
-  ProgressCallback progress;
+  ProgressCallback progress;  // 0..1 of the part's own work; Abort cancels the replay
+  // Every log as read, before preprocessing and without ranges (by name); null when the
+  // caller has none.
+  const std::vector<std::pair<std::string, const IdData*>>* rawLogs = nullptr;
 };
 
 class SessionPart {

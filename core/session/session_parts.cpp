@@ -1,5 +1,6 @@
-// The parts a session holds today: the model list and view state. A capability that lands
-// later adds its class here (or in its own module) and one line to sessionParts().
+// The parts a session holds today: the model list, fits, discovery, the LQG design and view
+// state. A capability that lands later adds its class here (or in its own module) and one
+// line to sessionParts().
 #include <algorithm>
 #include <cmath>
 #include <complex>
@@ -10,7 +11,9 @@
 #include "core/ident/evaluation.h"
 #include "core/models/analysis.h"
 #include "core/models/nonlinear_plant.h"
+#include "core/session/discovery_part.h"
 #include "core/session/fit_request.h"
+#include "core/session/lqg_part.h"
 #include "core/session/model_json.h"
 #include "core/session/session_part.h"
 #include "core/signal/preprocess.h"
@@ -185,10 +188,12 @@ class ViewPart : public SessionPart {
 }  // namespace
 
 const std::vector<std::shared_ptr<const SessionPart>>& sessionParts() {
-  // Report order. Identification, discovery, LQG and later capabilities add their part here.
+  // Report order. Later capabilities add their part here.
   static const std::vector<std::shared_ptr<const SessionPart>> kParts = {
       std::make_shared<ModelsPart>(),
       makeFitsPart(),
+      makeDiscoveryPart(),
+      makeLqgPart(),
       std::make_shared<ViewPart>(),
   };
   return kParts;

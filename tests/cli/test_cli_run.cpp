@@ -25,9 +25,11 @@ std::string pdfText(const std::string& pdf) {
   const std::string txt = pdf + ".txt";
   const std::string cmd = "pdftotext -layout '" + pdf + "' '" + txt + "'";
   EXPECT_EQ(std::system(cmd.c_str()), 0) << cmd;
-  // The PDF's font sets "fi" and "fl" as ligatures; read them as letters.
+  // The PDF's font sets "ff", "fi", "fl", "ffi" and "ffl" as ligatures; read them as letters.
   std::string text = readAll(txt);
-  for (const auto& [lig, letters] : {std::pair<std::string, std::string>{"\xef\xac\x81", "fi"}, {"\xef\xac\x82", "fl"}})
+  for (const auto& [lig, letters] :
+       {std::pair<std::string, std::string>{"\xef\xac\x80", "ff"}, {"\xef\xac\x81", "fi"},
+        {"\xef\xac\x82", "fl"}, {"\xef\xac\x83", "ffi"}, {"\xef\xac\x84", "ffl"}})
     for (std::size_t at; (at = text.find(lig)) != std::string::npos;) text.replace(at, lig.size(), letters);
   return text;
 }
@@ -45,7 +47,9 @@ TEST(CliRun, JsonNamesVersionLogChecksumAndEveryModel) {
   for (const auto& s : j["sections"]) titles.push_back(s["title"]);
   EXPECT_EQ(titles, (std::vector<std::string>{"Data", "Model three-mass", "Model two-mass",
                                               "Non-parametric estimate (SPA)",
-                                              "Fit three-mass estimate"}));
+                                              "Fit three-mass estimate",
+                                              "Discovery: the missing effect",
+                                              "LQG design (chapter 8)"}));
   EXPECT_EQ(j["sections"][0]["values"]["rate_hz"].get<double>(), 200.0);
 }
 
@@ -93,6 +97,45 @@ TEST(CliRun, PdfTextHasTitlesParametersChecksumAndTheJsonFitPercent) {
                             "Measured and simulated output on the validation range",
                             "Residual autocorrelation", "Cross-correlation of residuals and input",
                             "Bode magnitude, SPA of the estimation data"})
+    EXPECT_NE(text.find(title), std::string::npos) << title;
+
+  // Discovery on the torque-ripple log names the effect that generated it, with the
+  // numbers of --json as printed: fit % with 2 decimals, residual RMS with 4 digits.
+  const nlohmann::json truth =
+      nlohmann::json::parse(readAll(std::string(FLEXARM_SAMPLE_DIR) + "/effect_torque_ripple.truth.json"));
+  const std::string hidden = truth["effects"][0]["name"];
+  const nlohmann::json* discovery = nullptr;
+  const nlohmann::json* lqg = nullptr;
+  for (const auto& s : j["sections"]) {
+    if (s["title"] == "Discovery: the missing effect") discovery = &s["values"];
+    if (s["title"] == "LQG design (chapter 8)") lqg = &s["values"];
+  }
+  ASSERT_NE(discovery, nullptr);
+  ASSERT_NE(lqg, nullptr);
+  EXPECT_EQ((*discovery)["effect"], hidden);
+  EXPECT_NE(text.find("Verdict: the missing effect is " + hidden), std::string::npos);
+  for (const char* model : {"base", "augmented"}) {
+    char rms[32], fit[32];
+    std::snprintf(rms, sizeof rms, "%.4g", (*discovery)[model]["rms_validation"].get<double>());
+    std::snprintf(fit, sizeof fit, "%.2f", (*discovery)[model]["fit_percent_validation"].get<double>());
+    EXPECT_NE(text.find(rms), std::string::npos) << model << " RMS " << rms;
+    EXPECT_NE(text.find(fit), std::string::npos) << model << " fit % " << fit;
+  }
+  EXPECT_LT((*discovery)["augmented"]["rms_validation"].get<double>(),
+            (*discovery)["base"]["rms_validation"].get<double>());
+  for (const char* title : {"Candidates", "Base and augmented model: fit % (5.2) and residual RMS",
+                            "Motor velocity on the validation data, before and after",
+                            "Residual on the validation data, before and after"})
+    EXPECT_NE(text.find(title), std::string::npos) << title;
+  // Case (i) of the seed: a stable regulator (Section 8.6), max |S| as printed.
+  EXPECT_EQ((*lqg)["regulator_stability"], "the regulator is stable");
+  EXPECT_NE(text.find("Regulator: the regulator is stable"), std::string::npos);
+  char maxS[32];
+  std::snprintf(maxS, sizeof maxS, "%.4g", (*lqg)["max_sensitivity"].get<double>());
+  EXPECT_NE(text.find(std::string("max |S| (8.36)")), std::string::npos);
+  EXPECT_NE(text.find(maxS), std::string::npos) << maxS;
+  for (const char* title : {"Design options", "Nyquist curve of F_y G near -1",
+                            "Sensitivity |S| (8.36) and complementary sensitivity |T|"})
     EXPECT_NE(text.find(title), std::string::npos) << title;
 }
 

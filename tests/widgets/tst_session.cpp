@@ -9,6 +9,9 @@
 #include <QMessageBox>
 #include <QPushButton>
 #include <QSettings>
+#include <QTableWidget>
+#include <QComboBox>
+#include <QDockWidget>
 #include <QSignalSpy>
 #include <QTemporaryDir>
 #include <QUndoStack>
@@ -22,7 +25,9 @@
 #include "core/signal/preprocess.h"
 #include "widget_test_support.h"
 #include "widgets/arm/vtk_view.h"
+#include "widgets/discovery_panel.h"
 #include "widgets/fit_panel.h"
+#include "widgets/lqg_panel.h"
 #include "widgets/model_panel.h"
 #include "widgets/preprocess_panel.h"
 #include "widgets/workspace.h"
@@ -32,6 +37,7 @@ using namespace flexarm;
 namespace {
 
 const QString kSampleLog = QString(FLEXARM_SAMPLE_DIR) + "/three_mass_estimation_chirp.csv";
+const QString kRippleLog = QString(FLEXARM_SAMPLE_DIR) + "/effect_torque_ripple.csv";
 
 PreprocessOptions seedPreprocessing() {
   PreprocessOptions p;
@@ -159,7 +165,7 @@ class SessionTest : public QObject {
   }
 
   // The Fit panel's fits are saved as requests; reopening attaches them to the physical
-  // estimate and estimates the black-box model again; the headless replay of the saved file
+  // estimate and restores the black-box model from its stored estimate; the headless replay of the saved file
   // repeats each fit with the fit % the panel showed.
   void fitsAreSavedReopenedAndReplayed() {
     Workspace* ws = window_->workspace();
@@ -310,6 +316,92 @@ class SessionTest : public QObject {
     QString why;
     QVERIFY2(window_->sessionController()->save(saved_, &why), qPrintable(why));
     QVERIFY(!QFile::exists(window_->sessionController()->autosavePath()));
+  }
+
+  // The Discovery panel's run and the LQG panel's design are saved with the session; the
+  // reopened window shows the same verdict, evidence, candidates and scores without running
+  // anything, and the same design with the same stability badge.
+  void discoveryAndLqgAreSavedAndReopened() {
+    std::unique_ptr<MainWindow> w(newWindow());
+    QSignalSpy logged(w.get(), &MainWindow::logOpened);
+    w->openFile(kRippleLog);
+    QVERIFY(logged.wait(30000));
+    w->workspace()->setRange(RangeKind::Estimation, {0.0, 6.0});
+    w->workspace()->setRange(RangeKind::Validation, {6.0, 10.0});
+    DiscoveryPanel* d = w->discoveryPanel();
+    d->options().candidates = {EffectKind::CoulombFriction, EffectKind::TorqueRipple};
+    d->baseModelBox()->setCurrentIndex(d->baseModelBox()->findText("three-mass (nominal)"));
+    QSignalSpy done(d, &DiscoveryPanel::finished);
+    QTest::mouseClick(d->findButton(), Qt::LeftButton);
+    QVERIFY(done.wait(240000));
+    QVERIFY2(d->hasResult(), qPrintable(d->verdictText()));
+    QVERIFY2(d->verdictText().contains("torque_ripple"), qPrintable(d->verdictText()));
+    QTest::mouseClick(d->addButton(), Qt::LeftButton);
+    LqgPanel* l = w->lqgPanel();
+    l->applyPreset(LqgPanel::Preset::CaseII);
+    QTRY_VERIFY_WITH_TIMEOUT(!l->isComputing(), 20000);
+    QVERIFY2(l->badgeText().contains("unstable"), qPrintable(l->badgeText()));
+
+    const QString path = dir_.filePath("discovery.json");
+    QString why;
+    QVERIFY2(w->sessionController()->save(path, &why), qPrintable(why));
+    const auto loaded = loadSession(path.toStdString());
+    QVERIFY2(loaded.ok, loaded.message.c_str());
+    QVERIFY(loaded.session.parts.contains("discovery"));
+    QCOMPARE(loaded.session.parts["discovery"]["result"]["effect"].get<std::string>(),
+             std::string("torque_ripple"));
+
+    std::unique_ptr<MainWindow> other(newWindow());
+    QSignalSpy opened(other->sessionController(), &SessionController::sessionOpened);
+    other->sessionController()->open(path);
+    QVERIFY(opened.wait(30000));
+    DiscoveryPanel* d2 = other->discoveryPanel();
+    QVERIFY(d2->hasResult());
+    QVERIFY(!d2->isBusy());  // nothing recomputed on opening
+    QCOMPARE(d2->verdictText(), d->verdictText());
+    QCOMPARE(d2->evidenceText(), d->evidenceText());
+    QCOMPARE(d2->comparisonText(), d->comparisonText());
+    QCOMPARE(d2->baseModelBox()->currentText(), QString("three-mass (nominal)"));
+    QTableWidget* a = d->candidatesTable();
+    QTableWidget* b = d2->candidatesTable();
+    QCOMPARE(b->rowCount(), a->rowCount());
+    for (int r = 0; r < a->rowCount(); ++r)
+      for (int c = 0; c < a->columnCount(); ++c) QCOMPARE(b->item(r, c)->text(), a->item(r, c)->text());
+    LqgPanel* l2 = other->lqgPanel();
+    QTRY_VERIFY_WITH_TIMEOUT(!l2->isComputing(), 20000);
+    QCOMPARE(l2->options().r2(0), l->options().r2(0));
+    QCOMPARE(l2->options().q1(0), l->options().q1(0));
+    QCOMPARE(l2->badgeText(), l->badgeText());
+    const auto before = stateOf(*w, path), after = stateOf(*other, path);
+    QCOMPARE(QString::fromStdString(after["parts"]["discovery"].dump(1)),
+             QString::fromStdString(before["parts"]["discovery"].dump(1)));
+    QCOMPARE(QString::fromStdString(after["parts"]["lqg"].dump(1)),
+             QString::fromStdString(before["parts"]["lqg"].dump(1)));
+    if (auto* dock = other->findChild<QDockWidget*>("discoveryDock")) {
+      dock->show();
+      dock->raise();
+    }
+    QTest::qWait(100);
+    test::saveShot(d2->grab().toImage(), "session-discovery-restored");
+
+    // A session without a discovery run shows none, and so does not save this one again.
+    QSignalSpy reopened(other->sessionController(), &SessionController::sessionOpened);
+    other->sessionController()->open(saved_);
+    QVERIFY(reopened.wait(30000));
+    QVERIFY(!d2->hasResult());
+    QCOMPARE(d2->candidatesTable()->rowCount(), 0);
+    QVERIFY(!stateOf(*other, saved_)["parts"].contains("discovery"));
+    QTRY_VERIFY_WITH_TIMEOUT(!l2->isComputing(), 20000);
+    QCOMPARE(l2->options().r2(0), window_->lqgPanel()->options().r2(0));
+
+    // The sample session's stored discovery result is shown as it opens.
+    QSignalSpy sample(other->sessionController(), &SessionController::sessionOpened);
+    other->sessionController()->open(QString(FLEXARM_SAMPLE_DIR) + "/sample_session.json");
+    QVERIFY(sample.wait(30000));
+    QVERIFY(!d2->isBusy());
+    QVERIFY2(d2->verdictText().contains("torque_ripple"), qPrintable(d2->verdictText()));
+    QCOMPARE(d2->candidatesTable()->rowCount(), 3);
+    QCOMPARE(l2->options().r2(0), 1e-6);  // the seed's case (i)
   }
 
   void cleanupTestCase() { delete window_; }

@@ -63,11 +63,13 @@ TEST(Sha256, KnownDigestsOfFips180Examples) {
             "cdc76e5c9914fb9281a1c7e284d73e67f1809a48a497200e046d39ccc7112cd0");
 }
 
-TEST(Session, SampleSessionChecksumMatchesItsLog) {
+TEST(Session, SampleSessionChecksumsMatchItsLogs) {
   Session s = sampleSession();
-  ASSERT_EQ(s.logs.size(), 1u);
+  ASSERT_EQ(s.logs.size(), 2u);  // the chirp analysed, the torque-ripple log for discovery
   std::string why;
   EXPECT_EQ(sha256OfFile(kChirp, &why).value_or(why), s.logs[0].sha256);
+  EXPECT_EQ(sha256OfFile(std::string(FLEXARM_SAMPLE_DIR) + "/effect_torque_ripple.csv", &why).value_or(why),
+            s.logs[1].sha256);
   EXPECT_TRUE(s.preprocessed);
   EXPECT_TRUE(s.preprocess.differentiateAngle);
   EXPECT_EQ(s.preprocess.decimation.factor, 10);
@@ -242,7 +244,7 @@ TEST(Replay, SaveReopenGivesIdenticalResults) {
   const auto dir = scratch();
   const std::string path = (dir / "reopen.json").string();
   Session s = sampleSession();
-  s.logs[0].path = storedLogPath(path, kChirp);
+  for (auto& l : s.logs) l.path = storedLogPath(path, std::string(FLEXARM_SAMPLE_DIR) + "/" + l.path);
   std::string why;
   ASSERT_TRUE(saveSession(s, path, &why)) << why;
   auto reopened = loadSession(path);
@@ -251,7 +253,8 @@ TEST(Replay, SaveReopenGivesIdenticalResults) {
   nlohmann::json b = replaySession(reopened.session, path).report.toJson();
   a.erase("session");
   b.erase("session");
-  for (auto* j : {&a, &b}) (*j)["logs"][0].erase("path");
+  for (auto* j : {&a, &b})
+    for (auto& l : (*j)["logs"]) l.erase("path");
   EXPECT_EQ(a.dump(), b.dump());
 }
 

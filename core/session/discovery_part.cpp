@@ -1,0 +1,592 @@
+#include "core/session/discovery_part.h"
+
+#include <cmath>
+#include <limits>
+
+#include "core/session/fit_request.h"
+#include "core/session/model_json.h"
+
+namespace flexarm {
+
+using nlohmann::json;
+
+namespace {
+
+const char* kStructures[] = {"two-mass", "three-mass", "four-mass"};
+
+// JSON has no NaN: non-finite numbers are stored as null and read back as NaN.
+json number(double v) { return std::isfinite(v) ? json(v) : json(nullptr); }
+
+bool readNumber(const json& j, const char* key, double& out, bool required, std::string* why,
+                const std::string& where) {
+  if (!j.contains(key)) {
+    if (!required) return true;
+    if (why) *why = where + key + " is missing";
+    return false;
+  }
+  if (j[key].is_null()) {
+    out = std::numeric_limits<double>::quiet_NaN();
+    return true;
+  }
+  if (!j[key].is_number()) {
+    if (why) *why = where + key + " must be a number";
+    return false;
+  }
+  out = j[key].get<double>();
+  return true;
+}
+
+bool readText(const json& j, const char* key, std::string& out, bool required, std::string* why,
+              const std::string& where) {
+  if (!j.contains(key)) {
+    if (!required) return true;
+    if (why) *why = where + key + " is missing";
+    return false;
+  }
+  if (!j[key].is_string()) {
+    if (why) *why = where + key + " must be text";
+    return false;
+  }
+  out = j[key].get<std::string>();
+  return true;
+}
+
+bool readFlag(const json& j, const char* key, bool& out, std::string* why, const std::string& where) {
+  if (!j.contains(key)) return true;
+  if (!j[key].is_boolean()) {
+    if (why) *why = where + key + " must be true or false";
+    return false;
+  }
+  out = j[key].get<bool>();
+  return true;
+}
+
+bool readWhole(const json& j, const char* key, int& out, std::string* why, const std::string& where) {
+  if (!j.contains(key)) return true;
+  if (!j[key].is_number_integer()) {
+    if (why) *why = where + key + " must be a whole number";
+    return false;
+  }
+  out = j[key].get<int>();
+  return true;
+}
+
+json dataRefToJson(const DiscoveryDataRef& d) {
+  return {{"log", d.log}, {"range_s", secondsRangeToJson(d.range)}};
+}
+
+bool dataRefFromJson(const json& j, DiscoveryDataRef& d, std::string* why, const std::string& where) {
+  if (!j.is_object()) {
+    if (why) *why = where + "must be an object with log and range_s";
+    return false;
+  }
+  std::string reason;
+  if (!readText(j, "log", d.log, false, why, where)) return false;
+  if (!readSecondsRange(j, "range_s", d.range, &reason)) {
+    if (why) *why = where + reason;
+    return false;
+  }
+  return true;
+}
+
+json scoreToJson(const DiscoveryScore& s) {
+  return {{"fit_percent", number(s.fitPercent)},
+          {"fit_percent_validation", number(s.fitPercentValidation)},
+          {"rms_estimation", number(s.rmsEstimation)},
+          {"rms_validation", number(s.rmsValidation)}};
+}
+
+bool scoreFromJson(const json& j, DiscoveryScore& s, std::string* why, const std::string& where) {
+  if (!j.is_object()) {
+    if (why) *why = where + "must be an object";
+    return false;
+  }
+  return readNumber(j, "fit_percent", s.fitPercent, true, why, where) &&
+         readNumber(j, "fit_percent_validation", s.fitPercentValidation, true, why, where) &&
+         readNumber(j, "rms_estimation", s.rmsEstimation, true, why, where) &&
+         readNumber(j, "rms_validation", s.rmsValidation, true, why, where);
+}
+
+json parametersToJson(const std::vector<EffectParameterEstimate>& ps) {
+  json list = json::array();
+  for (const auto& p : ps)
+    list.push_back({{"name", p.name}, {"unit", p.unit}, {"value", number(p.value)},
+                    {"std", number(p.std)}, {"lower", number(p.lower)}, {"upper", number(p.upper)},
+                    {"estimated", p.estimated}});
+  return list;
+}
+
+bool parametersFromJson(const json& j, std::vector<EffectParameterEstimate>& ps, std::string* why,
+                        const std::string& where) {
+  if (!j.is_array()) {
+    if (why) *why = where + "parameters must be a list";
+    return false;
+  }
+  for (const auto& p : j) {
+    EffectParameterEstimate e;
+    if (!p.is_object() || !readText(p, "name", e.name, true, why, where + "parameter ") ||
+        !readText(p, "unit", e.unit, false, why, where) ||
+        !readNumber(p, "value", e.value, true, why, where) ||
+        !readNumber(p, "std", e.std, true, why, where) ||
+        !readNumber(p, "lower", e.lower, true, why, where) ||
+        !readNumber(p, "upper", e.upper, true, why, where) ||
+        !readFlag(p, "estimated", e.estimated, why, where)) {
+      if (why && !p.is_object()) *why = where + "each parameter must be an object";
+      return false;
+    }
+    ps.push_back(e);
+  }
+  return true;
+}
+
+std::string describeData(const DiscoveryDataRef& d, const std::string& firstLog) {
+  std::string text = "log '" + (d.log.empty() ? firstLog : d.log) + "'";
+  if (d.range)
+    text += ", " + formatSignificant(d.range->start, 6) + "-" + formatSignificant(d.range->end, 6) + " s";
+  else
+    text += ", whole log";
+  return text;
+}
+
+// The chosen data set, or a sentence why there is none.
+std::optional<IdData> pickData(const DiscoveryDataRef& ref, bool raw, const ReplayContext& context,
+                               std::string* why) {
+  const auto* logs = raw ? context.rawLogs : &context.logs;
+  if (!logs || logs->empty()) {
+    *why = raw ? "the logs as read are not available" : "the session has no log";
+    return std::nullopt;
+  }
+  const IdData* d = nullptr;
+  for (const auto& [name, data] : *logs)
+    if (ref.log.empty() ? d == nullptr : name == ref.log) d = data;
+  if (!d) {
+    *why = "the session has no log named '" + ref.log + "'";
+    return std::nullopt;
+  }
+  if (!ref.range) return *d;
+  const SampleRange r = d->rangeForTimes(ref.range->start, ref.range->end);
+  if (r.size() < 10) {
+    *why = "the range " + formatSignificant(ref.range->start) + "-" + formatSignificant(ref.range->end) +
+           " s holds " + std::to_string(r.size()) + " samples of log '" + ref.log + "'";
+    return std::nullopt;
+  }
+  return d->select(r);
+}
+
+std::unique_ptr<PhysicalModel> pickBase(const DiscoveryRequest& q, const Session& session,
+                                        std::string* why) {
+  if (q.baseModel.empty()) return makeModel(q.baseStructure);
+  if (session.parts.contains("models"))
+    for (const auto& m : session.parts["models"]) {
+      auto spec = modelFromJson(m, why);
+      if (!spec || spec->name != q.baseModel) continue;
+      if (!spec->effects.empty()) {
+        *why = "the base model '" + q.baseModel + "' has effects; discovery starts from a model without";
+        return nullptr;
+      }
+      auto c = spec->model->clone();
+      return std::unique_ptr<PhysicalModel>(static_cast<PhysicalModel*>(c.release()));
+    }
+  *why = "the model list has no model named '" + q.baseModel + "'";
+  return nullptr;
+}
+
+ReportSeries series(const std::string& name, const std::vector<double>& t, std::vector<double> y,
+                    bool dashed, int color) {
+  ReportSeries s{name, t, std::move(y), dashed, color};
+  thinSeries(s.x, s.y, 3000);
+  return s;
+}
+
+std::vector<double> difference(const std::vector<double>& a, const std::vector<double>& b) {
+  std::vector<double> d(std::min(a.size(), b.size()));
+  for (std::size_t k = 0; k < d.size(); ++k) d[k] = a[k] - b[k];
+  return d;
+}
+
+class DiscoveryPart : public SessionPart {
+ public:
+  std::string key() const override { return "discovery"; }
+
+  bool validate(const json& section, std::string* why) const override {
+    if (!section.is_object() || !section.contains("request")) {
+      if (why) *why = "must be an object with a request";
+      return false;
+    }
+    if (!discoveryRequestFromJson(section["request"], why)) return false;
+    if (section.contains("result") && !section["result"].is_null() &&
+        !discoveryResultFromJson(section["result"], why))
+      return false;
+    return true;
+  }
+
+  void replay(const json& section, const ReplayContext& context, Report& report) const override {
+    std::string why;
+    auto request = discoveryRequestFromJson(section["request"], &why);
+    if (!request) return;  // validated on load
+    ReportSection s;
+    s.title = "Discovery: the missing effect";
+    const std::string firstLog = context.session.logs.empty() ? "" : context.session.logs.front().name;
+    const std::string baseName = request->baseModel.empty() ? request->baseStructure + " (nominal)"
+                                                            : request->baseModel;
+    std::string dataText = "Base model " + baseName + ". Estimation data: " +
+                           describeData(request->estimation, firstLog);
+    if (request->validation)
+      dataText += "; validation data: " + describeData(*request->validation, firstLog);
+    dataText += request->rawData ? " (as read)." : " (preprocessed as the session says).";
+    s.paragraphs.push_back(dataText);
+    std::string candidates;
+    for (EffectKind k : request->options.candidates)
+      candidates += (candidates.empty() ? "" : ", ") + std::string(toString(k));
+    s.paragraphs.push_back("Candidates tested: " + candidates + ". An effect is named only when the "
+                           "F-test of its parameters passes, the AIC falls, its parameter's " +
+                           formatSignificant(100.0 * request->options.level, 3) +
+                           " % interval excludes zero and the validation residual RMS drops by " +
+                           formatSignificant(100.0 * request->options.minValidationImprovement, 3) +
+                           " % or more.");
+    s.values = {{"base_model", baseName}};
+    auto fail = [&](const std::string& text) {
+      s.paragraphs.push_back("Discovery could not run: " + text + ".");
+      s.values["effect"] = nullptr;
+      s.values["message"] = text;
+      report.sections.push_back(s);
+    };
+    auto base = pickBase(*request, context.session, &why);
+    if (!base) return fail(why);
+    auto est = pickData(request->estimation, request->rawData, context, &why);
+    if (!est) return fail("estimation data: " + why);
+    std::optional<IdData> val;
+    if (request->validation) {
+      val = pickData(*request->validation, request->rawData, context, &why);
+      if (!val) return fail("validation data: " + why);
+    }
+    DiscoveryResult r;
+    try {
+      r = discoverMissingEffect(*base, *est, val ? &*val : nullptr, request->options, context.progress);
+    } catch (const std::invalid_argument& e) {
+      return fail(e.what());
+    }
+    if (r.termination == Termination::Failed || r.termination == Termination::Cancelled)
+      return fail(r.message.empty() ? toString(r.termination) : r.message);
+    fillSection(r, s);
+    if (section.contains("result") && section["result"].is_object()) {
+      auto stored = discoveryResultFromJson(section["result"], &why);
+      if (stored && stored->effect != r.effect) {
+        const std::string was = stored->effect ? toString(*stored->effect) : "none";
+        const std::string now = r.effect ? toString(*r.effect) : "none";
+        s.paragraphs.push_back("The session recorded the effect " + was + "; this replay names " + now + ".");
+        report.warnings.push_back("discovery: the session recorded " + was + ", the replay names " + now);
+      }
+      s.values["stored_effect"] = stored && stored->effect ? json(toString(*stored->effect)) : json("none");
+    }
+    report.sections.push_back(s);
+  }
+
+ private:
+  static void fillSection(const DiscoveryResult& r, ReportSection& s) {
+    const std::string effect = r.effect ? toString(*r.effect) : "none";
+    std::string verdict = r.effect ? "Verdict: the missing effect is " + effect + "."
+                                   : "Verdict: none of the candidates is significant; the missing effect is none.";
+    if (!r.tied.empty()) {
+      std::string t;
+      for (EffectKind k : r.tied) t += (t.empty() ? "" : ", ") + std::string(toString(k));
+      verdict += " It ties with " + t + ".";
+    }
+    s.paragraphs.push_back(verdict);
+    s.paragraphs.push_back("Evidence: " + r.evidence);
+    if (!r.disagreement.summary.empty())
+      s.paragraphs.push_back("Where the base model disagrees: " + r.disagreement.summary);
+
+    const CandidateFit* best = r.best >= 0 ? &r.candidates[static_cast<std::size_t>(r.best)] : nullptr;
+    json params = json::object();
+    if (best) {
+      ReportTable t{"Parameters of " + effect + " (99 % interval)",
+                    {"Parameter", "Value", "Std", "Lower", "Upper", "Unit"}, {}};
+      for (const auto& p : best->parameters) {
+        t.rows.push_back({p.name, formatSignificant(p.value), p.estimated ? formatSignificant(p.std, 3) : "held",
+                          formatSignificant(p.lower), formatSignificant(p.upper), p.unit});
+        params[p.name] = {{"value", number(p.value)}, {"std", number(p.std)}, {"unit", p.unit}};
+      }
+      s.tables.push_back(t);
+    }
+    ReportTable cand{"Candidates", {"Effect", "Loss (est.)", "RMS val. (rad/s)", "AIC - base", "F / threshold",
+                                    "Significant", "Reason"}, {}};
+    json candJson = json::array();
+    for (const auto& c : r.candidates) {
+      cand.rows.push_back({toString(c.kind), formatSignificant(c.lossEst),
+                           r.hasValidation ? formatSignificant(c.score.rmsValidation) : "-",
+                           std::isfinite(c.aic) ? formatFixed(c.aic - r.baseAic, 1) : "-",
+                           formatSignificant(c.fStatistic, 3) + " / " + formatSignificant(c.fThreshold, 3),
+                           c.significant ? "yes" : "no", c.reason});
+      candJson.push_back({{"effect", toString(c.kind)}, {"loss_est", number(c.lossEst)},
+                          {"rms_val", r.hasValidation ? number(c.score.rmsValidation) : json()},
+                          {"aic", number(c.aic)}, {"f", number(c.fStatistic)},
+                          {"f_threshold", number(c.fThreshold)}, {"significant", c.significant}});
+    }
+    s.tables.push_back(cand);
+
+    ReportTable cmp{"Base and augmented model: fit % (5.2) and residual RMS",
+                    {"Model", "Fit % est.", "Fit % val.", "RMS est. (rad/s)", "RMS val. (rad/s)"}, {}};
+    auto row = [&](const std::string& name, const DiscoveryScore& sc) {
+      cmp.rows.push_back({name, formatFixed(sc.fitPercent, 2),
+                          r.hasValidation ? formatFixed(sc.fitPercentValidation, 2) : "-",
+                          formatSignificant(sc.rmsEstimation),
+                          r.hasValidation ? formatSignificant(sc.rmsValidation) : "-"});
+    };
+    row("base", r.base);
+    row(r.effect ? "base + " + effect : "augmented (= base)", r.augmented);
+    s.tables.push_back(cmp);
+    if (r.hasValidation && r.base.rmsValidation > 0.0)
+      s.paragraphs.push_back("The validation residual RMS falls from " + formatSignificant(r.base.rmsValidation) +
+                             " to " + formatSignificant(r.augmented.rmsValidation) + " rad/s (" +
+                             formatFixed(100.0 * (1.0 - r.augmented.rmsValidation / r.base.rmsValidation), 0) +
+                             " % lower).");
+
+    s.values["effect"] = effect;
+    json tied = json::array();
+    for (EffectKind k : r.tied) tied.push_back(toString(k));
+    s.values["tied"] = tied;
+    s.values["effect_parameters"] = params;
+    s.values["evidence"] = r.evidence;
+    s.values["base"] = scoreToJson(r.base);
+    s.values["augmented"] = scoreToJson(r.augmented);
+    s.values["has_validation"] = r.hasValidation;
+    s.values["candidates"] = candJson;
+
+    const DiscoveryTrace& t = r.hasValidation ? r.validation : r.estimation;
+    const std::string where = r.hasValidation ? "validation" : "estimation";
+    if (t.time.empty()) return;
+    const std::string augName = r.effect ? "base + " + effect : "augmented (= base)";
+    s.plots.push_back(ReportPlot{"Motor velocity on the " + where + " data, before and after",
+                                 "time (s)", "motor velocity (rad/s)", false, false,
+                                 {series("measured", t.time, t.measured, false, 0),
+                                  series("base", t.time, t.base, true, 1),
+                                  series(augName, t.time, t.augmented, false, 2)}});
+    s.plots.push_back(ReportPlot{"Residual on the " + where + " data, before and after", "time (s)",
+                                 "residual (rad/s)", false, false,
+                                 {series("base", t.time, difference(t.measured, t.base), false, 1),
+                                  series(augName, t.time, difference(t.measured, t.augmented), false, 2)}});
+  }
+};
+
+}  // namespace
+
+bool DiscoveryRequest::isValid(std::string* why) const {
+  if (baseModel.empty()) {
+    bool known = false;
+    for (const char* s : kStructures) known = known || baseStructure == s;
+    if (!known) {
+      if (why) *why = "the base structure must be two-mass, three-mass or four-mass, not '" + baseStructure + "'";
+      return false;
+    }
+  }
+  return options.isValid(why);
+}
+
+json discoveryRequestToJson(const DiscoveryRequest& q) {
+  json j = json::object();
+  if (q.baseModel.empty()) j["base_structure"] = q.baseStructure;
+  else j["base_model"] = q.baseModel;
+  j["data"] = q.rawData ? "as-read" : "preprocessed";
+  j["estimation"] = dataRefToJson(q.estimation);
+  j["validation"] = q.validation ? dataRefToJson(*q.validation) : json(nullptr);
+  json candidates = json::array();
+  for (EffectKind k : q.options.candidates) candidates.push_back(toString(k));
+  const DiscoveryOptions& o = q.options;
+  j["options"] = {{"candidates", candidates},
+                  {"observer_bandwidth_hz", o.observerBandwidthHz},
+                  {"max_rate_hz", o.maxRateHz},
+                  {"substeps", o.substeps},
+                  {"base_iterations", o.baseIterations},
+                  {"candidate_iterations", o.candidateIterations},
+                  {"level", o.level},
+                  {"min_validation_improvement", o.minValidationImprovement},
+                  {"tie_tolerance", o.tieTolerance},
+                  {"threads", o.threads}};
+  return j;
+}
+
+std::optional<DiscoveryRequest> discoveryRequestFromJson(const json& j, std::string* why) {
+  const std::string where = "the discovery request: ";
+  if (!j.is_object()) {
+    if (why) *why = where + "must be an object";
+    return std::nullopt;
+  }
+  DiscoveryRequest q;
+  if (!readText(j, "base_model", q.baseModel, false, why, where) ||
+      !readText(j, "base_structure", q.baseStructure, false, why, where))
+    return std::nullopt;
+  if (q.baseModel.empty() == q.baseStructure.empty()) {
+    if (why) *why = where + "give either base_model (a model of the list) or base_structure";
+    return std::nullopt;
+  }
+  std::string data = "preprocessed";
+  if (!readText(j, "data", data, false, why, where)) return std::nullopt;
+  if (data != "preprocessed" && data != "as-read") {
+    if (why) *why = where + "data must be \"preprocessed\" or \"as-read\", not '" + data + "'";
+    return std::nullopt;
+  }
+  q.rawData = data == "as-read";
+  if (!j.contains("estimation")) {
+    if (why) *why = where + "estimation is missing";
+    return std::nullopt;
+  }
+  if (!dataRefFromJson(j["estimation"], q.estimation, why, where + "estimation: ")) return std::nullopt;
+  if (j.contains("validation") && !j["validation"].is_null()) {
+    q.validation.emplace();
+    if (!dataRefFromJson(j["validation"], *q.validation, why, where + "validation: ")) return std::nullopt;
+  }
+  if (j.contains("options")) {
+    const json& o = j["options"];
+    const std::string ow = where + "options: ";
+    if (!o.is_object()) {
+      if (why) *why = ow + "must be an object";
+      return std::nullopt;
+    }
+    DiscoveryOptions& d = q.options;
+    if (o.contains("candidates")) {
+      if (!o["candidates"].is_array()) {
+        if (why) *why = ow + "candidates must be a list of effect names";
+        return std::nullopt;
+      }
+      d.candidates.clear();
+      for (const auto& c : o["candidates"]) {
+        auto k = c.is_string() ? effectKindFromString(c.get<std::string>()) : std::nullopt;
+        if (!k) {
+          if (why) *why = ow + "unknown candidate effect " + c.dump();
+          return std::nullopt;
+        }
+        d.candidates.push_back(*k);
+      }
+    }
+    if (!readNumber(o, "observer_bandwidth_hz", d.observerBandwidthHz, false, why, ow) ||
+        !readNumber(o, "max_rate_hz", d.maxRateHz, false, why, ow) ||
+        !readWhole(o, "substeps", d.substeps, why, ow) ||
+        !readWhole(o, "base_iterations", d.baseIterations, why, ow) ||
+        !readWhole(o, "candidate_iterations", d.candidateIterations, why, ow) ||
+        !readNumber(o, "level", d.level, false, why, ow) ||
+        !readNumber(o, "min_validation_improvement", d.minValidationImprovement, false, why, ow) ||
+        !readNumber(o, "tie_tolerance", d.tieTolerance, false, why, ow) ||
+        !readWhole(o, "threads", d.threads, why, ow))
+      return std::nullopt;
+  }
+  std::string reason;
+  if (!q.isValid(&reason)) {
+    if (why) *why = where + reason;
+    return std::nullopt;
+  }
+  return q;
+}
+
+json discoveryResultToJson(const DiscoveryResult& r) {
+  json tied = json::array();
+  for (EffectKind k : r.tied) tied.push_back(toString(k));
+  json candidates = json::array();
+  for (const auto& c : r.candidates)
+    candidates.push_back({{"effect", toString(c.kind)},
+                          {"parameters", parametersToJson(c.parameters)},
+                          {"parameter_count", c.parameterCount},
+                          {"loss_est", number(c.lossEst)},
+                          {"aic", number(c.aic)},
+                          {"f", number(c.fStatistic)},
+                          {"f_threshold", number(c.fThreshold)},
+                          {"score", scoreToJson(c.score)},
+                          {"significant", c.significant},
+                          {"reason", c.reason}});
+  return {{"effect", r.effect ? toString(*r.effect) : "none"},
+          {"tied", tied},
+          {"evidence", r.evidence},
+          {"disagreement", r.disagreement.summary},
+          {"has_validation", r.hasValidation},
+          {"sample_time", number(r.sampleTime)},
+          {"base_loss", number(r.baseLoss)},
+          {"base_aic", number(r.baseAic)},
+          {"base", scoreToJson(r.base)},
+          {"augmented", scoreToJson(r.augmented)},
+          {"best", r.best},
+          {"candidates", candidates}};
+}
+
+std::optional<DiscoveryResult> discoveryResultFromJson(const json& j, std::string* why) {
+  const std::string where = "the discovery result: ";
+  if (!j.is_object()) {
+    if (why) *why = where + "must be an object";
+    return std::nullopt;
+  }
+  DiscoveryResult r;
+  r.termination = Termination::Converged;
+  std::string effect;
+  if (!readText(j, "effect", effect, true, why, where)) return std::nullopt;
+  if (effect != "none") {
+    r.effect = effectKindFromString(effect);
+    if (!r.effect) {
+      if (why) *why = where + "unknown effect '" + effect + "'";
+      return std::nullopt;
+    }
+  }
+  if (j.contains("tied")) {
+    if (!j["tied"].is_array()) {
+      if (why) *why = where + "tied must be a list";
+      return std::nullopt;
+    }
+    for (const auto& t : j["tied"]) {
+      auto k = t.is_string() ? effectKindFromString(t.get<std::string>()) : std::nullopt;
+      if (!k) {
+        if (why) *why = where + "unknown tied effect " + t.dump();
+        return std::nullopt;
+      }
+      r.tied.push_back(*k);
+    }
+  }
+  if (!readText(j, "evidence", r.evidence, false, why, where) ||
+      !readText(j, "disagreement", r.disagreement.summary, false, why, where) ||
+      !readFlag(j, "has_validation", r.hasValidation, why, where) ||
+      !readNumber(j, "sample_time", r.sampleTime, false, why, where) ||
+      !readNumber(j, "base_loss", r.baseLoss, false, why, where) ||
+      !readNumber(j, "base_aic", r.baseAic, false, why, where) ||
+      !readWhole(j, "best", r.best, why, where))
+    return std::nullopt;
+  if (!j.contains("base") || !scoreFromJson(j["base"], r.base, why, where + "base: ") ||
+      !j.contains("augmented") || !scoreFromJson(j["augmented"], r.augmented, why, where + "augmented: ")) {
+    if (why && (!j.contains("base") || !j.contains("augmented"))) *why = where + "base and augmented scores are needed";
+    return std::nullopt;
+  }
+  if (!j.contains("candidates") || !j["candidates"].is_array()) {
+    if (why) *why = where + "candidates must be a list";
+    return std::nullopt;
+  }
+  for (const auto& c : j["candidates"]) {
+    CandidateFit f;
+    std::string name;
+    const std::string cw = where + "candidate: ";
+    if (!c.is_object() || !readText(c, "effect", name, true, why, cw)) {
+      if (why && !c.is_object()) *why = cw + "must be an object";
+      return std::nullopt;
+    }
+    auto k = effectKindFromString(name);
+    if (!k) {
+      if (why) *why = cw + "unknown effect '" + name + "'";
+      return std::nullopt;
+    }
+    f.kind = *k;
+    f.termination = Termination::Converged;
+    if ((c.contains("parameters") && !parametersFromJson(c["parameters"], f.parameters, why, cw)) ||
+        !readWhole(c, "parameter_count", f.parameterCount, why, cw) ||
+        !readNumber(c, "loss_est", f.lossEst, true, why, cw) ||
+        !readNumber(c, "aic", f.aic, false, why, cw) || !readNumber(c, "f", f.fStatistic, false, why, cw) ||
+        !readNumber(c, "f_threshold", f.fThreshold, false, why, cw) ||
+        !readFlag(c, "significant", f.significant, why, cw) || !readText(c, "reason", f.reason, false, why, cw) ||
+        (c.contains("score") && !scoreFromJson(c["score"], f.score, why, cw + "score: ")))
+      return std::nullopt;
+    r.candidates.push_back(f);
+  }
+  if (r.best < -1 || r.best >= static_cast<int>(r.candidates.size())) {
+    if (why) *why = where + "best must index a candidate (or be -1)";
+    return std::nullopt;
+  }
+  return r;
+}
+
+std::shared_ptr<const SessionPart> makeDiscoveryPart() { return std::make_shared<DiscoveryPart>(); }
+
+}  // namespace flexarm
