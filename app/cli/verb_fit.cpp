@@ -146,14 +146,17 @@ const char* fitOptionsHelp() {
          "  --closed-loop M       physical models: auto|direct|two-stage|indirect. two-stage\n"
          "                        fits output error to the part of the input the reference\n"
          "                        explains (an FIR of the reference channel), consistent in\n"
-         "                        closed loop, with a covariance that allows coloured errors;\n"
-         "                        auto (default) uses it when the log has a reference and no\n"
-         "                        --noise-model. indirect fits the whole loop (the log's\n"
-         "                        controller from its metadata controller_kp, controller_kv,\n"
-         "                        controller_ti, controller_rate_hz) from the reference to the\n"
-         "                        measured angle, from the log's first sample to the end of\n"
-         "                        the estimation range, at the log's own rate (its loss is\n"
-         "                        that of the loop's angle, in rad^2)\n"
+         "                        closed loop, with a covariance that allows coloured errors.\n"
+         "                        indirect fits the whole loop (the log's controller from its\n"
+         "                        metadata controller_kp, controller_kv, controller_ti,\n"
+         "                        controller_rate_hz) from the reference to the measured\n"
+         "                        angle, from the log's first sample to the end of the\n"
+         "                        estimation range, at the log's own rate (its loss is that of\n"
+         "                        the loop's angle, in rad^2). auto (default, without\n"
+         "                        --noise-model): indirect when the log carries its controller,\n"
+         "                        is at the controller's rate, is not decimated and the\n"
+         "                        estimation range starts at its first sample; else two-stage\n"
+         "                        when the log has a reference; else direct\n"
          "  --decimate N          decimate by N with the anti-alias FIR before fitting\n"
          "  --range A:B           estimation data from A to B seconds (default: the log's\n"
          "                        stored estimation range, else everything)\n"
@@ -282,44 +285,58 @@ int prepareAndFit(ArgParser& args, const std::string& verb, FitOutcome& out, std
     return kExitBadInput;
   }
   // The indirect method closes the logged controller around the model: it needs the measured
-  // angle and the reference as logged, and the controller from the log's metadata.
+  // angle and the reference as logged, and the controller from the log's metadata. Asked for,
+  // anything missing is an error naming it; under auto it is used whenever all of it is there
+  // (a physical output-error fit at the log's own rate), as the consistent closed-loop choice.
   Eigen::VectorXd loopAngle, loopReference;
   ControllerOptions loopController;
-  if (askedMethod == ClosedLoopMethod::Indirect) {
-    const Channel* angle = data->channel(columns::kMotorAngle);
-    const Channel* ref = data->withRole(ChannelRole::Reference);
-    if (!angle || !ref) {
-      err << "flexarm: " << args.positional()[0] << ": --closed-loop indirect needs the "
-          << columns::kMotorAngle << " and reference channels, and the log lacks "
-          << (angle ? "the reference" : columns::kMotorAngle) << "\n";
-      return kExitBadInput;
-    }
-    const std::pair<const char*, double*> keys[] = {
-        {"controller_rate_hz", &loopController.rateHz}, {"controller_kp", &loopController.kp},
-        {"controller_kv", &loopController.kv}, {"controller_ti", &loopController.ti}};
-    for (const auto& [key, target] : keys) {
-      const std::string text = data->meta(key);
-      char* end = nullptr;
-      const double v = text.empty() ? NAN : std::strtod(text.c_str(), &end);
-      if (text.empty() || end != text.c_str() + text.size() || !std::isfinite(v)) {
-        err << "flexarm: " << args.positional()[0] << ": --closed-loop indirect needs the "
-            << "controller, and the log's metadata key " << key
-            << (text.empty() ? " is missing" : " is not a number") << " (logs written by "
-            << "flexarm simulate carry controller_rate_hz, controller_kp, controller_kv and "
-               "controller_ti)\n";
-        return kExitBadInput;
+  const bool loopWanted = askedMethod == ClosedLoopMethod::Indirect;
+  const bool loopPossible = out.spec.physical && decimation == 1 && !args.flag("noise-model") &&
+                            (loopWanted || !askedMethod);
+  bool loopReady = false;
+  if (loopPossible) {
+    std::ostringstream why2;
+    auto refuse = [&](const std::string& text) {
+      why2 << "flexarm: " << args.positional()[0] << ": " << text << "\n";
+      return false;
+    };
+    auto readLoop = [&]() {
+      const Channel* angle = data->channel(columns::kMotorAngle);
+      const Channel* ref = data->withRole(ChannelRole::Reference);
+      if (!angle || !ref)
+        return refuse(std::string("--closed-loop indirect needs the ") + columns::kMotorAngle +
+                      " and reference channels, and the log lacks " +
+                      (angle ? "the reference" : columns::kMotorAngle));
+      const std::pair<const char*, double*> keys[] = {
+          {"controller_rate_hz", &loopController.rateHz}, {"controller_kp", &loopController.kp},
+          {"controller_kv", &loopController.kv}, {"controller_ti", &loopController.ti}};
+      for (const auto& [key, target] : keys) {
+        const std::string text = data->meta(key);
+        char* end = nullptr;
+        const double v = text.empty() ? NAN : std::strtod(text.c_str(), &end);
+        if (text.empty() || end != text.c_str() + text.size() || !std::isfinite(v))
+          return refuse(std::string("--closed-loop indirect needs the controller, and the "
+                                    "log's metadata key ") + key +
+                        (text.empty() ? " is missing" : " is not a number") +
+                        " (logs written by flexarm simulate carry controller_rate_hz, "
+                        "controller_kp, controller_kv and controller_ti)");
+        *target = v;
       }
-      *target = v;
-    }
-    if (!loopController.isValid(&why)) {
-      err << "flexarm: " << args.positional()[0] << ": the controller in the metadata: " << why
-          << "\n";
+      std::string bad;
+      if (!loopController.isValid(&bad)) return refuse("the controller in the metadata: " + bad);
+      if (std::abs(loopController.rateHz * data->sampleTime - 1.0) > 1e-6)
+        return refuse("--closed-loop indirect needs the log at the controller's rate");
+      loopAngle = Eigen::Map<const Eigen::VectorXd>(angle->values.data(),
+                                                    static_cast<Eigen::Index>(angle->values.size()));
+      loopReference = Eigen::Map<const Eigen::VectorXd>(ref->values.data(),
+                                                        static_cast<Eigen::Index>(ref->values.size()));
+      return true;
+    };
+    loopReady = readLoop();
+    if (loopWanted && !loopReady) {
+      err << why2.str();
       return kExitBadInput;
     }
-    loopAngle = Eigen::Map<const Eigen::VectorXd>(angle->values.data(),
-                                                  static_cast<Eigen::Index>(angle->values.size()));
-    loopReference = Eigen::Map<const Eigen::VectorXd>(ref->values.data(),
-                                                      static_cast<Eigen::Index>(ref->values.size()));
   }
   if (!prepareData(*data, static_cast<int>(decimation), err, verb, out.spec.physical))
     return kExitUsage;
@@ -476,7 +493,8 @@ int prepareAndFit(ArgParser& args, const std::string& verb, FitOutcome& out, std
     }
     ClosedLoopPemOptions co;
     co.pem = po;
-    co.method = askedMethod.value_or(rEst.size() && !args.flag("noise-model")
+    co.method = askedMethod.value_or(loopReady && est.begin == 0 ? ClosedLoopMethod::Indirect
+                                     : rEst.size() && !args.flag("noise-model")
                                          ? ClosedLoopMethod::TwoStage
                                          : ClosedLoopMethod::Direct);
     co.controller = loopController;

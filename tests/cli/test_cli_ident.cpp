@@ -112,14 +112,15 @@ TEST(CliIdent, FitPhysicalWithFreeAndFixedParametersOnTheSampleLog) {
   EXPECT_EQ(j["covariance"], "white");
 }
 
-// The default for a log with a reference channel: the two-stage fit (output error on the part
-// of the torque the reference explains), consistent in closed loop, with sandwich intervals
-// that allow coloured errors: every truth of the sidecar lies inside its 99 % interval.
+// The two-stage fit (output error on the part of the torque the reference explains),
+// consistent in closed loop, with sandwich intervals that allow coloured errors: every truth
+// of the sidecar lies inside its 99 % interval.
 TEST(CliIdent, FitPhysicalOnAClosedLoopLogRunsTwoStageAndCoversTheTruth) {
   const auto t = truth();
   const std::string fixDg = "d_g=" + std::to_string(t.at("d_g"));
   const auto r = runFlexarm({"fit", velocityLog(), "--model", "three-mass", "--free",
-                             "J_m,J_g,J_a,k_g,k_a", "--fix", fixDg, "--json"});
+                             "J_m,J_g,J_a,k_g,k_a", "--fix", fixDg, "--closed-loop",
+                             "two-stage", "--json"});
   ASSERT_EQ(r.code, 0) << r.err;
   const json j = json::parse(r.out);
   EXPECT_EQ(j["closed_loop_method"], "two-stage");
@@ -286,17 +287,27 @@ TEST(CliIdent, IndirectFitReadsTheControllerAndRecoversEveryParameter) {
   r = runFlexarm({"fit", noKv, "--model", "three-mass", "--closed-loop", "indirect"});
   EXPECT_EQ(r.code, 3);
   EXPECT_NE(r.err.find("metadata key controller_kv is missing"), std::string::npos) << r.err;
+  // Without --closed-loop the same log falls back to the two-stage fit on its reference.
+  r = runFlexarm({"fit", noKv, "--model", "three-mass", "--free", "J_m,J_a,k_g,k_a", "--json"});
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(nlohmann::json::parse(r.out)["closed_loop_method"], "two-stage");
+  // Decimated, the loop no longer runs at the controller's rate: two-stage as well.
+  r = runFlexarm({"fit", kChirp, "--model", "three-mass", "--free", "J_m,J_a,k_g,k_a",
+                  "--decimate", "4", "--json"});
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(nlohmann::json::parse(r.out)["closed_loop_method"], "two-stage");
 }
 
 // A physical model gives the motor velocity: the chirp sample log, whose output is the motor
-// angle, is differentiated first (Section 5.2) and the two-stage closed-loop fit recovers the
-// truth of its sidecar (Table 5.7 p6) inside the 99 % intervals (z = 2.576).
+// angle, is differentiated first (Section 5.2). The log carries its controller, so the default
+// closed-loop method is the indirect fit, which recovers the truth of its sidecar (Table 5.7
+// p6) inside the 99 % intervals (z = 2.576).
 TEST(CliIdent, PhysicalFitOfTheAngleLogDifferentiatesAndRecoversTheTruth) {
   auto r = runFlexarm({"fit", std::string(FLEXARM_SAMPLE_DIR) + "/three_mass_estimation_chirp.csv",
                        "--model", "three-mass", "--free", "J_m,J_a,k_g,k_a", "--json"});
   ASSERT_EQ(r.code, 0) << r.err;
   const auto j = nlohmann::json::parse(r.out);
-  EXPECT_EQ(j["closed_loop_method"], "two-stage");
+  EXPECT_EQ(j["closed_loop_method"], "indirect");
   EXPECT_GT(j["fit_percent"].get<double>(), 70.0);
   const auto truth = nlohmann::json::parse(
       readAll(std::string(FLEXARM_SAMPLE_DIR) + "/three_mass_estimation_chirp.truth.json"));
