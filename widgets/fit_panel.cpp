@@ -112,10 +112,13 @@ FitPanel::FitPanel(Workspace* workspace, QWidget* parent)
   closedLoop_->setObjectName("closedLoopCombo");
   closedLoop_->addItem(tr("Two-stage: fit to the input part the reference explains"), "two-stage");
   closedLoop_->addItem(tr("Direct: fit to the logged input"), "direct");
+  closedLoop_->addItem(tr("Indirect: the log's controller closed around the model"), "indirect");
   closedLoop_->setToolTip(tr("For output-error fits of logs with a reference channel. Noise "
                              "reaches the input through the controller, which biases the "
                              "direct fit (4.43); the two-stage fit is consistent and its "
-                             "intervals allow coloured errors"));
+                             "intervals allow coloured errors; the indirect fit closes the "
+                             "controller named in the log's metadata around the model and "
+                             "fits the loop from the reference (undecimated logs)"));
   starts_->setRange(0, 200);
   starts_->setObjectName("startsSpin");
   starts_->setToolTip(tr("Random starts besides the model's own values, plus two whose "
@@ -271,7 +274,7 @@ QStringList FitPanel::freeParameters() const {
 void FitPanel::setDecimation(int factor) { decimation_->setValue(factor); }
 void FitPanel::setNoiseModel(NoiseModel m) { noise_->setCurrentIndex(m == NoiseModel::Innovations); }
 void FitPanel::setClosedLoopMethod(ClosedLoopMethod m) {
-  closedLoop_->setCurrentIndex(m == ClosedLoopMethod::Direct);
+  closedLoop_->setCurrentIndex(std::max(0, closedLoop_->findData(QString(toString(m)))));
 }
 void FitPanel::setStarts(int randomStarts) { starts_->setValue(randomStarts); }
 void FitPanel::setStudyRuns(int runs) { studyRuns_->setValue(runs); }
@@ -397,8 +400,8 @@ void FitPanel::estimate() {
     req.pem.maxIterations = req.maxIterations;
     req.pem.noiseModel = noise_->currentIndex() == 1 ? NoiseModel::Innovations
                                                      : NoiseModel::OutputError;
-    req.closedLoop = closedLoop_->currentIndex() == 1 ? ClosedLoopMethod::Direct
-                                                      : ClosedLoopMethod::TwoStage;
+    req.closedLoop = closedLoopMethodFromString(closedLoop_->currentData().toString().toStdString())
+                         .value_or(ClosedLoopMethod::TwoStage);
     req.pem.randomStarts = starts_->value();
     req.pem.seed = static_cast<unsigned>(++fits_);
   }

@@ -307,23 +307,10 @@ int prepareAndFit(ArgParser& args, const std::string& verb, FitOutcome& out, std
         return refuse(std::string("--closed-loop indirect needs the ") + columns::kMotorAngle +
                       " and reference channels, and the log lacks " +
                       (angle ? "the reference" : columns::kMotorAngle));
-      const std::pair<const char*, double*> keys[] = {
-          {"controller_rate_hz", &loopController.rateHz}, {"controller_kp", &loopController.kp},
-          {"controller_kv", &loopController.kv}, {"controller_ti", &loopController.ti}};
-      for (const auto& [key, target] : keys) {
-        const std::string text = data->meta(key);
-        char* end = nullptr;
-        const double v = text.empty() ? NAN : std::strtod(text.c_str(), &end);
-        if (text.empty() || end != text.c_str() + text.size() || !std::isfinite(v))
-          return refuse(std::string("--closed-loop indirect needs the controller, and the "
-                                    "log's metadata key ") + key +
-                        (text.empty() ? " is missing" : " is not a number") +
-                        " (logs written by flexarm simulate carry controller_rate_hz, "
-                        "controller_kp, controller_kv and controller_ti)");
-        *target = v;
-      }
       std::string bad;
-      if (!loopController.isValid(&bad)) return refuse("the controller in the metadata: " + bad);
+      const auto controller = controllerFromMetadata(*data, &bad);
+      if (!controller) return refuse("--closed-loop indirect needs the controller, and " + bad);
+      loopController = *controller;
       if (std::abs(loopController.rateHz * data->sampleTime - 1.0) > 1e-6)
         return refuse("--closed-loop indirect needs the log at the controller's rate");
       loopAngle = Eigen::Map<const Eigen::VectorXd>(angle->values.data(),

@@ -10,6 +10,7 @@
 #include "core/ident/residuals.h"
 #include "core/session/model_json.h"
 #include "core/signal/preprocess.h"
+#include "core/sim/closed_loop.h"
 
 namespace flexarm {
 
@@ -136,10 +137,10 @@ std::optional<FitRequest> fitRequestFromJson(const json& j, std::string* why) {
     if (j.contains("closed_loop")) {
       auto m = j["closed_loop"].is_string() ? closedLoopMethodFromString(j["closed_loop"].get<std::string>())
                                             : std::nullopt;
-      // The indirect method runs from the command line only (it needs the log's controller).
-      if (!m || *m == ClosedLoopMethod::Indirect)
+      if (!m)
         return fail(where + "closed_loop must be \"" + toString(ClosedLoopMethod::TwoStage) +
-                    "\" or \"" + toString(ClosedLoopMethod::Direct) + "\"");
+                    "\", \"" + toString(ClosedLoopMethod::Direct) + "\" or \"" +
+                    toString(ClosedLoopMethod::Indirect) + "\"");
       r.closedLoop = *m;
     }
     int seed = 1;
@@ -305,13 +306,41 @@ FitRun runFitRequest(const FitRequest& request, const IdData& data, const Progre
       }
       ClosedLoopPemOptions co;
       co.pem = po;
-      co.method = request.closedLoop == ClosedLoopMethod::TwoStage && s.r.size() == s.u.size() &&
-                          po.noiseModel == NoiseModel::OutputError
-                      ? ClosedLoopMethod::TwoStage
-                      : ClosedLoopMethod::Direct;
-      const Eigen::VectorXd r0 =
-          co.method == ClosedLoopMethod::TwoStage ? Eigen::VectorXd(s.r.segment(b, n)) : Eigen::VectorXd();
-      ClosedLoopPemResult cl = pemClosedLoop(*request.start, u, y, r0, T, co, progress);
+      ClosedLoopPemResult cl;
+      if (request.closedLoop == ClosedLoopMethod::Indirect) {
+        // The log's controller closed around the model, fitted from the reference to the
+        // measured angle as logged: the loop starts at rest at the first sample and runs to
+        // the end of the estimation range, at the controller's own rate.
+        if (po.noiseModel != NoiseModel::OutputError)
+          return finish(Termination::Failed, "the indirect closed-loop fit is output error (K = 0)");
+        const Channel* angle = data.channel(columns::kMotorAngle);
+        const Channel* ref = data.withRole(ChannelRole::Reference);
+        if (!angle || !ref)
+          return finish(Termination::Failed, std::string("the indirect closed-loop fit needs the ") +
+                                                 columns::kMotorAngle + " and reference channels");
+        const auto controller = controllerFromMetadata(data, &why);
+        if (!controller) return finish(Termination::Failed, "the indirect closed-loop fit: " + why);
+        if (request.decimation > 1 || std::abs(controller->rateHz * data.sampleTime - 1.0) > 1e-6)
+          return finish(Termination::Failed,
+                        "the indirect closed-loop fit runs at the controller's rate (" +
+                            std::to_string(static_cast<int>(controller->rateHz)) +
+                            " Hz); fit the log undecimated");
+        co.method = ClosedLoopMethod::Indirect;
+        co.controller = *controller;
+        const auto end = static_cast<Eigen::Index>(s.estimation.end);
+        const Eigen::Map<const Eigen::VectorXd> a(angle->values.data(), end), rr(ref->values.data(), end);
+        cl = pemClosedLoop(*request.start, {}, a, rr, T, co, progress);
+        run.data.note += ", indirect closed-loop fit: the log's controller around the model, "
+                         "from the reference to the motor angle";
+      } else {
+        co.method = request.closedLoop == ClosedLoopMethod::TwoStage && s.r.size() == s.u.size() &&
+                            po.noiseModel == NoiseModel::OutputError
+                        ? ClosedLoopMethod::TwoStage
+                        : ClosedLoopMethod::Direct;
+        const Eigen::VectorXd r0 =
+            co.method == ClosedLoopMethod::TwoStage ? Eigen::VectorXd(s.r.segment(b, n)) : Eigen::VectorXd();
+        cl = pemClosedLoop(*request.start, u, y, r0, T, co, progress);
+      }
       if (cl.method == ClosedLoopMethod::TwoStage && cl.projection.ok) {
         char buf[160];
         std::snprintf(buf, sizeof buf,
@@ -319,7 +348,7 @@ FitRun runFitRequest(const FitRequest& request, const IdData& data, const Progre
                       "intervals allow coloured errors",
                       cl.projection.fitPercent);
         run.data.note += buf;
-      } else if (s.closedLoop) {
+      } else if (s.closedLoop && cl.method == ClosedLoopMethod::Direct) {
         run.data.note += ", direct fit of closed-loop data";
       }
       PemResult r = std::move(cl.pem);

@@ -3,6 +3,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <stdexcept>
 #include <utility>
 
@@ -184,6 +185,34 @@ SimulationResult simulateClosedLoop(const PhysicalModel& model, const std::vecto
   result.controllerTicks = ticks;
   result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return result;
+}
+
+std::optional<ControllerOptions> controllerFromMetadata(const IdData& data, std::string* why) {
+  ControllerOptions c;
+  const std::pair<const char*, double*> keys[] = {{"controller_rate_hz", &c.rateHz},
+                                                  {"controller_kp", &c.kp},
+                                                  {"controller_kv", &c.kv},
+                                                  {"controller_ti", &c.ti}};
+  for (const auto& [key, target] : keys) {
+    const std::string text = data.meta(key);
+    char* end = nullptr;
+    const double v = text.empty() ? NAN : std::strtod(text.c_str(), &end);
+    if (text.empty() || end != text.c_str() + text.size() || !std::isfinite(v)) {
+      if (why)
+        *why = std::string("the log's metadata key ") + key +
+               (text.empty() ? " is missing" : " is not a number") +
+               " (logs written by flexarm simulate carry controller_rate_hz, controller_kp, "
+               "controller_kv and controller_ti)";
+      return std::nullopt;
+    }
+    *target = v;
+  }
+  std::string bad;
+  if (!c.isValid(&bad)) {
+    if (why) *why = "the controller in the log's metadata: " + bad;
+    return std::nullopt;
+  }
+  return c;
 }
 
 }  // namespace flexarm

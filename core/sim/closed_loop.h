@@ -8,6 +8,7 @@
 // arm acceleration), and its metadata the controller (controller_rate_hz, controller_kp,
 // controller_kv, controller_ti).
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -68,5 +69,11 @@ struct SimulationResult {
 SimulationResult simulateClosedLoop(const PhysicalModel& model, const std::vector<Effect>& effects,
                                     const SimulationOptions& options,
                                     const ProgressCallback& progress = {});
+
+// The controller a log was recorded under, from its metadata (controller_rate_hz,
+// controller_kp, controller_kv, controller_ti, as simulateClosedLoop writes them): what the
+// indirect closed-loop fit closes around the model. nullopt with a sentence naming the
+// missing or malformed key, or the invalid controller.
+std::optional<ControllerOptions> controllerFromMetadata(const IdData& data, std::string* why);
 
 }  // namespace flexarm
