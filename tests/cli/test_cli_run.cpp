@@ -21,7 +21,8 @@ const std::string kMultisine =
 
 // This build renders reports (the GUI build); a build without Qt refuses --report clearly.
 
-std::string pdfText(const std::string& pdf) {
+// The text of a rendered PDF (used where the build renders reports).
+[[maybe_unused]] std::string pdfText(const std::string& pdf) {
   const std::string txt = pdf + ".txt";
   const std::string cmd = "pdftotext -layout '" + pdf + "' '" + txt + "'";
   EXPECT_EQ(std::system(cmd.c_str()), 0) << cmd;
