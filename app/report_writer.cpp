@@ -61,8 +61,14 @@ QString sectionHtml(const ReportSection& s) {
     h += "</tr>";
     for (const auto& row : t.rows) {
       h += "<tr>";
-      for (const auto& c : row)
-        h += (looksNumeric(c) ? "<td class=\"num\" align=\"right\">" : "<td>") + esc(c) + "</td>";
+      for (const auto& c : row) {
+        // A single word (an effect or parameter name) is never broken across lines.
+        const bool word = c.find(' ') == std::string::npos;
+        h += (looksNumeric(c) ? "<td class=\"num\" align=\"right\">"
+              : word          ? "<td style=\"white-space:nowrap\">"
+                              : "<td>") +
+             esc(c) + "</td>";
+      }
       h += "</tr>";
     }
     h += "</table>";
