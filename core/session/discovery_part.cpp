@@ -17,58 +17,52 @@ const char* kStructures[] = {"two-mass", "three-mass", "four-mass"};
 // JSON has no NaN: non-finite numbers are stored as null and read back as NaN.
 json number(double v) { return std::isfinite(v) ? json(v) : json(nullptr); }
 
+// Looks key up: Absent (an error only when required), Bad (missing though required, or of
+// another kind than `kind` names) or Present; an error leaves a sentence in why.
+enum class Field { Absent, Present, Bad };
+template <class IsKind>
+Field field(const json& j, const char* key, bool required, IsKind isKind, const char* kind,
+            std::string* why, const std::string& where) {
+  if (!j.contains(key)) {
+    if (!required) return Field::Absent;
+    if (why) *why = where + key + " is missing";
+    return Field::Bad;
+  }
+  if (!isKind(j[key])) {
+    if (why) *why = where + key + " must be " + kind;
+    return Field::Bad;
+  }
+  return Field::Present;
+}
+
 bool readNumber(const json& j, const char* key, double& out, bool required, std::string* why,
                 const std::string& where) {
-  if (!j.contains(key)) {
-    if (!required) return true;
-    if (why) *why = where + key + " is missing";
-    return false;
-  }
-  if (j[key].is_null()) {
-    out = std::numeric_limits<double>::quiet_NaN();
-    return true;
-  }
-  if (!j[key].is_number()) {
-    if (why) *why = where + key + " must be a number";
-    return false;
-  }
-  out = j[key].get<double>();
-  return true;
+  const Field f = field(j, key, required, [](const json& v) { return v.is_number() || v.is_null(); },
+                        "a number", why, where);
+  if (f == Field::Present)
+    out = j[key].is_null() ? std::numeric_limits<double>::quiet_NaN() : j[key].get<double>();
+  return f != Field::Bad;
 }
 
 bool readText(const json& j, const char* key, std::string& out, bool required, std::string* why,
               const std::string& where) {
-  if (!j.contains(key)) {
-    if (!required) return true;
-    if (why) *why = where + key + " is missing";
-    return false;
-  }
-  if (!j[key].is_string()) {
-    if (why) *why = where + key + " must be text";
-    return false;
-  }
-  out = j[key].get<std::string>();
-  return true;
+  const Field f = field(j, key, required, [](const json& v) { return v.is_string(); }, "text", why, where);
+  if (f == Field::Present) out = j[key].get<std::string>();
+  return f != Field::Bad;
 }
 
 bool readFlag(const json& j, const char* key, bool& out, std::string* why, const std::string& where) {
-  if (!j.contains(key)) return true;
-  if (!j[key].is_boolean()) {
-    if (why) *why = where + key + " must be true or false";
-    return false;
-  }
-  out = j[key].get<bool>();
-  return true;
+  const Field f = field(j, key, false, [](const json& v) { return v.is_boolean(); }, "true or false",
+                        why, where);
+  if (f == Field::Present) out = j[key].get<bool>();
+  return f != Field::Bad;
 }
 
 bool readWhole(const json& j, const char* key, int& out, std::string* why, const std::string& where) {
-  if (!j.contains(key)) return true;
-  if (!j[key].is_number_integer()) {
-    if (why) *why = where + key + " must be a whole number";
-    return false;
-  }
-  out = j[key].get<int>();
-  return true;
+  const Field f = field(j, key, false, [](const json& v) { return v.is_number_integer(); },
+                        "a whole number", why, where);
+  if (f == Field::Present) out = j[key].get<int>();
+  return f != Field::Bad;
 }
 
 json dataRefToJson(const DiscoveryDataRef& d) {
