@@ -295,9 +295,9 @@ int prepareAndFit(ArgParser& args, const std::string& verb, FitOutcome& out, std
                             (loopWanted || !askedMethod);
   bool loopReady = false;
   if (loopPossible) {
-    std::ostringstream why2;
-    auto refuse = [&](const std::string& text) {
-      why2 << "flexarm: " << args.positional()[0] << ": " << text << "\n";
+    std::string loopWhy;  // printed only when the indirect fit was asked for
+    auto refuse = [&loopWhy](const std::string& text) {
+      loopWhy = text;
       return false;
     };
     auto readLoop = [&]() {
@@ -321,7 +321,7 @@ int prepareAndFit(ArgParser& args, const std::string& verb, FitOutcome& out, std
     };
     loopReady = readLoop();
     if (loopWanted && !loopReady) {
-      err << why2.str();
+      err << "flexarm: " << args.positional()[0] << ": " << loopWhy << "\n";
       return kExitBadInput;
     }
   }
