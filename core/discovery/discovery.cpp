@@ -110,11 +110,21 @@ double totalInertia(const PhysicalModel& m) {
   return J;
 }
 
-// The nonlinear predictor: the plant driven by u, with the arm-side load estimated by a PI
-// observer of the motor velocity error (bandwidth wo rad/s, damping ratio 1). Returns false
-// when the simulation blows up.
-bool predictVelocity(const NonlinearPlant& plant, const Series& s, int substeps, double wo,
-                     std::vector<double>& yhat, std::vector<double>* deflection = nullptr) {
+// The load observer of the predictor: a PI torque on the motor from the motor velocity
+// error. Its gain is one for every model compared in a run (the total inertia of the
+// engineer's base model over k_T, for a bandwidth of wo rad/s, damping ratio 1): were it
+// taken from each model's own inertias, a model could buy a faster observer by growing an
+// inertia the data do not see (an arm behind an open backlash gap), and fit anything.
+struct Observer {
+  double wo = 0.0;    // rad/s; 0: pure output error (simulation)
+  double gain = 0.0;  // torque reference per unit of motor acceleration error, kg m^2 / k_T
+};
+
+// The nonlinear predictor: the plant driven by u, with the arm-side load estimated by the
+// observer. Returns false when the simulation blows up.
+bool predictVelocity(const NonlinearPlant& plant, const Series& s, int substeps,
+                     const Observer& observer, std::vector<double>& yhat,
+                     std::vector<double>* deflection = nullptr) {
   const std::size_t N = s.u.size();
   std::vector<double> phiHat(N);
   if (deflection) deflection->resize(N);
@@ -147,7 +157,7 @@ bool predictVelocity(const NonlinearPlant& plant, const Series& s, int substeps,
     if (edge <= a) return held(a) + correction;
     return ((edge - a) * held(a) + (b - edge) * held(b)) / (b - a) + correction;
   };
-  const double gain = totalInertia(plant.model()) / plant.model().value("k_T");
+  const double wo = observer.wo, gain = observer.gain;
   const double kp = 2.0 * wo, ki = wo * wo;
   double integral = 0.0;
   const double limit = 1e6 + 1e3 * std::abs(s.phi[0]);
@@ -211,7 +221,7 @@ struct Problem {
   std::vector<Coordinate> coords;
   const Series* series = nullptr;
   int substeps = 4;
-  double wo = 0.0;
+  Observer observer;
   const std::atomic<bool>* cancel = nullptr;
 
   // Model and effect for a coordinate vector; throws std::invalid_argument when the values
@@ -238,7 +248,7 @@ struct Problem {
     try {
       auto built = build(phi);
       const NonlinearPlant plant(*built.first, built.second);
-      return predictVelocity(plant, s, substeps, wo, yhat, deflection);
+      return predictVelocity(plant, s, substeps, observer, yhat, deflection);
     } catch (const std::invalid_argument&) {
       return false;
     }
@@ -316,6 +326,16 @@ Eigen::VectorXd coordinatesOf(const Problem& pr, const Effect& e) {
     phi[static_cast<Eigen::Index>(i)] = c.toPhi(v);
   }
   return phi;
+}
+
+// The 99th percentile of |a|.
+double percentile99(const std::vector<double>& a) {
+  if (a.empty()) return 0.0;
+  std::vector<double> m(a.size());
+  for (std::size_t k = 0; k < a.size(); ++k) m[k] = std::abs(a[k]);
+  const std::size_t q = std::min(m.size() - 1, m.size() * 99 / 100);
+  std::nth_element(m.begin(), m.begin() + static_cast<long>(q), m.end());
+  return m[q];
 }
 
 double rms(const std::vector<double>& a, const std::vector<double>& b) {
@@ -424,11 +444,14 @@ struct CandidateWork {
   std::vector<double> yhatEst, yhatVal;
 };
 
-// Fits one candidate: short screening fits from a few starts, then the full refit.
-void fitCandidate(EffectKind kind, const PhysicalModel& base, const Series& est,
-                  const Series* val, const DiscoveryOptions& o, int substeps, double wo,
-                  double residualPeakRadS, double baseResonance, double deflectionRange,
-                  const std::vector<double>& eBase,
+// Fits one candidate: short screening fits from a few starts, then the full refit. `base`
+// is the base model refitted without the effect, `nominal` the engineer's: an effect the
+// linear refit has bent its parameters to imitate (a soft spring for a backlash gap) is
+// found again from the engineer's values.
+void fitCandidate(EffectKind kind, const PhysicalModel& base, const PhysicalModel& nominal,
+                  const Series& est, const Series* val, const DiscoveryOptions& o,
+                  int substeps, const Observer& observer, double residualPeakRadS,
+                  double baseResonance, double gapRange, const std::vector<double>& eBase,
                   const std::atomic<bool>& cancel, CandidateWork& w) {
   Problem pr;
   pr.base = &base;
@@ -436,7 +459,7 @@ void fitCandidate(EffectKind kind, const PhysicalModel& base, const Series& est,
   pr.fixedEffect = Effect::withDefaults(kind);
   pr.series = &est;
   pr.substeps = substeps;
-  pr.wo = wo;
+  pr.observer = observer;
   pr.cancel = &cancel;
   pr.coords = baseCoordinates(base);
   const auto& info = effectParameters(kind);
@@ -450,6 +473,7 @@ void fitCandidate(EffectKind kind, const PhysicalModel& base, const Series& est,
     pr.coords.push_back(c);
   };
   std::vector<Effect> starts;
+  std::vector<const PhysicalModel*> startModels;  // base parameters of each start (default: base)
   Effect e0 = pr.fixedEffect;
   int extraCount = 0;  // parameters chosen on a grid (count in the penalty)
   switch (kind) {
@@ -459,16 +483,68 @@ void fitCandidate(EffectKind kind, const PhysicalModel& base, const Series& est,
       starts.push_back(e0);
       break;
     case EffectKind::Backlash: {
-      // The gap is searched on a logarithmic grid over the gear deflections the base model
-      // sees in the data and kept inside them: a gap wider than the deflections would stand
-      // for a motor running free of the arm, which explains much of any data and is not a
-      // gear the arm has; a gap far below them changes nothing the data can show.
+      // The response is far from smooth in the gap b (each contact moves with it), so the
+      // gap is first profiled on a logarithmic grid up to the gear travel the data show, from
+      // both the refitted base and the engineer's values; the best three grid points start
+      // the screening fits. A gap wider than the travel is a motor that never meets the arm:
+      // its loss is flat in b and its interval does not exclude zero.
       addEffect(0, Map::Log);
-      const double range = std::max(deflectionRange, 1e-3 * info[0].defaultValue);
+      const double range = std::max(gapRange, 1e-3 * info[0].defaultValue);
       pr.coords.back().minPhi = std::log(1e-3 * range);
       pr.coords.back().maxPhi = std::log(range);
-      for (double f : {0.02, 0.05, 0.1, 0.2, 0.35, 0.6, 0.9}) {
-        e0.values[0] = f * range;
+      struct GridPoint {
+        double loss;
+        const PhysicalModel* model;
+        double b;
+      };
+      std::vector<GridPoint> grid;
+      std::vector<double> yhat;
+      const int points = 32;
+      auto gapAt = [range, points](double i) { return range * std::pow(10.0, -2.0 + 2.0 * i / (points - 1)); };
+      for (const PhysicalModel* m : {&base, &nominal}) {
+        Problem gp = pr;
+        gp.base = m;
+        auto lossAt = [&gp, &e0, &est, &yhat](double gap) {
+          Effect e = e0;
+          e.values[0] = gap;
+          return gp.simulate(coordinatesOf(gp, e), est, yhat) ? rms(est.y, yhat) : INFINITY;
+        };
+        double bestLoss = INFINITY;
+        int best = -1;
+        for (int i = 0; i < points && !cancel.load(); ++i) {
+          const double l = lossAt(gapAt(i));
+          if (l < bestLoss) bestLoss = l, best = i;
+        }
+        if (best < 0) continue;
+        // The minimum is sharp (a gap a little too wide loses the contacts): golden-section
+        // search between the neighbouring grid points.
+        double a = best - 1.0, c = best + 1.0;
+        const double g = 0.5 * (std::sqrt(5.0) - 1.0);
+        double x1 = c - g * (c - a), x2 = a + g * (c - a);
+        double f1 = lossAt(gapAt(x1)), f2 = lossAt(gapAt(x2));
+        for (int it = 0; it < 10 && !cancel.load(); ++it) {
+          if (f1 < f2) {
+            c = x2, x2 = x1, f2 = f1;
+            x1 = c - g * (c - a);
+            f1 = lossAt(gapAt(x1));
+          } else {
+            a = x1, x1 = x2, f1 = f2;
+            x2 = a + g * (c - a);
+            f2 = lossAt(gapAt(x2));
+          }
+        }
+        grid.push_back({bestLoss, m, gapAt(best)});
+        grid.push_back({std::min(f1, f2), m, gapAt(f1 < f2 ? x1 : x2)});
+      }
+      std::sort(grid.begin(), grid.end(),
+                [](const GridPoint& a, const GridPoint& b) { return a.loss < b.loss; });
+      for (std::size_t i = 0; i < grid.size() && i < 3; ++i) {
+        e0.values[0] = grid[i].b;
+        starts.push_back(e0);
+        startModels.push_back(grid[i].model);
+      }
+      if (starts.empty()) {
+        e0.values[0] = 0.3 * range;
         starts.push_back(e0);
       }
       break;
@@ -518,9 +594,11 @@ void fitCandidate(EffectKind kind, const PhysicalModel& base, const Series& est,
   Effect bestStart = starts.front();
   double bestSum = INFINITY;
   if (starts.size() > 1) {
-    for (const Effect& s : starts) {
+    for (std::size_t i = 0; i < starts.size(); ++i) {
       if (cancel.load()) break;
+      const Effect& s = starts[i];
       Problem sp = pr;
+      if (i < startModels.size()) sp.base = startModels[i];
       sp.fixedEffect = s;
       if (kind == EffectKind::TorqueRipple) {
         sp.coords.erase(sp.coords.begin(), sp.coords.end() - 1);  // A only
@@ -653,7 +731,8 @@ DiscoveryResult discoverMissingEffect(const PhysicalModel& base, const IdData& e
   const Series* valp = val ? &*val : nullptr;
   const int substeps = o.substeps > 0 ? o.substeps
                                       : std::max(2, static_cast<int>(std::ceil(est->Ts / 2.5e-4 - 1e-9)));
-  const double wo = 2.0 * M_PI * o.observerBandwidthHz;
+  const Observer observer{2.0 * M_PI * o.observerBandwidthHz,
+                          totalInertia(base) / base.value("k_T")};
   std::atomic<bool> cancel{false};
   std::mutex progressMutex;
   auto report = [&](double f, const std::string& stage) {
@@ -669,7 +748,7 @@ DiscoveryResult discoverMissingEffect(const PhysicalModel& base, const IdData& e
   bp.base = baseCopy.get();
   bp.series = &*est;
   bp.substeps = substeps;
-  bp.wo = wo;
+  bp.observer = observer;
   bp.cancel = &cancel;
   bp.coords = baseCoordinates(*baseCopy);
   if (bp.coords.empty()) return done(Termination::Failed, "the base model has no free parameter");
@@ -761,16 +840,21 @@ DiscoveryResult discoverMissingEffect(const PhysicalModel& base, const IdData& e
     D.summary = s;
   }
 
-  // The size of the gear deflections in the data: the 99th percentile of |delta|.
-  double deflectionRange = 0.0;
+  // How wide a backlash gap the data can show: the gear travel, r times the motor's swing
+  // about its 0.5 s moving mean (a gap the motor never crosses is invisible), or the base
+  // model's gear deflections if larger; 99th percentiles of the absolute values.
+  double gapRange = percentile99(deflection);
   {
-    std::vector<double> a(deflection.size());
-    for (std::size_t k = 0; k < a.size(); ++k) a[k] = std::abs(deflection[k]);
-    if (!a.empty()) {
-      const std::size_t q = std::min(a.size() - 1, a.size() * 99 / 100);
-      std::nth_element(a.begin(), a.begin() + static_cast<long>(q), a.end());
-      deflectionRange = a[q];
+    const std::size_t half = std::max<std::size_t>(1, static_cast<std::size_t>(0.25 / est->Ts));
+    std::vector<double> swing(N);
+    double sum = 0.0;
+    std::size_t lo = 0, hi = 0;  // the window [lo, hi)
+    for (std::size_t k = 0; k < N; ++k) {
+      for (; hi < std::min(N, k + half + 1); ++hi) sum += est->phi[hi];
+      for (; lo + half < k; ++lo) sum -= est->phi[lo];
+      swing[k] = est->phi[k] - sum / static_cast<double>(hi - lo);
     }
+    gapRange = std::max(gapRange, baseFit->value("r") * percentile99(swing));
   }
 
   // 3. Candidates in parallel.
@@ -786,8 +870,8 @@ DiscoveryResult discoverMissingEffect(const PhysicalModel& base, const IdData& e
     for (;;) {
       const std::size_t i = next++;
       if (i >= kinds.size() || cancel.load()) return;
-      fitCandidate(kinds[i], *baseFit, *est, valp, o, substeps, wo, D.spectrumPeakRadS,
-                   baseResonance, deflectionRange, eBase, cancel, work[i]);
+      fitCandidate(kinds[i], *baseFit, *baseCopy, *est, valp, o, substeps, observer,
+                   D.spectrumPeakRadS, baseResonance, gapRange, eBase, cancel, work[i]);
       const std::size_t f = ++finished;
       report(0.15 + 0.8 * static_cast<double>(f) / kinds.size(),
              std::string("fitted ") + toString(kinds[i]));

@@ -67,7 +67,12 @@ IdData makeLog(const PhysicalModel& truth, const std::vector<Effect>& effects, i
   const ExcitationKind kinds[] = {ExcitationKind::Chirp, ExcitationKind::Multisine,
                                   ExcitationKind::Prbs};
   o.excitation.kind = kinds[(seed + (validation ? 1 : 0)) % 3];
-  o.excitation.amplitude = o.excitation.kind == ExcitationKind::Prbs ? 0.02 : 0.05;
+  // The motor swings three to four times across the widest backlash gap tested (0.6 mrad on
+  // the arm, 0.07 rad at the motor). With the default 0.05 rad it would stay inside the gap,
+  // where the arm rattles, driven by the load disturbance alone, and the log carries nothing
+  // about the gap that a predictor without the load could use.
+  const double swings[] = {0.2, 0.25, 0.3};
+  o.excitation.amplitude = o.excitation.kind == ExcitationKind::Prbs ? 0.15 : swings[(seed / 2) % 3];
   o.excitation.multisinePeriodS = 4.0;
   o.excitation.multisineLastLine = 120;
   const double kp[] = {40.0, 30.0, 50.0}, kv[] = {0.3, 0.4, 0.25};
@@ -140,18 +145,64 @@ TEST(Discovery, RejectsMisuseAndReportsBadData) {
   EXPECT_NE(r.message.find("motor angle"), std::string::npos) << r.message;
 }
 
-// Naming an effect that is not there is the worst outcome: on logs whose truth has no
-// effect (several seeds, both excitations, turning and not) the verdict is "none".
-TEST(Discovery, AnswersNoneWhenNothingIsHidden) {
+// The headline test: every effect hidden in several logs (three seeds and sizes each, the
+// excitation, its swing and the controller tuning varying with the seed), and logs without
+// an effect, on which naming anything is the worst outcome. The right name in at least 90 %
+// of the cases, "none" on every log without an effect, and where the name is right the
+// validation residual RMS at least 30 % lower.
+TEST(Discovery, NamesTheHiddenEffect) {
   std::vector<Case> cases;
+  const double magnitudes[] = {1.5, 2.0, 3.0};
+  for (EffectKind k : allEffectKinds())
+    for (int s = 0; s < 3; ++s) {
+      double mag = magnitudes[s];
+      if (k == EffectKind::ExtraMass) mag = 0.7 + 0.3 * s;  // 70, 100, 130 rad/s
+      cases.push_back({k, 11 + 7 * s + static_cast<int>(k), mag});
+    }
   for (int s = 0; s < 4; ++s) cases.push_back({std::nullopt, 5 + 3 * s, 0.0});
-  for (const auto& o : runAll(cases)) {
-    ASSERT_TRUE(o.error.empty()) << "seed " << o.c.seed << ": " << o.error;
+
+  const auto outcomes = runAll(cases);
+  std::map<std::string, std::map<std::string, int>> confusion;
+  int right = 0, withEffect = 0;
+  double seconds = 0.0;
+  for (const auto& o : outcomes) {
+    const std::string truth = o.c.hidden ? toString(*o.c.hidden) : "none";
+    ASSERT_TRUE(o.error.empty()) << truth << " seed " << o.c.seed << ": " << o.error;
+    const std::string said = verdictName(o.result);
+    confusion[truth][said]++;
+    seconds = std::max(seconds, o.result.seconds);
+    std::printf("%-17s seed %2d x%.1f -> %-17s val RMS %.4f -> %.4f  %s\n", truth.c_str(),
+                o.c.seed, o.c.magnitude, said.c_str(), o.result.base.rmsValidation,
+                o.result.augmented.rmsValidation, o.result.evidence.c_str());
     ASSERT_EQ(o.result.termination, Termination::Converged) << o.result.message;
-    EXPECT_FALSE(o.result.effect.has_value())
-        << "named " << verdictName(o.result) << " where there is no effect (seed " << o.c.seed << ")";
-    EXPECT_FALSE(o.result.candidates.empty());
+    for (const auto& c : o.result.candidates)
+      std::printf("    %-17s loss %.5f val %.4f aic %.1f F %.1f/%.1f %s %s\n", toString(c.kind),
+                  c.lossEst, c.score.rmsValidation, c.aic - o.result.baseAic, c.fStatistic,
+                  c.fThreshold, toString(c.effect).c_str(), c.reason.c_str());
+    if (!o.c.hidden) {
+      EXPECT_FALSE(o.result.effect.has_value())
+          << "named " << said << " where there is no effect (seed " << o.c.seed << ")";
+      continue;
+    }
+    ++withEffect;
+    if (said == truth) {
+      ++right;
+      EXPECT_LE(o.result.augmented.rmsValidation, 0.7 * o.result.base.rmsValidation)
+          << truth << " seed " << o.c.seed;
+    }
   }
+  std::printf("\nConfusion matrix (rows: hidden effect, columns: verdict)\n%-17s", "");
+  std::vector<std::string> names = {"none"};
+  for (EffectKind k : allEffectKinds()) names.push_back(toString(k));
+  for (const auto& n : names) std::printf(" %6.6s", n.c_str());
+  std::printf("\n");
+  for (const auto& row : names) {
+    std::printf("%-17s", row.c_str());
+    for (const auto& col : names) std::printf(" %6d", confusion[row][col]);
+    std::printf("\n");
+  }
+  std::printf("right %d of %d; slowest run %.1f s\n", right, withEffect, seconds);
+  EXPECT_GE(right, static_cast<int>(std::ceil(0.9 * withEffect)));
 }
 
 }  // namespace
