@@ -44,6 +44,27 @@ bool readNumber(const json& j, const char* key, double& out, bool required, std:
   return f != Field::Bad;
 }
 
+// The effect names listed under key, if the key is there (else out is left as it is); false
+// with a sentence when the value is not a list or names an unknown effect.
+bool readEffectList(const json& j, const char* key, const char* notList, const char* unknown,
+                    std::vector<EffectKind>& out, std::string* why, const std::string& where) {
+  if (!j.contains(key)) return true;
+  if (!j[key].is_array()) {
+    if (why) *why = where + notList;
+    return false;
+  }
+  out.clear();
+  for (const auto& e : j[key]) {
+    auto k = e.is_string() ? effectKindFromString(e.get<std::string>()) : std::nullopt;
+    if (!k) {
+      if (why) *why = where + unknown + e.dump();
+      return false;
+    }
+    out.push_back(*k);
+  }
+  return true;
+}
+
 bool readText(const json& j, const char* key, std::string& out, bool required, std::string* why,
               const std::string& where) {
   const Field f = field(j, key, required, [](const json& v) { return v.is_string(); }, "text", why, where);
@@ -438,21 +459,9 @@ std::optional<DiscoveryRequest> discoveryRequestFromJson(const json& j, std::str
       return std::nullopt;
     }
     DiscoveryOptions& d = q.options;
-    if (o.contains("candidates")) {
-      if (!o["candidates"].is_array()) {
-        if (why) *why = ow + "candidates must be a list of effect names";
-        return std::nullopt;
-      }
-      d.candidates.clear();
-      for (const auto& c : o["candidates"]) {
-        auto k = c.is_string() ? effectKindFromString(c.get<std::string>()) : std::nullopt;
-        if (!k) {
-          if (why) *why = ow + "unknown candidate effect " + c.dump();
-          return std::nullopt;
-        }
-        d.candidates.push_back(*k);
-      }
-    }
+    if (!readEffectList(o, "candidates", "candidates must be a list of effect names",
+                        "unknown candidate effect ", d.candidates, why, ow))
+      return std::nullopt;
     if (!readNumber(o, "observer_bandwidth_hz", d.observerBandwidthHz, false, why, ow) ||
         !readNumber(o, "max_rate_hz", d.maxRateHz, false, why, ow) ||
         !readWhole(o, "substeps", d.substeps, why, ow) ||
@@ -518,20 +527,9 @@ std::optional<DiscoveryResult> discoveryResultFromJson(const json& j, std::strin
       return std::nullopt;
     }
   }
-  if (j.contains("tied")) {
-    if (!j["tied"].is_array()) {
-      if (why) *why = where + "tied must be a list";
-      return std::nullopt;
-    }
-    for (const auto& t : j["tied"]) {
-      auto k = t.is_string() ? effectKindFromString(t.get<std::string>()) : std::nullopt;
-      if (!k) {
-        if (why) *why = where + "unknown tied effect " + t.dump();
-        return std::nullopt;
-      }
-      r.tied.push_back(*k);
-    }
-  }
+  if (!readEffectList(j, "tied", "tied must be a list", "unknown tied effect ", r.tied, why,
+                      where))
+    return std::nullopt;
   if (!readText(j, "evidence", r.evidence, false, why, where) ||
       !readText(j, "disagreement", r.disagreement.summary, false, why, where) ||
       !readFlag(j, "has_validation", r.hasValidation, why, where) ||
