@@ -291,6 +291,8 @@ ClosedLoopPemResult indirect(const ParametricModel& model, const Eigen::VectorXd
                              const ProgressCallback& progress) {
   if (r.size() != y.size())
     throw std::invalid_argument("pemClosedLoop: the indirect method needs a reference as long as the output");
+  if (options.loopWarmup < 0 || options.loopWarmup >= y.size())
+    throw std::invalid_argument("pemClosedLoop: the loop's warm-up must leave samples to compare");
   ClosedLoopPemResult out;
   out.method = ClosedLoopMethod::Indirect;
   const std::string head = "indirect closed-loop fit";
@@ -314,10 +316,17 @@ ClosedLoopPemResult indirect(const ParametricModel& model, const Eigen::VectorXd
   po.covariance = CovarianceKind::Sandwich;
   const ControllerOptions ctl = options.controller;
   const LoopOutput output = options.loopOutput;
-  po.predictor = [ctl, output](const ParametricModel& m, const Eigen::VectorXd& ref,
-                               const Eigen::VectorXd& angle, double Ts,
-                               const std::vector<int>& free, bool withGradient) {
-    return evaluateLoop(m, ctl, ref, angle, Ts, free, withGradient, output);
+  const Eigen::Index skip = options.loopWarmup;
+  po.predictor = [ctl, output, skip](const ParametricModel& m, const Eigen::VectorXd& ref,
+                                     const Eigen::VectorXd& angle, double Ts,
+                                     const std::vector<int>& free, bool withGradient) {
+    PemEvaluation ev = evaluateLoop(m, ctl, ref, angle, Ts, free, withGradient, output);
+    if (skip > 0) {
+      const Eigen::Index n = ev.eps.size() - skip;
+      ev.eps = Eigen::VectorXd(ev.eps.tail(n));
+      if (withGradient) ev.psi = Eigen::MatrixXd(ev.psi.bottomRows(n));
+    }
+    return ev;
   };
   out.pem = pem(*work, rRel, yRel, T, po, progress);
   // Back to the caller's output (e.g. the motor velocity) for Bode plots and simulation.

@@ -540,7 +540,9 @@ PemResult pem(const ParametricModel& model0, const Eigen::VectorXd& u, const Eig
     totalIterations += sol.summary.iterations;
     cancelled = sol.summary.termination == Termination::Cancelled;
     const bool ok = sol.summary.termination != Termination::Failed;
-    result.startLosses.push_back(ok ? sol.sumSquares / y.size() : INFINITY);
+    // Per error the predictor compares (a custom one may compare fewer samples than y holds).
+    result.startLosses.push_back(ok ? sol.sumSquares / static_cast<double>(std::max<Eigen::Index>(1, sol.eps.size()))
+                                    : INFINITY);
     if (!ok && firstFailure.empty()) firstFailure = sol.summary.message;
     if (ok && (!best.ok || sol.sumSquares < best.sol.sumSquares)) {
       best.sol = std::move(sol);
@@ -570,7 +572,7 @@ PemResult pem(const ParametricModel& model0, const Eigen::VectorXd& u, const Eig
   if (result.starts > 1)
     sum.message += "; best of " + std::to_string(result.starts) + " starts (start " +
                    std::to_string(result.bestStart) + ")";
-  fillStatistics(sum, best.sol.sumSquares, y.size(), p);
+  fillStatistics(sum, best.sol.sumSquares, best.sol.eps.size(), p);
   // Covariance in phi, mapped to theta with the Jacobian of the transform.
   result.covarianceKind = options.covariance;
   Eigen::MatrixXd covPhi;
