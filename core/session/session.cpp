@@ -75,10 +75,6 @@ class FieldReader {
   bool failed_ = false;
 };
 
-json rangeToJson(const std::optional<SecondsRange>& r) {
-  return r ? json::array({r->start, r->end}) : json(nullptr);
-}
-
 bool rangeFromJson(const json& v, const std::string& where, std::optional<SecondsRange>& out,
                    FieldReader& f) {
   if (v.is_null()) {
@@ -190,6 +186,23 @@ std::string placeOf(const std::string& text, std::size_t byte) {
 
 }  // namespace
 
+json secondsRangeToJson(const std::optional<SecondsRange>& r) {
+  return r ? json::array({r->start, r->end}) : json(nullptr);
+}
+
+bool readSecondsRange(const json& j, const char* key, std::optional<SecondsRange>& out, std::string* why) {
+  out.reset();
+  if (!j.contains(key) || j[key].is_null()) return true;
+  const json& r = j[key];
+  if (!r.is_array() || r.size() != 2 || !r[0].is_number() || !r[1].is_number() ||
+      !(r[0].get<double>() < r[1].get<double>())) {
+    if (why) *why = std::string(key) + " must be [start, end] in seconds with start < end";
+    return false;
+  }
+  out = SecondsRange{r[0].get<double>(), r[1].get<double>()};
+  return true;
+}
+
 std::string toJsonText(const Session& s) {
   json logs = json::array();
   for (const auto& l : s.logs)
@@ -201,8 +214,8 @@ std::string toJsonText(const Session& s) {
             {"logs", logs},
             {"preprocessing", preprocessToJson(s)},
             {"ranges",
-             {{"estimation_s", rangeToJson(s.estimation)},
-              {"validation_s", rangeToJson(s.validation)}}},
+             {{"estimation_s", secondsRangeToJson(s.estimation)},
+              {"validation_s", secondsRangeToJson(s.validation)}}},
             {"parts", s.parts.is_object() ? s.parts : json::object()}};
   return j.dump(2) + "\n";
 }

@@ -43,6 +43,13 @@ struct Session {
   std::string writtenBy;  // "FlexArm 0.1.0" of the program that saved the file
 };
 
+// A range in seconds as session JSON, [start, end] or null.
+nlohmann::json secondsRangeToJson(const std::optional<SecondsRange>& r);
+// Reads j[key] (absent or null: no range); false with a sentence unless [start, end] with
+// start < end.
+bool readSecondsRange(const nlohmann::json& j, const char* key, std::optional<SecondsRange>& out,
+                      std::string* why);
+
 // The session as JSON text (pretty-printed, keys in a stable order).
 std::string toJsonText(const Session& session);
 
