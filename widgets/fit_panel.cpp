@@ -7,6 +7,7 @@
 #include <QHeaderView>
 #include <QLabel>
 #include <QListWidget>
+#include <QPlainTextEdit>
 #include <QProgressBar>
 #include <QPushButton>
 #include <QSpinBox>
@@ -44,7 +45,7 @@ FitPanel::FitPanel(Workspace* workspace, QWidget* parent)
       noise_(new QComboBox(this)), closedLoop_(new QComboBox(this)), starts_(new QSpinBox(this)), iterations_(new QSpinBox(this)),
       estimate_(new QPushButton(tr("Estimate"), this)),
       cancel_(new QPushButton(tr("Cancel"), this)), progress_(new QProgressBar(this)),
-      table_(new QTableWidget(0, 6, this)), summary_(new QLabel(this)),
+      table_(new QTableWidget(0, 6, this)), summary_(new QPlainTextEdit(this)),
       studyRuns_(new QSpinBox(this)), study_button_(new QPushButton(tr("Run study"), this)),
       studyTable_(new QTableWidget(0, 3, this)), studySummary_(new QLabel(this)),
       poll_(new QTimer(this)), permille_(std::make_shared<std::atomic<int>>(0)),
@@ -125,11 +126,13 @@ FitPanel::FitPanel(Workspace* workspace, QWidget* parent)
   table_->horizontalHeader()->setSectionResizeMode(QHeaderView::ResizeToContents);
   table_->verticalHeader()->setVisible(false);
   table_->setEditTriggers(QAbstractItemView::NoEditTriggers);
+  // Read-only and scrolling: the method, the controller and the warnings may run long.
   summary_->setObjectName("fitSummary");
-  summary_->setWordWrap(true);
-  summary_->setMinimumHeight(6 * summary_->fontMetrics().lineSpacing());
-  summary_->setAlignment(Qt::AlignLeft | Qt::AlignTop);
-  summary_->setTextInteractionFlags(Qt::TextSelectableByMouse);
+  summary_->setReadOnly(true);
+  summary_->setLineWrapMode(QPlainTextEdit::WidgetWidth);
+  summary_->setFrameShape(QFrame::NoFrame);
+  summary_->setMinimumHeight(7 * summary_->fontMetrics().lineSpacing());
+  summary_->setMaximumHeight(11 * summary_->fontMetrics().lineSpacing());
 
   auto* studyBox = new QGroupBox(tr("Sensitivity study (Section 5.3.3)"), this);
   studyRuns_->setRange(1, 100000);
@@ -322,7 +325,7 @@ void FitPanel::startProgress() {
 
 void FitPanel::cancel() {
   abort_->store(true);
-  summary_->setText(tr("Cancelling..."));
+  summary_->setPlainText(tr("Cancelling..."));
 }
 
 // The pipeline's options from the panel's choices and the workspace's data and ranges;
@@ -360,7 +363,7 @@ std::optional<FitOptions> FitPanel::options(QString* name) {
     auto start = clonePhysical(*base);
     const QStringList names = freeParameters();
     if (names.isEmpty()) {
-      summary_->setText(tr("Check at least one parameter to estimate."));
+      summary_->setPlainText(tr("Check at least one parameter to estimate."));
       return std::nullopt;
     }
     for (const auto& p : base->parameters()) start->setFree(p.name, names.contains(QString::fromStdString(p.name)));
@@ -372,13 +375,13 @@ std::optional<FitOptions> FitPanel::options(QString* name) {
     o.randomStarts = starts_->value();
   }
   if (!workspace_->current()) {
-    summary_->setText(tr("Open a log with an input and an output channel first."));
+    summary_->setPlainText(tr("Open a log with an input and an output channel first."));
     return std::nullopt;
   }
   useWorkspaceData(*workspace_, o);
   std::string why;
   if (!o.isValid(&why)) {
-    summary_->setText(tr("The fit cannot run: %1").arg(QString::fromStdString(why)));
+    summary_->setPlainText(tr("The fit cannot run: %1").arg(QString::fromStdString(why)));
     return std::nullopt;
   }
   return o;
@@ -400,7 +403,7 @@ void FitPanel::estimate() {
   record->estimation = o->estimation.front().range;
   if (!o->validation.empty()) record->validation = o->validation.front().range;
   table_->setRowCount(0);
-  summary_->setText(tr("Estimating %1...").arg(QString::fromStdString(o->model.name())));
+  summary_->setPlainText(tr("Estimating %1...").arg(QString::fromStdString(o->model.name())));
   startProgress();
   const auto progress = progressCallback();
   // The one fit pipeline (core/ident/fit.h), as `flexarm fit` and a session's replay run it.
@@ -426,7 +429,7 @@ void FitPanel::onFinished() {
   progress_->setValue(ok ? 1000 : 0);
   if (!ok) {
     const QString reason = !out.error.isEmpty() ? out.error : QString::fromStdString(r.message);
-    summary_->setText(r.termination == Termination::Cancelled ? tr("Cancelled: %1").arg(reason)
+    summary_->setPlainText(r.termination == Termination::Cancelled ? tr("Cancelled: %1").arg(reason)
                                                               : tr("The fit failed: %1").arg(reason));
     updateControls();
     emit estimated(false);
@@ -492,13 +495,13 @@ void FitPanel::onFinished() {
   out.request->name = name.toStdString();
   entry.fitRequest = out.request;
   lines << tr("Added to the model list as \"%1\".").arg(name);
-  summary_->setText(lines.join("\n"));
+  summary_->setPlainText(lines.join("\n"));
   lastIndex_ = workspace_->addModel(entry);
   updateControls();
   emit estimated(true);
 }
 
-QString FitPanel::summaryText() const { return summary_->text(); }
+QString FitPanel::summaryText() const { return summary_->toPlainText(); }
 QString FitPanel::studyText() const { return studySummary_->text(); }
 
 void FitPanel::runStudy() {

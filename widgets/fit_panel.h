@@ -19,6 +19,7 @@
 class QComboBox;
 class QLabel;
 class QListWidget;
+class QPlainTextEdit;
 class QProgressBar;
 class QPushButton;
 class QSpinBox;
@@ -111,7 +112,7 @@ class FitPanel : public QWidget {
   QPushButton* cancel_;
   QProgressBar* progress_;
   QTableWidget* table_;
-  QLabel* summary_;
+  QPlainTextEdit* summary_;
   QSpinBox* studyRuns_;
   QPushButton* study_button_;
   QTableWidget* studyTable_;

@@ -207,6 +207,13 @@ class IdentificationTest : public QObject {
     QVERIFY((*replay)["notches_rad_s"] == line["notches_rad_s"]);
     const QString shown = QString::number(line["fit_percent_validation"].get<double>(), 'f', 1) + " %";
     QVERIFY2(fit->summaryText().contains(shown), qPrintable(shown + " not in " + fit->summaryText()));
+    // As a user sees it on a 1366 x 768 screen.
+    window_->resize(1366, 768);
+    QTest::qWait(300);
+    test::saveShot(window_->grab().toImage(), "fit_identity_1366x768");
+    test::saveShot(fit->grab().toImage(), "fit_panel_identity");
+    window_->resize(1500, 1000);
+    QTest::qWait(100);
   }
 
   void blackBoxFitJoinsTheListToo() {
