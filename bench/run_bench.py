@@ -202,7 +202,7 @@ def plot(rows, info, stem):
     for yi, v in zip(y, values):
         ax.text(v * 1.08, yi, fmt_ratio(v), va="center", fontsize=7)
     ax.set_xlim(min(0.5, min(values) / 2), max(values) * 4)
-    ax.set_title(f"FlexArm against its peers ({info['cpu']}, {info['cores']} cores); "
+    ax.set_title(f"FlexArm against its peers ({info['cpu']}, {info['cores']} cores)\n"
                  "blue: results agree, red: they do not, grey: not compared", fontsize=8)
     ax.grid(axis="x", which="both", alpha=0.3)
     fig.tight_layout()
