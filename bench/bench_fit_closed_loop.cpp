@@ -9,7 +9,10 @@
 // Then the same for data decimated by 10 (the seed's 200 Hz, where the indirect fit cannot
 // run), and the coverage of Auto's intervals over many logs of both arms.
 //
-//   cmake --build BUILD --target bench_fit_closed_loop && BUILD/bench/bench_fit_closed_loop [SEEDS [COVERAGE_LOGS]]
+// Rows on stdout (bench/README.md: one per noise level and case, Auto against the direct fit),
+// the tables on stderr. The defaults (4 logs per level, 20 per coverage case) keep the suite
+// within minutes; the numbers README and the fit's sentences quote come from 6 and 40:
+//   cmake --build BUILD --target bench_fit_closed_loop && BUILD/bench/bench_fit_closed_loop [SEEDS [COVERAGE_LOGS [PARTS]]]
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -20,6 +23,7 @@
 #include <string>
 #include <vector>
 
+#include "bench_common.h"
 #include "core/ident/fit.h"
 #include "core/models/physical_models.h"
 #include "core/sim/closed_loop.h"
@@ -126,24 +130,66 @@ void fitInto(Tally& t, const Arm& arm, const std::shared_ptr<IdData>& log, Close
 }
 
 void printRow(const char* head, const char* method, const Arm& arm, const Tally& t) {
-  std::printf("%-6s %-10s", head, method);
+  std::fprintf(stderr, "%-6s %-10s", head, method);
   for (const auto& p : arm.free) {
     auto it = t.relErr.find(p);
     char cell[40] = "-";
     if (it != t.relErr.end())
       std::snprintf(cell, sizeof cell, "%+.2f/%.2f", 100 * mean(it->second), 100 * spread(it->second));
-    std::printf(" %-15s", cell);
+    std::fprintf(stderr, " %-15s", cell);
   }
-  std::printf(" %4d/%-4d %8.3f  ", t.inside, t.total, t.fits + t.failed ? t.seconds / (t.fits + t.failed) : 0.0);
-  for (const auto& [name, n] : t.picks) std::printf("%s %d ", name.c_str(), n);
-  if (t.failed) std::printf("(%d failed)", t.failed);
-  std::printf("\n");
+  std::fprintf(stderr, " %4d/%-4d %8.3f  ", t.inside, t.total, t.fits + t.failed ? t.seconds / (t.fits + t.failed) : 0.0);
+  for (const auto& [name, n] : t.picks) std::fprintf(stderr, "%s %d ", name.c_str(), n);
+  if (t.failed) std::fprintf(stderr, "(%d failed)", t.failed);
+  std::fprintf(stderr, "\n");
 }
 
 void printHeader(const Arm& arm, const char* first) {
-  std::printf("%-6s %-10s", first, "method");
-  for (const auto& p : arm.free) std::printf(" %-15s", (p + " bias/spr").c_str());
-  std::printf(" coverage   seconds  picks\n");
+  std::fprintf(stderr, "%-6s %-10s", first, "method");
+  for (const auto& p : arm.free) std::fprintf(stderr, " %-15s", (p + " bias/spr").c_str());
+  std::fprintf(stderr, " coverage   seconds  picks\n");
+}
+
+// "30/30 inside, largest bias d_a -18.3 % (spread 5.0 %)" of one method.
+std::string summary(const Tally& t) {
+  std::string worst;
+  double w = -1.0, sw = 0.0;
+  for (const auto& [name, e] : t.relErr)
+    if (std::abs(mean(e)) > w) {
+      w = std::abs(mean(e));
+      worst = name;
+      sw = spread(e);
+    }
+  char buf[160];
+  std::snprintf(buf, sizeof buf, "%d/%d inside, largest bias %s %+.2g %% (spread %.2g %%)", t.inside, t.total,
+                worst.c_str(), worst.empty() ? 0.0 : 100.0 * mean(t.relErr.at(worst)), 100.0 * sw);
+  return buf;
+}
+
+double secondsPerFit(const Tally& t) { return t.fits + t.failed ? t.seconds / (t.fits + t.failed) : 0.0; }
+
+// One row per noise level: Auto against the direct fit an engineer would run, in time, bias
+// and coverage; agree: every interval of Auto's held the truth.
+void emitLevel(const Arm& arm, double level, int decimation, int seeds, std::map<ClosedLoopChoice, Tally>& t) {
+  const Tally& a = t[ClosedLoopChoice::Auto];
+  const Tally& d = t[ClosedLoopChoice::Direct];
+  bench::Row row;
+  row.group = "closed-loop fit: bias and 99 % coverage (simulated logs)";
+  std::string pick;
+  for (const auto& [name, n] : a.picks) pick += (pick.empty() ? "" : ", ") + name;
+  char task[160];
+  std::snprintf(task, sizeof task, "%s%s, noise x%g: auto (%s)", arm.structure.c_str(),
+                decimation > 1 ? (", decimated x" + std::to_string(decimation)).c_str() : ", 2 kHz", level, pick.c_str());
+  row.task = task;
+  row.size = std::to_string(seeds) + " logs of " + std::to_string(static_cast<int>(arm.durationS)) + " s";
+  row.flexarmSeconds = secondsPerFit(a);
+  row.peer = "direct fit (FlexArm)";
+  row.peerSeconds = secondsPerFit(d);
+  row.agree = a.total > 0 && a.inside == a.total;
+  std::string text = "auto " + summary(a) + "; direct " + summary(d);
+  if (t.count(ClosedLoopChoice::TwoStage)) text += "; two-stage " + summary(t[ClosedLoopChoice::TwoStage]);
+  row.agreement = text;
+  bench::emit(row);
 }
 
 // Bias and spread per method over noise levels.
@@ -159,7 +205,8 @@ void levelTable(const Arm& arm, const std::vector<double>& levels, const std::ve
     char head[16];
     std::snprintf(head, sizeof head, "%g", level);
     for (ClosedLoopChoice m : methods) printRow(head, toString(m), arm, tallies[m]);
-    std::fflush(stdout);
+    std::fflush(stderr);
+    emitLevel(arm, level, decimation, seeds, tallies);
   }
 }
 
@@ -168,25 +215,34 @@ void coverage(const Arm& arm, int decimation, int logs) {
   Tally t;
   for (int s = 0; s < logs; ++s)
     fitInto(t, arm, simulatedLog(arm, 1.0, static_cast<std::uint64_t>(1000 + s)), ClosedLoopChoice::Auto, decimation);
-  std::printf("%-10s x%-3d %4d/%-4d inside (%.1f %% missed; per parameter:", arm.structure.c_str(), decimation,
+  std::fprintf(stderr, "%-10s x%-3d %4d/%-4d inside (%.1f %% missed; per parameter:", arm.structure.c_str(), decimation,
               t.inside, t.total, t.total ? 100.0 * (t.total - t.inside) / t.total : 0.0);
-  for (const auto& p : arm.free) std::printf(" %s %d", p.c_str(), t.missed[p]);
-  std::printf("); picks ");
-  for (const auto& [name, n] : t.picks) std::printf("%s %d ", name.c_str(), n);
-  std::printf("\n");
-  for (const auto& w : t.warnings) std::printf("  warning: %s\n", w.c_str());
-  std::fflush(stdout);
+  for (const auto& p : arm.free) std::fprintf(stderr, " %s %d", p.c_str(), t.missed[p]);
+  std::fprintf(stderr, "); picks ");
+  for (const auto& [name, n] : t.picks) std::fprintf(stderr, "%s %d ", name.c_str(), n);
+  std::fprintf(stderr, "\n");
+  for (const auto& w : t.warnings) std::fprintf(stderr, "  warning: %s\n", w.c_str());
+  std::fflush(stderr);
+  bench::Row row;
+  row.group = "closed-loop fit: bias and 99 % coverage (simulated logs)";
+  row.task = "coverage of auto's 99 % intervals, " + arm.structure + (decimation > 1 ? ", decimated x" + std::to_string(decimation) : ", 2 kHz");
+  row.size = std::to_string(logs) + " logs at the sample logs' noise";
+  row.flexarmSeconds = secondsPerFit(t);
+  row.peer = "none (a coverage count)";
+  row.agree = t.total > 0 && (t.total - t.inside) <= t.total / 100;
+  row.agreement = summary(t) + (t.warnings.empty() ? "" : "; the fit says so in a warning");
+  bench::emit(row);
 }
 
 }  // namespace
 
 int main(int argc, char** argv) {
-  const int seeds = argc > 1 ? std::max(2, std::atoi(argv[1])) : 6;
-  const int logs = argc > 2 ? std::max(1, std::atoi(argv[2])) : 40;
+  const int seeds = argc > 1 ? std::max(2, std::atoi(argv[1])) : bench::quick() ? 2 : 4;
+  const int logs = argc > 2 ? std::max(1, std::atoi(argv[2])) : bench::quick() ? 6 : 20;
   const std::string parts = argc > 3 ? argv[3] : "123";  // which of the three parts to run
   using C = ClosedLoopChoice;
   if (parts.find('1') != std::string::npos) {
-    std::printf("1. Two-mass arm, 2 kHz: %d logs per noise level, controller identified from each log.\n"
+    std::fprintf(stderr, "1. Two-mass arm, 2 kHz: %d logs per noise level, controller identified from each log.\n"
                 "Bias: mean of (estimate - truth) / truth; spread: their standard deviation; both in %%.\n"
                 "Coverage: truths inside their 99 %% intervals.\n\n",
                 seeds);
@@ -194,12 +250,12 @@ int main(int argc, char** argv) {
                seeds);
   }
   if (parts.find('2') != std::string::npos) {
-    std::printf("\n2. Decimated by 10 (200 Hz; the indirect fit needs the controller's rate):\n\n");
+    std::fprintf(stderr, "\n2. Decimated by 10 (200 Hz; the indirect fit needs the controller's rate):\n\n");
     levelTable(kTwoMass, {0.3, 1.0, 3.0}, {C::Direct, C::TwoStage, C::Auto}, 10, seeds);
     levelTable(kThreeMass, {1.0}, {C::Direct, C::TwoStage, C::Auto}, 10, seeds);
   }
   if (parts.find('3') != std::string::npos) {
-    std::printf("\n3. Coverage of Auto's 99 %% intervals, %d logs per row at noise level 1:\n\n", logs);
+    std::fprintf(stderr, "\n3. Coverage of Auto's 99 %% intervals, %d logs per row at noise level 1:\n\n", logs);
     coverage(kTwoMass, 1, logs);
     coverage(kThreeMass, 1, logs);
     coverage(kTwoMass, 10, logs);
