@@ -114,6 +114,7 @@ NonparametricEstimate etfe(const Eigen::VectorXd& u, const Eigen::VectorXd& y, d
   if (omega.empty())
     for (int k = 1; k <= nb; ++k) omega.push_back(k * dw);
   const double width = std::max(1, options.smoothingWidth);
+  r.window = std::max(1, options.smoothingWidth);
   // The Hann weights at whole-bin offsets, for frequencies on the DFT grid (the default).
   const int half = static_cast<int>(std::ceil(width));
   std::vector<double> gridWeight(2 * half + 1);
@@ -175,6 +176,7 @@ NonparametricEstimate spa(const Eigen::VectorXd& u, const Eigen::VectorXd& y, do
   int M = options.windowWidth > 0 ? options.windowWidth
                                   : static_cast<int>(std::min<Eigen::Index>(n / 10, 30));
   M = static_cast<int>(std::max<Eigen::Index>(1, std::min<Eigen::Index>(M, n - 1)));
+  r.window = M;
   // Covariances R_yu(tau) = 1/N sum y(t + tau) u(t), tau = -M..M, and R_u, R_y for tau >= 0.
   auto cov = [&](const Eigen::VectorXd& a, const Eigen::VectorXd& b, int tau) {
     double s = 0.0;

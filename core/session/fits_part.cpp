@@ -117,7 +117,7 @@ class FitsPart : public SessionPart {
       return s;
     }
     const auto n = static_cast<Eigen::Index>(e.data.estimation.size());
-    const int m = o.model.windowWidth > 0 ? o.model.windowWidth : static_cast<int>(std::min<Eigen::Index>(n / 10, 30));
+    const int m = e.nonparametric.window;
     s.paragraphs.push_back("Blackman-Tukey spectral analysis (4.28) of the estimation data (" +
                            std::to_string(n) + " samples, " + e.data.note() + "), Hann lag window M = " +
                            std::to_string(m) + ", 99 % band from (6.62).");
