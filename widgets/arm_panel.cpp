@@ -273,6 +273,7 @@ void ArmPanel::onSourceChanged() {
   scene_->setGhostVisible(false);
   const int source = source_->currentData().toInt();
   if (source != kLogSource && workspace_->raw()) startSimulation();
+  placeParameterFault();
   updateCaption();
   redraw();
 }
@@ -342,6 +343,7 @@ void ArmPanel::onSimulated() {
                                          angles_->maxParallelDeflection}));
     exaggerate_->setValue(niceDown(kDeflectionDrawn / std::max(1e-12, largest), 1, 1000000));
     scene_->setGhostVisible(ghost_->isChecked());
+    placeParameterFault();
   }
   updateCaption();
   if (!ok) {
@@ -433,6 +435,7 @@ void ArmPanel::showTime(double t) {
 }
 
 void ArmPanel::showFault(ArmPart part, const QString& reason) {
+  faultParameter_.clear();
   if (fault_) scene_->setHighlight(*fault_, false);
   fault_ = part;
   faultReason_ = reason;
@@ -441,7 +444,27 @@ void ArmPanel::showFault(ArmPart part, const QString& reason) {
   redraw();
 }
 
+bool ArmPanel::showParameterFault(const QString& parameter, const QString& reason) {
+  const auto part = armPartForParameter(shownStructure(), parameter.toStdString());
+  if (!part) return false;
+  showFault(*part, reason);
+  faultParameter_ = parameter;
+  return true;
+}
+
+std::string ArmPanel::shownStructure() const { return angles_ ? angles_->structure : "rigid"; }
+
+void ArmPanel::placeParameterFault() {
+  if (faultParameter_.isEmpty()) return;
+  const auto part = armPartForParameter(shownStructure(), faultParameter_.toStdString());
+  if (!part || part == fault_) return;
+  const QString parameter = faultParameter_;
+  showFault(*part, faultReason_);
+  faultParameter_ = parameter;
+}
+
 void ArmPanel::clearFault() {
+  faultParameter_.clear();
   if (!fault_) return;
   scene_->clearHighlights();
   fault_.reset();

@@ -81,6 +81,8 @@ class ArmPanel : public QWidget {
   // Diagnosis hook: draws part in red with the reason on the view until cleared.
   void showFault(ArmPart part, const QString& reason);
   void clearFault();
+  // The highlighted part, if any.
+  std::optional<ArmPart> fault() const { return fault_; }
 
   // The view at time t as an image (the playhead is not moved), for stills and frames.
   QImage renderAt(double t);
@@ -91,6 +93,15 @@ class ArmPanel : public QWidget {
   void exportFrames(const QString& folder, double t0, double t1, double fps, double speed,
                     bool runFfmpeg = true);
   bool isExporting() const { return exporting_; }
+
+ public slots:
+  // Diagnosis hook by name, for the Diagnosis dock to connect to: highlights the part that
+  // parameter `parameter` (J_m, k_g, d_a, ... of Table 3.1, as the models name them) belongs
+  // to in the model shown, with the reason on the view. The part follows the model: k_a is the
+  // gear spring of the two-mass model and the arm spring of the three-mass one, so choosing
+  // another source moves the highlight. A name that is no part of the arm (r, or unknown)
+  // changes nothing and returns false.
+  bool showParameterFault(const QString& parameter, const QString& reason);
 
  signals:
   // A source's simulation finished (or failed: message says why); the arm plays it.
@@ -135,8 +146,14 @@ class ArmPanel : public QWidget {
     std::vector<Effect> effects;
   };
   std::optional<External> external_;
+  // The structure of the model shown ("rigid" while the arm plays the log).
+  std::string shownStructure() const;
+  // Maps a fault given by parameter name onto the model shown (after the source changed).
+  void placeParameterFault();
+
   std::optional<ArmPart> fault_;
   QString faultReason_;
+  QString faultParameter_;  // set when the fault came by parameter name
   QString sourceText_;
   ArmOverlay overlay_;
   QString computingName_;

@@ -2,7 +2,8 @@
 // frame shown; the flexible arm differs from its rigid ghost when excited at a resonance and
 // coincides with it at rest (a picture check); after a torque step the arm lags the ghost and
 // rings (with a screenshot sequence at 1366x768); the four-mass model shows its parallel mass;
-// a fault is highlighted; nothing renders when nothing changed; frames and a still export.
+// a fault is highlighted, also when the diagnosis names a parameter; nothing renders when
+// nothing changed; frames and a still export.
 #include <QApplication>
 #include <QComboBox>
 #include <QDir>
@@ -249,6 +250,37 @@ class ArmViewTest : public QObject {
     arm_->clearFault();
     QVERIFY(!arm_->scene()->isHighlighted(ArmPart::Arm));
     QVERIFY(red(picture()) < before + 50);
+  }
+
+  // The Diagnosis dock names the faulty parameter; the view highlights the part it belongs to
+  // in the model shown (k_a: the arm spring of the four-mass model, the gear spring of the
+  // two-mass one) and moves the highlight when the model shown changes.
+  void aFaultyParameterHighlightsItsPart() {
+    QCOMPARE(arm_->scene()->springs(), 3);  // the four-mass model is shown
+    bool placed = false;
+    QVERIFY(QMetaObject::invokeMethod(arm_, "showParameterFault", Q_RETURN_ARG(bool, placed),
+                                      Q_ARG(QString, "k_a"), Q_ARG(QString, "k_a 30 % low")));
+    QVERIFY(placed);
+    QCOMPARE(arm_->fault(), std::optional<ArmPart>(ArmPart::ArmSpring));
+    QVERIFY(arm_->scene()->isHighlighted(ArmPart::ArmSpring));
+    QVERIFY(!arm_->scene()->isHighlighted(ArmPart::GearSpring));
+    QVERIFY(arm_->captionText().contains("Fault: k_a 30 % low (arm_spring in red)"));
+    // The gear ratio is no part of the arm: nothing changes.
+    QVERIFY(!arm_->showParameterFault("r", "r changed"));
+    QCOMPARE(arm_->fault(), std::optional<ArmPart>(ArmPart::ArmSpring));
+    // The two-mass model's only spring is k_a: the highlight moves to the gear spring.
+    QSignalSpy ready(arm_, &ArmPanel::anglesReady);
+    arm_->setExternalModel("Recursive estimate", std::shared_ptr<const PhysicalModel>(makeModel("two-mass")));
+    QVERIFY(ready.wait(30000));
+    QCOMPARE(arm_->scene()->springs(), 1);
+    QCOMPARE(arm_->fault(), std::optional<ArmPart>(ArmPart::GearSpring));
+    QVERIFY(arm_->scene()->isHighlighted(ArmPart::GearSpring));
+    QVERIFY(!arm_->scene()->isHighlighted(ArmPart::ArmSpring));
+    QVERIFY(arm_->captionText().contains("Fault: k_a 30 % low (gear_spring in red)"));
+    arm_->clearExternalModel();
+    arm_->clearFault();
+    QCOMPARE(arm_->fault(), std::nullopt);
+    QVERIFY(!arm_->captionText().contains("Fault"));
   }
 
   void externalModelIsNamedOnTheView() {
