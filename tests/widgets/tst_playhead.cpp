@@ -167,6 +167,14 @@ class PlayheadTest : public QObject {
     QVERIFY(window_->logPanel()->playheadCursor()->isInView());
     QCOMPARE(window_->comparePanel()->playheadCursor()->shownTime(), 14.5);
     QVERIFY(window_->comparePanel()->playheadCursor()->isInView());
+    // Every time plot of the window (Log, Compare, the Model panel's simulation, Discovery's
+    // residuals and overlay) holds its cursor at the playhead.
+    const auto cursors = window_->findChildren<PlayheadCursor*>();
+    QVERIFY2(cursors.size() >= 5, qPrintable(QString::number(cursors.size())));
+    for (const PlayheadCursor* c : cursors) {
+      QCOMPARE(c->playhead(), p);
+      QCOMPARE(c->shownTime(), 14.5);
+    }
     QVERIFY2(window_->armPanel()->statusText().startsWith("t = 14.500 s"),
              qPrintable(window_->armPanel()->statusText()));
     QVERIFY(scene->drawnAngle(ArmPart::Arm) != axisBefore);
