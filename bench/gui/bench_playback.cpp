@@ -125,7 +125,7 @@ int main(int argc, char** argv) {
               masses.nsecsElapsed() * 1e-9, angles->seconds, uiTurns, w.width(), w.height(),
               w.armPanel()->view()->width(), w.armPanel()->view()->height());
 
-  if (!getenv("ONLY_ARM")) for (double speed : {1.0, 100.0}) {
+  for (double speed : {1.0, 100.0}) {
     const Played r = play(w, speed, seconds);
     std::printf("Playing at x%g for %d s: arm view %.1f frames/s (render %.2f ms mean, %.1f ms "
                 "worst; %.1f ms of CPU a frame), playhead %.1f ticks/s, %.2f s of log played\n",
@@ -156,7 +156,6 @@ int main(int argc, char** argv) {
                 what, 1e3 * s / frames, frames / s, 1e3 * cpu / frames,
                 static_cast<long long>(view->frameStats().frames));
   };
-  if (getenv("ONLY_ARM")) { for (int k=0;k<4;++k) driven("arm", [&](double t) { w.armPanel()->showTime(t); }); return 0; }
   driven("whole window", [&](double t) { p->setTime(t); });
   driven("Arm view alone", [&](double t) { w.armPanel()->showTime(t); });
   w.armPanel()->setPlayhead(nullptr);
