@@ -38,6 +38,9 @@ constexpr double kTraceSeconds = 1.0;
 // largest deflection at about that one (radians).
 constexpr double kMotionDrawn = 0.6, kDeflectionDrawn = 0.5;
 
+// A deflection in milliradians with four decimals, without the "-0.0000" of a tiny negative.
+QString mrad(double rad) { return QString::number(std::round(1e7 * rad) / 1e4 + 0.0, 'f', 4); }
+
 // The largest of 1, 2, 5 times a power of ten that is at most x, clamped to [lo, hi].
 int niceDown(double x, int lo, int hi) {
   if (!(x > 0) || !std::isfinite(x)) return lo;
@@ -424,11 +427,11 @@ void ArmPanel::showTime(double t) {
                  .arg(pose.motor, 0, 'g', 4)
                  .arg(1e3 * pose.arm, 0, 'g', 4);
     if (angles_ && angles_->springs >= 1)
-      status += tr("\nr phi_m - phi_g %1 mrad").arg(1e3 * pose.gearDeflection, 0, 'f', 4);
+      status += tr("\nr phi_m - phi_g %1 mrad").arg(mrad(pose.gearDeflection));
     if (angles_ && angles_->springs >= 2)
-      status += tr("   phi_g - phi_a %1 mrad").arg(1e3 * pose.armDeflection, 0, 'f', 4);
+      status += tr("   phi_g - phi_a %1 mrad").arg(mrad(pose.armDeflection));
     if (angles_ && angles_->springs >= 3)
-      status += tr("   phi_g - phi_p %1 mrad").arg(1e3 * pose.parallelDeflection, 0, 'f', 4);
+      status += tr("   phi_g - phi_p %1 mrad").arg(mrad(pose.parallelDeflection));
   }
   overlay_.status = status;
   view_->requestRender();

@@ -265,6 +265,7 @@ class ArmViewTest : public QObject {
     QVERIFY(arm_->scene()->isHighlighted(ArmPart::ArmSpring));
     QVERIFY(!arm_->scene()->isHighlighted(ArmPart::GearSpring));
     QVERIFY(arm_->captionText().contains("Fault: k_a 30 % low (arm_spring in red)"));
+    test::saveShot(picture(), "arm_fault_arm_spring");
     // The gear ratio is no part of the arm: nothing changes.
     QVERIFY(!arm_->showParameterFault("r", "r changed"));
     QCOMPARE(arm_->fault(), std::optional<ArmPart>(ArmPart::ArmSpring));

@@ -103,6 +103,8 @@ struct ArmScene::Cage {
   vtkSmartPointer<vtkPoints> points;
   vtkSmartPointer<vtkDoubleArray> scalars;
   vtkSmartPointer<vtkPolyData> lines;
+  vtkSmartPointer<vtkTubeFilter> tubes;
+  double radius = 0.0;  // of a bar's tube, m
   vtkSmartPointer<vtkActor> actor;
 };
 
@@ -309,12 +311,13 @@ void ArmScene::build() {
     c.lines->SetPoints(c.points);
     c.lines->SetLines(cells);
     c.lines->GetPointData()->SetScalars(c.scalars);
-    auto tubes = vtkSmartPointer<vtkTubeFilter>::New();
-    tubes->SetInputData(c.lines);
-    tubes->SetRadius(radial ? 0.007 : 0.009);
-    tubes->SetNumberOfSides(8);
+    c.radius = radial ? 0.007 : 0.009;
+    c.tubes = vtkSmartPointer<vtkTubeFilter>::New();
+    c.tubes->SetInputData(c.lines);
+    c.tubes->SetRadius(c.radius);
+    c.tubes->SetNumberOfSides(8);
     auto mapper = vtkSmartPointer<vtkPolyDataMapper>::New();
-    mapper->SetInputConnection(tubes->GetOutputPort());
+    mapper->SetInputConnection(c.tubes->GetOutputPort());
     mapper->SetLookupTable(lut_);
     mapper->UseLookupTableScalarRangeOn();
     c.actor = vtkSmartPointer<vtkActor>::New();
@@ -540,8 +543,9 @@ void ArmScene::applyColours() {
   }
   for (Cage& c : cages_) {
     const bool hot = isHighlighted(c.part);
-    // A highlighted spring is solid red and thicker-looking; otherwise coloured by the scale.
+    // A highlighted spring is solid red with bars twice as thick; otherwise coloured by the scale.
     c.actor->GetMapper()->SetScalarVisibility(!hot);
+    c.tubes->SetRadius(hot ? 2.0 * c.radius : c.radius);
     c.actor->GetProperty()->SetColor(kHighlight[0], kHighlight[1], kHighlight[2]);
   }
 }
