@@ -65,6 +65,9 @@ struct RecursiveEstimator::Impl {
   RecursiveStep step;
   Eigen::VectorXd psi, gain;
   std::size_t count = 0;
+  std::size_t heldRun = 0, heldTotal = 0;  // samples held at the bounds: in a row, in all
+  double heldSince = 0.0;
+  std::string firstHeld;
   bool good = true;
   std::string message;
   double lambda0 = 0.0;
@@ -214,6 +217,9 @@ struct RecursiveEstimator::Impl {
       xMinus[sj] = Eigen::VectorXd::Zero(n);
     }
     count = 0;
+    heldRun = heldTotal = 0;
+    heldSince = 0.0;
+    firstHeld.clear();
     good = true;
     message = "No sample processed yet.";
     lambda0 = options.noiseVariance;
@@ -272,14 +278,30 @@ struct RecursiveEstimator::Impl {
       }
       thetaNew = theta;
       if (options.updateParameters) thetaNew.noalias() += gain * eps;  // (6.15)/(6.20)
+      if (!thetaNew.allFinite()) {
+        stop("The estimate is no longer a finite number at t = " + formatNumber(t) + " s.");
+        return step;
+      }
+      step.held = false;
       const Eigen::Index bad = outOfBounds(thetaNew);
       if (bad >= 0) {
+        // Projection: the update is held back while it would leave the bounds.
         const RecursiveParameter& q = params[static_cast<std::size_t>(bad)];
-        std::string text = "The estimate of " + q.name + " left its bounds [" + formatNumber(q.lower) +
-                           ", " + formatNumber(q.upper) + "] at t = " + formatNumber(t) + " s";
-        if (std::isfinite(thetaNew[bad])) text += " (it would have become " + formatNumber(thetaNew[bad]) + ")";
-        stop(text + ".");
-        return step;
+        const std::string where = "the estimate of " + q.name + " would have left its bounds [" +
+                                  formatNumber(q.lower) + ", " + formatNumber(q.upper) + "]";
+        if (heldRun == 0) heldSince = t;
+        ++heldRun;
+        if (heldTotal++ == 0)
+          firstHeld = where + " at t = " + formatNumber(t) + " s (as " + formatNumber(thetaNew[bad]) + ")";
+        if (static_cast<double>(heldRun) * T > options.maxHeldSeconds) {
+          stop("The estimate left its bounds: from t = " + formatNumber(heldSince) + " s on, " +
+               where + " for " + std::to_string(heldRun) + " samples in a row.");
+          return step;
+        }
+        thetaNew = theta;
+        step.held = true;
+      } else {
+        heldRun = 0;
       }
       const std::string problem = covarianceProblem(Pnew, t);
       if (!problem.empty()) {
@@ -384,9 +406,15 @@ Termination RecursiveEstimator::termination() const {
   return impl_->good ? Termination::Converged : Termination::Diverged;
 }
 const std::string& RecursiveEstimator::message() const {
-  if (impl_->good && impl_->count > 0)
-    impl_->message = "Processed " + std::to_string(impl_->count) +
-                     " samples; the estimates stayed within their bounds.";
+  if (impl_->good && impl_->count > 0) {
+    impl_->message = "Processed " + std::to_string(impl_->count) + " samples; ";
+    if (impl_->heldTotal == 0)
+      impl_->message += "the estimates stayed within their bounds.";
+    else
+      impl_->message += "the update was held back at the bounds in " +
+                        std::to_string(impl_->heldTotal) + " of them (first: " +
+                        impl_->firstHeld + ").";
+  }
   return impl_->message;
 }
 void RecursiveEstimator::reset() { impl_->reset(); }

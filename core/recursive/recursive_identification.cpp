@@ -199,9 +199,9 @@ RecursiveResult recursiveIdentification(const ParametricModel& nominal, const Ei
                 " samples.";
   } else {
     r.termination = Termination::Converged;
+    std::string m = est.message();  // "Processed N samples; ..."
     r.message = "Processed all " + std::to_string(N) + " samples (" +
-                formatNumber(static_cast<double>(N) * T) +
-                " s); the estimates stayed within their bounds.";
+                formatNumber(static_cast<double>(N) * T) + " s)" + m.substr(m.find(';'));
   }
   r.seconds = elapsed();
   return r;

@@ -81,6 +81,10 @@ struct RecursiveOptions {
   bool updateParameters = true;
   // P is taken as blown up when a diagonal element exceeds this multiple of its P(0) value.
   double covarianceLimit = 1e8;
+  // An update that would take theta outside its bounds (the model's, e.g. f_m >= 0) is held
+  // back: theta(t) = theta(t-1), the projection of Ljung and Soederstroem. When it keeps
+  // pushing outside for this long (seconds), the estimate has left its bounds: Diverged.
+  double maxHeldSeconds = 1.0;
 
   bool isValid(std::string* why) const;
 };
@@ -115,6 +119,7 @@ struct RecursiveStep {
   Eigen::VectorXd psi;        // psi(t), the gradient of yhat(t) in theta
   Eigen::VectorXd gain;       // K(t) of (6.14)/(6.19)
   double noiseVariance = 0.0; // lambda_0 used for sigma
+  bool held = false;          // the update would have left the bounds and was held back
   bool ok = true;             // false once the estimate left its bounds or P blew up
 };
 
