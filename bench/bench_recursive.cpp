@@ -31,6 +31,7 @@
 #include "core/recursive/rpem.h"
 #include "core/signal/preprocess.h"
 #include "core/sim/closed_loop.h"
+#include "tests/core/recursive/recursive_helpers.h"
 
 using namespace flexarm;
 using Json = nlohmann::json;
@@ -64,19 +65,6 @@ double medianSeconds(int repeats, const std::function<void()>& work) {
   return t[t.size() / 2];
 }
 
-std::unique_ptr<PhysicalModel> p6() {
-  auto m = makeModel("three-mass");  // Table 5.7 p6
-  m->setParameter("J_m", 0.000456);
-  m->setParameter("J_g", 9.92);
-  m->setParameter("J_a", 1.72);
-  m->setParameter("f_m", 0.0355);
-  m->setParameter("k_g", 150000.0);
-  m->setParameter("k_a", 44600.0);
-  m->setParameter("d_g", -62.0);
-  m->setParameter("d_a", 20.0);
-  return m;
-}
-
 // Runs a command, returns its stdout; empty optional-like flag on failure.
 bool run(const std::string& command, std::string& out) {
   out.clear();
@@ -98,7 +86,7 @@ int main() {
   so.seed = 6;
   so.excitation.kind = ExcitationKind::Multisine;
   so.excitation.amplitude = 0.2;
-  const auto truth = p6();
+  const auto truth = testing::threeMassP6();
   const auto sim = simulateClosedLoop(*truth, {}, so);
   DecimateOptions dec;
   dec.factor = 10;
