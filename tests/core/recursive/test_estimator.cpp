@@ -235,3 +235,41 @@ TEST(RecursiveIdentification, ProgressCanCancel) {
 
 }  // namespace
 }  // namespace flexarm
+
+namespace flexarm {
+namespace {
+
+// With white output noise the assumptions of (7.8) hold: the +-3 sigma band holds the truth
+// and no caveat is printed; with coloured noise it does not, and the result says so.
+TEST(RecursiveSigma, HonestForWhiteErrorsAndFlaggedForColouredOnes) {
+  const auto m = testing::threeMassP6();
+  std::mt19937 rng(31);
+  const Eigen::Index n = 8000;
+  const Eigen::VectorXd u = testing::gaussian(n, 0.1, rng);
+  const Eigen::VectorXd clean = simulate(*m, u, kTs);
+  const double level = std::sqrt(clean.squaredNorm() / static_cast<double>(n));
+  const Eigen::VectorXd white = testing::gaussian(n, 0.05 * level, rng);
+  RecursiveOptions o;
+  const RecursiveResult r = recursiveIdentification(*m, u, clean + white, kTs, o);
+  ASSERT_EQ(r.termination, Termination::Converged) << r.message;
+  EXPECT_TRUE(r.caveat.empty()) << r.caveat;
+  const auto& t = r.trajectory;
+  std::size_t misses = 0, count = 0;
+  for (std::size_t i = 0; i < 3; ++i)
+    for (std::size_t k = t.size() / 4; k < t.size(); ++k, ++count)
+      if (std::abs(t.theta[i][k] - r.estimates[i].parameter.nominal) > 3.0 * t.sigma[i][k]) ++misses;
+  EXPECT_LT(static_cast<double>(misses) / static_cast<double>(count), 0.01);
+  for (const auto& e : r.estimates) EXPECT_LT(e.spread, e.meanSigma) << e.parameter.name;
+
+  // The same noise through a slow filter: strongly coloured errors.
+  Eigen::VectorXd coloured(n);
+  double state = 0.0;
+  for (Eigen::Index k = 0; k < n; ++k) coloured[k] = state = 0.98 * state + white[k];
+  const RecursiveResult c = recursiveIdentification(*m, u, clean + coloured, kTs, o);
+  ASSERT_EQ(c.termination, Termination::Converged) << c.message;
+  EXPECT_GT(c.epsilonLag1, 0.9);
+  EXPECT_NE(c.caveat.find("coloured"), std::string::npos) << c.caveat;
+}
+
+}  // namespace
+}  // namespace flexarm
