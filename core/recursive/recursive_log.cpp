@@ -28,6 +28,17 @@ int recursiveDecimation(int decimation, double sampleRateHz) {
 PreparedData prepareRecursiveData(const IdData& log, const RecursiveDataOptions& options) {
   std::string why;
   if (!options.isValid(&why)) throw std::invalid_argument("recursive identification: " + why);
+  // Only the input and the output go through the preparation (the reference and any other
+  // channel would be decimated for nothing).
+  IdData used;
+  used.sampleTime = log.sampleTime;
+  used.startTime = log.startTime;
+  used.metadata = log.metadata;
+  for (const Channel& c : log.channels) {
+    const bool wanted = options.input.empty() ? c.role == ChannelRole::Input : c.name == options.input;
+    const bool output = options.output.empty() ? c.role == ChannelRole::Output : c.name == options.output;
+    if (wanted || output) used.channels.push_back(c);
+  }
   FitDataOptions f;
   f.input = options.input;
   f.output = options.output;
@@ -35,7 +46,7 @@ PreparedData prepareRecursiveData(const IdData& log, const RecursiveDataOptions&
   f.decimation = recursiveDecimation(options.decimation, log.sampleRateHz());
   f.estimation = options.range;
   f.removeMeans = true;
-  return prepareFitData(log, f);
+  return prepareFitData(used, f);
 }
 
 RecursiveLogResult recursiveIdentification(const IdData& log, const ParametricModel& nominal,
