@@ -117,21 +117,6 @@ void perSample() {
   }
 }
 
-// Runs a command; its standard output (empty on failure).
-std::string capture(const std::string& command, bool* ok) {
-  std::string out;
-  FILE* p = popen(command.c_str(), "r");
-  if (!p) {
-    *ok = false;
-    return out;
-  }
-  char buf[65536];
-  std::size_t got;
-  while ((got = std::fread(buf, 1, sizeof buf, p)) > 0) out.append(buf, got);
-  *ok = pclose(p) == 0;
-  return out;
-}
-
 // The whole process, from reading the log to the JSON, against the log's duration.
 void wholeProcess(const std::string& log, const std::string& size) {
   const LogReadResult read = readLog(log);
