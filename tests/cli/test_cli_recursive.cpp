@@ -116,8 +116,8 @@ TEST(CliRecursive, UsageAndBadInputExitCodes) {
   EXPECT_NE(r.err.find("holds no samples"), std::string::npos) << r.err;
 }
 
-// The difference gradient of (6.33) on the same experiment: the estimate leaves its bounds
-// (Example 6.1's failure), exit 4 with the time in the message and the trajectory up to there.
+// The difference gradient of (6.33) on the same experiment diverges (Example 6.1: it misses the
+// output-error recursion): exit 4 with the time in the message and the trajectory up to there.
 TEST(CliRecursive, TheDifferenceGradientDivergesWithExitFour) {
   const auto dir = scratchDir();
   const std::string csv = (dir / "difference.csv").string();
