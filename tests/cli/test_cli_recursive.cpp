@@ -163,9 +163,8 @@ TEST(CliRecursive, FlexarmRunReplaysASessionsRecursiveRun) {
   const std::string pdf = (dir / "recursive.pdf").string();
   const auto p = runFlexarm({"run", path, "--report", pdf});
   ASSERT_EQ(p.code, 0) << p.err;
-  const std::string txt = pdf + ".txt";
-  ASSERT_EQ(std::system(("pdftotext -layout '" + pdf + "' '" + txt + "'").c_str()), 0);
-  const std::string text = readAll(txt);
+  const std::string text = pdfText(pdf);
+  ASSERT_FALSE(text.empty()) << "pdftotext could not read " << pdf;
   EXPECT_NE(text.find("Recursive identification: seed"), std::string::npos);
   EXPECT_NE(text.find("Estimates at the end"), std::string::npos);
   EXPECT_NE(text.find("J_a^-1 (theta)"), std::string::npos);
