@@ -174,6 +174,11 @@ RecursivePanel::RecursivePanel(Workspace* workspace, QWidget* parent)
   connect(play_, &QPushButton::clicked, this, &RecursivePanel::play);
   connect(again_, &QPushButton::clicked, this, &RecursivePanel::runAgain);
   connect(cancel_, &QPushButton::clicked, this, &RecursivePanel::cancel);
+  // Showing or hiding the previous run redraws the plots as far as the playhead.
+  connect(overlay_, &QCheckBox::toggled, this, [this] {
+    buildPlot();
+    if (current_) showUpTo(playhead_ ? playhead_->time() : current_->end);
+  });
   connect(model_, &QComboBox::currentIndexChanged, this, &RecursivePanel::refillParameters);
   auto algorithmChanged = [this] {
     const bool kalman = algorithm_->currentData().toString() == "kalman";

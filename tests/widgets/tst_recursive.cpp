@@ -168,6 +168,12 @@ class RecursivePanelTest : public QObject {
     QCOMPARE(panel_->previousRun()->request.options.lambda, 0.995);
     QCOMPARE(panel_->currentRun()->request.options.lambda, 0.98);
     QCOMPARE(panel_->plot()->graph(3)->dataCount(), 4800);  // k_T of the previous run, dashed
+    // Unticking the overlay hides it (and the legend's entry); the current run stays drawn.
+    panel_->overlayBox()->setChecked(false);
+    QCOMPARE(panel_->plot()->graph(3)->dataCount(), 0);
+    QCOMPARE(panel_->plot()->graph(2)->dataCount(), 4800);
+    panel_->overlayBox()->setChecked(true);
+    QCOMPARE(panel_->plot()->graph(3)->dataCount(), 4800);
     // The session keeps both runs with their results; a new window opened on it gets the
     // controls of the last one.
     const nlohmann::json section = capture("recursive", *window_);
