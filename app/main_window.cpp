@@ -41,6 +41,7 @@
 #include "widgets/model_panel.h"
 #include "widgets/playhead.h"
 #include "widgets/preprocess_panel.h"
+#include "widgets/recursive_panel.h"
 #include "widgets/residuals_panel.h"
 #include "widgets/transport_bar.h"
 #include "widgets/workspace.h"
@@ -132,6 +133,8 @@ MainWindow::MainWindow(QWidget* parent)
   lqgDock_ = addPanel(lqgPanel_ = new LqgPanel(workspace_, this), tr("LQG"), "lqgDock",
                       "Ctrl+Shift+L", preprocessDock_);
   discoveryDock_ = addPanel(discoveryPanel_ = new DiscoveryPanel(workspace_, this), tr("Discovery"), "discoveryDock", "Ctrl+Shift+D", preprocessDock_);
+  recursiveDock_ = addPanel(recursivePanel_ = new RecursivePanel(workspace_, this), tr("Recursive"),
+                            "recursiveDock", "Ctrl+Shift+I", preprocessDock_);
   preprocessDock_->raise();
   // The playhead spans the log as read (preprocessing keeps its times); every panel that
   // shows time follows it.
@@ -147,6 +150,7 @@ MainWindow::MainWindow(QWidget* parent)
   comparePanel_->setPlayhead(playhead_);
   modelPanel_->setPlayhead(playhead_);
   discoveryPanel_->setPlayhead(playhead_);
+  recursivePanel_->setPlayhead(playhead_);
   transportBar_ = new TransportBar(playhead_, this);
   auto* transport = new QToolBar(tr("Playhead"), this);
   transport->setObjectName("transportToolBar");
