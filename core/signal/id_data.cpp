@@ -137,6 +137,12 @@ IdData IdData::select(SampleRange r) const {
   };
   out.estimationRange = shift(estimationRange);
   out.validationRange = shift(validationRange);
+  auto slice = [&](const auto& v, auto& into) {
+    if (v.size() == samples())
+      into.assign(v.begin() + static_cast<std::ptrdiff_t>(r.begin), v.begin() + static_cast<std::ptrdiff_t>(r.end));
+  };
+  slice(timeStamps, out.timeStamps);
+  slice(sourceLines, out.sourceLines);
   return out;
 }
 
@@ -148,12 +154,23 @@ bool IdData::isValid(std::string* why) const {
   if (!(sampleTime > 0.0) || !std::isfinite(sampleTime))
     return fail("the sample time must be positive and finite");
   const std::size_t n = samples();
+  if (!timeStamps.empty()) {
+    if (timeStamps.size() != n)
+      return fail("there are " + std::to_string(timeStamps.size()) + " time stamps for " +
+                  std::to_string(n) + " samples");
+    for (std::size_t i = 0; i < n; ++i)
+      if (!std::isfinite(timeStamps[i]))
+        return fail("the time stamp of sample " + std::to_string(i) + " is not finite");
+  }
+  if (!sourceLines.empty() && sourceLines.size() != n)
+    return fail("there are " + std::to_string(sourceLines.size()) + " source lines for " +
+                std::to_string(n) + " samples");
   for (const auto& c : channels) {
     if (c.values.size() != n)
       return fail("channel '" + c.name + "' has " + std::to_string(c.values.size()) +
                   " samples, expected " + std::to_string(n));
     for (std::size_t i = 0; i < n; ++i)
-      if (!std::isfinite(c.values[i]))
+      if (!std::isfinite(c.values[i]) && !(std::isnan(c.values[i]) && !timeStamps.empty()))
         return fail("channel '" + c.name + "' has a non-finite value at sample " +
                     std::to_string(i));
   }
