@@ -90,6 +90,9 @@ class IdData {
 
   // The samples whose time lies in [t0, t1], clipped to the data.
   SampleRange rangeForTimes(double t0, double t1) const;
+  // The sample nearest to time t (the first at or after t among time stamps, which are
+  // searched as if sorted); 0 for empty data.
+  std::size_t indexNear(double t) const;
   // A copy holding only the samples in r; ranges are shifted and clipped to it.
   IdData select(SampleRange r) const;
 

@@ -235,7 +235,11 @@ PreprocessResult runPreprocess(const IdData& data, const PreprocessOptions& opti
     std::vector<const IdData*> logs{&data};
     logs.insert(logs.end(), otherLogs.begin(), otherLogs.end());
     UniformGridResult u = resampleToUniform(logs, *options.resample, progress);
-    if (u.termination != Termination::Converged) return finish(u.termination, u.message);
+    if (u.termination != Termination::Converged) {
+      std::string message = u.message;
+      r.resampling = std::move(u);  // its time-stamp report shows where the problem is
+      return finish(r.resampling->termination, message);
+    }
     d = std::move(u.data);
     u.data = IdData{};
     r.resampling = std::move(u);

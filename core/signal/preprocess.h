@@ -75,7 +75,8 @@ struct PreprocessResult {
   std::string message;  // why it failed, or what resampling did (empty without it)
   double seconds = 0.0;
   IdData data;
-  // The resampling step's report (its data moved into `data`), when it ran.
+  // The resampling step's report (its data moved into `data`), when it ran, also when it
+  // failed (e.g. the time-stamp report of a log with a gap above the limit).
   std::optional<UniformGridResult> resampling;
 };
 

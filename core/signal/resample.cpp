@@ -38,8 +38,8 @@ double dot1Portable(const double* g, long len, const double* x) {
   return acc;
 }
 
-// out[t] = sum_j g[j] x[t stride + j], t = 0..3.
-void dot4Portable(const double* g, long len, const double* x, long stride, double* out) {
+// out[t os] = sum_j g[j] x[t stride + j], t = 0..3.
+void dot4Portable(const double* g, long len, const double* x, long stride, double* out, long os) {
   const double *x0 = x, *x1 = x + stride, *x2 = x + 2 * stride, *x3 = x + 3 * stride;
   double a0 = 0.0, a1 = 0.0, a2 = 0.0, a3 = 0.0;
   for (long j = 0; j < len; ++j) {
@@ -50,40 +50,49 @@ void dot4Portable(const double* g, long len, const double* x, long stride, doubl
     a3 += h * x3[j];
   }
   out[0] = a0;
-  out[1] = a1;
-  out[2] = a2;
-  out[3] = a3;
+  out[os] = a1;
+  out[2 * os] = a2;
+  out[3 * os] = a3;
 }
 
 #ifdef FLEXARM_AVX2_KERNELS
-__attribute__((target("avx2,fma"))) inline double horizontalSum(__m256d v) {
-  __m128d s = _mm_add_pd(_mm256_castpd256_pd128(v), _mm256_extractf128_pd(v, 1));
-  return _mm_cvtsd_f64(_mm_add_sd(s, _mm_unpackhi_pd(s, s)));
-}
-
-// One lane of dot4Avx2 (the same sums in the same order), so that an output does not depend
-// on whether it was computed alone or in a group of four.
+// The AVX2 kernels need the tap count to be a multiple of 8 (the plan pads the phases with
+// zeros). Each output sums two interleaved halves of its taps lane by lane and then adds the
+// lanes as (0 + 1) + (2 + 3); dot1Avx2 is one lane of dot4Avx2, the same sums in the same
+// order, so that an output does not depend on whether it was computed alone or in a group.
 __attribute__((target("avx2,fma"))) double dot1Avx2(const double* g, long len, const double* x) {
   __m256d a = _mm256_setzero_pd(), b = _mm256_setzero_pd();
-  long j = 0;
-  for (; j + 8 <= len; j += 8) {
+  for (long j = 0; j < len; j += 8) {
     a = _mm256_fmadd_pd(_mm256_loadu_pd(g + j), _mm256_loadu_pd(x + j), a);
     b = _mm256_fmadd_pd(_mm256_loadu_pd(g + j + 4), _mm256_loadu_pd(x + j + 4), b);
   }
-  for (; j + 4 <= len; j += 4) a = _mm256_fmadd_pd(_mm256_loadu_pd(g + j), _mm256_loadu_pd(x + j), a);
-  double acc = horizontalSum(_mm256_add_pd(a, b));
-  for (; j < len; ++j) acc += g[j] * x[j];
-  return acc;
+  alignas(32) double lanes[4];
+  _mm256_store_pd(lanes, _mm256_add_pd(a, b));
+  return (lanes[0] + lanes[1]) + (lanes[2] + lanes[3]);
 }
 
+// Stores the four sums to out[t os] (straight from the registers: reading them back from a
+// vector store would stall).
+__attribute__((target("avx2,fma"))) inline void store4(__m256d sum, double* out, long os) {
+  if (os == 1) {
+    _mm256_storeu_pd(out, sum);
+    return;
+  }
+  const __m128d lo = _mm256_castpd256_pd128(sum), hi = _mm256_extractf128_pd(sum, 1);
+  _mm_storel_pd(out, lo);
+  _mm_storeh_pd(out + os, lo);
+  _mm_storel_pd(out + 2 * os, hi);
+  _mm_storeh_pd(out + 3 * os, hi);
+}
+
+// out[t os] = sum_j g[j] x[t stride + j], t = 0..3.
 __attribute__((target("avx2,fma"))) void dot4Avx2(const double* g, long len, const double* x,
-                                                   long stride, double* out) {
+                                                   long stride, double* out, long os) {
   const double *x0 = x, *x1 = x + stride, *x2 = x + 2 * stride, *x3 = x + 3 * stride;
   __m256d a0 = _mm256_setzero_pd(), a1 = _mm256_setzero_pd(), a2 = _mm256_setzero_pd(),
           a3 = _mm256_setzero_pd(), b0 = _mm256_setzero_pd(), b1 = _mm256_setzero_pd(),
           b2 = _mm256_setzero_pd(), b3 = _mm256_setzero_pd();
-  long j = 0;
-  for (; j + 8 <= len; j += 8) {
+  for (long j = 0; j < len; j += 8) {
     const __m256d h = _mm256_loadu_pd(g + j), k = _mm256_loadu_pd(g + j + 4);
     a0 = _mm256_fmadd_pd(h, _mm256_loadu_pd(x0 + j), a0);
     a1 = _mm256_fmadd_pd(h, _mm256_loadu_pd(x1 + j), a1);
@@ -94,29 +103,53 @@ __attribute__((target("avx2,fma"))) void dot4Avx2(const double* g, long len, con
     b2 = _mm256_fmadd_pd(k, _mm256_loadu_pd(x2 + j + 4), b2);
     b3 = _mm256_fmadd_pd(k, _mm256_loadu_pd(x3 + j + 4), b3);
   }
-  for (; j + 4 <= len; j += 4) {
-    const __m256d h = _mm256_loadu_pd(g + j);
-    a0 = _mm256_fmadd_pd(h, _mm256_loadu_pd(x0 + j), a0);
-    a1 = _mm256_fmadd_pd(h, _mm256_loadu_pd(x1 + j), a1);
-    a2 = _mm256_fmadd_pd(h, _mm256_loadu_pd(x2 + j), a2);
-    a3 = _mm256_fmadd_pd(h, _mm256_loadu_pd(x3 + j), a3);
+  a0 = _mm256_add_pd(a0, b0);
+  a1 = _mm256_add_pd(a1, b1);
+  a2 = _mm256_add_pd(a2, b2);
+  a3 = _mm256_add_pd(a3, b3);
+  // Four lane sums at once: hadd gives (0 + 1) and (2 + 3) of two outputs side by side.
+  const __m256d s01 = _mm256_hadd_pd(a0, a1), s23 = _mm256_hadd_pd(a2, a3);
+  store4(_mm256_add_pd(_mm256_permute2f128_pd(s01, s23, 0x20), _mm256_permute2f128_pd(s01, s23, 0x31)), out, os);
+}
+
+// dot4Avx2 for stride 4 (e.g. 2000 -> 1500 Hz): window t at taps j..j+3 is window t + 1 at
+// taps j - 4..j - 1, so each input vector is loaded once and passed on; the same sums in
+// the same order as dot4Avx2.
+__attribute__((target("avx2,fma"))) void dot4Stride4Avx2(const double* g, long len, const double* x, double* out,
+                                                          long os) {
+  __m256d a0 = _mm256_setzero_pd(), a1 = _mm256_setzero_pd(), a2 = _mm256_setzero_pd(),
+          a3 = _mm256_setzero_pd(), b0 = _mm256_setzero_pd(), b1 = _mm256_setzero_pd(),
+          b2 = _mm256_setzero_pd(), b3 = _mm256_setzero_pd();
+  __m256d v0 = _mm256_loadu_pd(x), v1 = _mm256_loadu_pd(x + 4), v2 = _mm256_loadu_pd(x + 8);
+  for (long j = 0; j < len; j += 8) {
+    const __m256d h = _mm256_loadu_pd(g + j), k = _mm256_loadu_pd(g + j + 4);
+    const __m256d v3 = _mm256_loadu_pd(x + j + 12), v4 = _mm256_loadu_pd(x + j + 16);
+    a0 = _mm256_fmadd_pd(h, v0, a0);
+    a1 = _mm256_fmadd_pd(h, v1, a1);
+    a2 = _mm256_fmadd_pd(h, v2, a2);
+    a3 = _mm256_fmadd_pd(h, v3, a3);
+    b0 = _mm256_fmadd_pd(k, v1, b0);
+    b1 = _mm256_fmadd_pd(k, v2, b1);
+    b2 = _mm256_fmadd_pd(k, v3, b2);
+    b3 = _mm256_fmadd_pd(k, v4, b3);
+    v0 = v2;
+    v1 = v3;
+    v2 = v4;
   }
-  out[0] = horizontalSum(_mm256_add_pd(a0, b0));
-  out[1] = horizontalSum(_mm256_add_pd(a1, b1));
-  out[2] = horizontalSum(_mm256_add_pd(a2, b2));
-  out[3] = horizontalSum(_mm256_add_pd(a3, b3));
-  for (; j < len; ++j) {
-    out[0] += g[j] * x0[j];
-    out[1] += g[j] * x1[j];
-    out[2] += g[j] * x2[j];
-    out[3] += g[j] * x3[j];
-  }
+  a0 = _mm256_add_pd(a0, b0);
+  a1 = _mm256_add_pd(a1, b1);
+  a2 = _mm256_add_pd(a2, b2);
+  a3 = _mm256_add_pd(a3, b3);
+  const __m256d s01 = _mm256_hadd_pd(a0, a1), s23 = _mm256_hadd_pd(a2, a3);
+  store4(_mm256_add_pd(_mm256_permute2f128_pd(s01, s23, 0x20), _mm256_permute2f128_pd(s01, s23, 0x31)), out, os);
 }
 #endif
 
 struct Kernels {
   double (*dot1)(const double*, long, const double*) = dot1Portable;
-  void (*dot4)(const double*, long, const double*, long, double*) = dot4Portable;
+  void (*dot4)(const double*, long, const double*, long, double*, long) = dot4Portable;
+  long tapMultiple = 1;  // the phases' tap counts are padded with zeros to a multiple of this
+  void (*dot4Stride4)(const double*, long, const double*, double*, long) = nullptr;  // when available
 };
 
 const Kernels& kernels() {
@@ -127,6 +160,8 @@ const Kernels& kernels() {
     if (__builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma")) {
       s.dot1 = dot1Avx2;
       s.dot4 = dot4Avx2;
+      s.tapMultiple = 8;
+      s.dot4Stride4 = dot4Stride4Avx2;
     }
 #endif
     return s;
@@ -181,6 +216,9 @@ FirPlan makeFirPlan(const ResampleOptions& o) {
     double sum = 0.0;
     for (double v : ph.taps) sum += v;
     for (double& v : ph.taps) v /= sum;
+    // Zero taps at the end leave every sum as it is and let the kernels skip their tails.
+    const long multiple = kernels().tapMultiple;
+    while (static_cast<long>(ph.taps.size()) % multiple) ph.taps.push_back(0.0);
   }
   return plan;
 }
@@ -215,12 +253,47 @@ void runJobs(std::size_t count, int threads, const Job& job) {
   for (auto& th : pool) th.join();
 }
 
+// Outputs [kb, ke) of one channel, phase by phase (see firBlock).
+template <class Edge>
+void firStretch(const FirPlan& plan, const std::vector<double>& x, std::size_t kb, std::size_t ke, double* y,
+                const Edge& edge) {
+  const Kernels& k = kernels();
+  const long n = static_cast<long>(x.size());
+  const std::uint64_t L = static_cast<std::uint64_t>(plan.up), M = static_cast<std::uint64_t>(plan.down);
+  const std::size_t up = static_cast<std::size_t>(plan.up);
+  const long stride = static_cast<long>(M);
+  const std::size_t classes = std::min<std::size_t>(up, ke - kb);
+  for (std::size_t s = 0; s < classes; ++s) {
+    const std::size_t k0 = kb + s;
+    const std::uint64_t pos = static_cast<std::uint64_t>(k0) * M;
+    const Phase& ph = plan.phases[static_cast<std::size_t>(pos % L)];
+    const double* taps = ph.taps.data();
+    const long len = static_cast<long>(ph.taps.size());
+    const long first = plan.whole + static_cast<long>(pos / L) + ph.start;  // window of output k0
+    const long count = static_cast<long>((ke - k0 + up - 1) / up);          // outputs of this phase
+    double* out = y + s;
+    // Groups of four whose windows all lie inside the input: [g0, g1).
+    const long g0 = first >= 0 ? 0 : (-first + 4 * stride - 1) / (4 * stride);
+    const long room = n - len - 3 * stride - first;  // base + 3 stride + len <= n
+    const long g1 = std::min(count / 4, room < 0 ? 0 : room / (4 * stride) + 1);
+    long t = 0;
+    for (; t < std::min(4 * g0, count); ++t) out[static_cast<std::size_t>(t) * up] = edge(ph, first + t * stride);
+    const double* xp = x.data() + first + t * stride;
+    const long os = static_cast<long>(up);
+    if (stride == 4 && k.dot4Stride4) {
+      for (; t < 4 * g1; t += 4, xp += 16) k.dot4Stride4(taps, len, xp, out + static_cast<std::size_t>(t) * up, os);
+    } else {
+      for (; t < 4 * g1; t += 4, xp += 4 * stride) k.dot4(taps, len, xp, stride, out + static_cast<std::size_t>(t) * up, os);
+    }
+    for (; t < count; ++t) out[static_cast<std::size_t>(t) * up] = edge(ph, first + t * stride);
+  }
+}
+
 // Outputs [kb, ke) of one channel through the polyphase FIR.
 void firBlock(const FirPlan& plan, const std::vector<double>& x, std::size_t kb, std::size_t ke,
               double* y) {
   const Kernels& k = kernels();
   const long n = static_cast<long>(x.size());
-  const std::uint64_t L = static_cast<std::uint64_t>(plan.up), M = static_cast<std::uint64_t>(plan.down);
   std::vector<double> scratch;
   // One output whose window may reach past the ends: gather the extended input first.
   auto edge = [&](const Phase& ph, long base) {
@@ -230,26 +303,13 @@ void firBlock(const FirPlan& plan, const std::vector<double>& x, std::size_t kb,
     for (long j = 0; j < len; ++j) scratch[static_cast<std::size_t>(j)] = extended(x, base + j);
     return dot1Portable(ph.taps.data(), len, scratch.data());
   };
-  // Outputs k, k + up, k + 2 up, ... share a phase and lie `down` input samples apart.
-  const std::size_t classes = std::min<std::size_t>(plan.up, ke - kb);
-  for (std::size_t s = 0; s < classes; ++s) {
-    const std::size_t k0 = kb + s;
-    const std::uint64_t pos = static_cast<std::uint64_t>(k0) * M;
-    const Phase& ph = plan.phases[static_cast<std::size_t>(pos % L)];
-    const long len = static_cast<long>(ph.taps.size());
-    long base = plan.whole + static_cast<long>(pos / L) + ph.start;
-    const long stride = static_cast<long>(M);
-    std::size_t kk = k0;
-    for (; kk + 3 * plan.up < ke; kk += 4 * static_cast<std::size_t>(plan.up), base += 4 * stride) {
-      if (base >= 0 && base + 3 * stride + len <= n) {
-        double out[4];
-        k.dot4(ph.taps.data(), len, x.data() + base, stride, out);
-        for (int t = 0; t < 4; ++t) y[kk + static_cast<std::size_t>(t) * plan.up - kb] = out[t];
-      } else {
-        for (int t = 0; t < 4; ++t) y[kk + static_cast<std::size_t>(t) * plan.up - kb] = edge(ph, base + t * stride);
-      }
-    }
-    for (; kk < ke; kk += static_cast<std::size_t>(plan.up), base += stride) y[kk - kb] = edge(ph, base);
+  // Outputs k, k + up, k + 2 up, ... share a phase and lie `down` input samples apart. The
+  // phases take turns over short stretches of output, so that the input they share is read
+  // from the cache rather than from memory once per phase.
+  const std::size_t stretch = 256 * static_cast<std::size_t>(plan.up);
+  for (std::size_t sb = kb; sb < ke; sb += stretch) {
+    const std::size_t se = std::min(ke, sb + stretch);
+    firStretch(plan, x, sb, se, y + (sb - kb), edge);
   }
 }
 

@@ -19,23 +19,21 @@ std::string plural(std::size_t n, const char* one, const char* many) {
   return std::to_string(n) + " " + (n == 1 ? one : many);
 }
 
-// Slope b of t = a + b s by least squares over the samples listed (centred sums).
+// Slope b of t = a + b s, robustly: the median of the slopes between the samples half the log
+// apart (long baselines for precision, the median against jittered samples).
 double fitSlope(const std::vector<double>& t, const std::vector<long>& s, const std::vector<std::size_t>& use,
                 double b) {
-  double sm = 0.0, tm = 0.0;
-  for (std::size_t i : use) {
-    sm += static_cast<double>(s[i]);
-    tm += t[i];
+  const std::size_t half = use.size() / 2;
+  std::vector<double> slopes;
+  slopes.reserve(use.size() - half);
+  for (std::size_t q = 0; q + half < use.size(); ++q) {
+    const std::size_t i = use[q], k = use[q + half];
+    if (s[k] > s[i]) slopes.push_back((t[k] - t[i]) / static_cast<double>(s[k] - s[i]));
   }
-  sm /= static_cast<double>(use.size());
-  tm /= static_cast<double>(use.size());
-  double sst = 0.0, sss = 0.0;
-  for (std::size_t i : use) {
-    const double ds = static_cast<double>(s[i]) - sm;
-    sst += ds * (t[i] - tm);
-    sss += ds * ds;
-  }
-  return sss > 0.0 ? sst / sss : b;
+  if (slopes.empty()) return b;
+  auto mid = slopes.begin() + static_cast<std::ptrdiff_t>(slopes.size() / 2);
+  std::nth_element(slopes.begin(), mid, slopes.end());
+  return *mid;
 }
 
 // Grid start a for the interval b: the median of t - b s, so that the samples on the grid

@@ -111,7 +111,7 @@ UniformGridResult resampleToUniform(const std::vector<const IdData*>& logs, cons
     res.termination = t;
     res.message = std::move(message);
     res.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - clockStart).count();
-    return res;
+    return std::move(res);
   };
   auto cancelled = [&](double fraction, const char* stage) { return reportProgress(progress, fraction, stage); };
 
@@ -165,7 +165,8 @@ UniformGridResult resampleToUniform(const std::vector<const IdData*>& logs, cons
       ChannelGroup g;
       g.log = l;
       for (std::size_t c : members[m]) g.channels.push_back(d.channels[c].name);
-      const std::string names = joined(g.channels);
+      // Named in messages only when the log's channels have different instants.
+      const std::string names = masks.size() > 1 ? joined(g.channels) + ": " : std::string();
       std::vector<std::size_t> rows;
       std::vector<double> t;
       std::vector<int> lines;
@@ -175,21 +176,22 @@ UniformGridResult resampleToUniform(const std::vector<const IdData*>& logs, cons
           t.push_back(d.timeStamps[i]);
           if (d.sourceLines.size() == d.samples()) lines.push_back(d.sourceLines[i]);
         }
-      if (rows.size() < 2) return finish(Termination::Failed, which + names + ": fewer than two samples");
+      if (rows.size() < 2) return finish(Termination::Failed, which + names + "fewer than two samples");
       TimingOptions to;
       to.jitterTolerance = o.jitterTolerance;
       to.declaredRateHz = declaredRate(d);
       g.timing = analyzeTiming(t, lines, to);
       if (!(g.timing.interval > 0.0))
-        return finish(Termination::Failed, which + names + ": every sample has the same time stamp");
+        return finish(Termination::Failed, which + names + "every sample has the same time stamp");
       const double limit = o.maxGapSeconds > 0.0 ? o.maxGapSeconds : 10.0 * g.timing.interval;
       if (g.timing.longestGap > limit) {
         std::string place = format("%.6g s", g.timing.longestGapTime);
         for (const auto& e : g.timing.events)
           if (e.kind == TimingEventKind::Gap && e.size == g.timing.longestGap && e.line > 0)
             place += ", line " + std::to_string(e.line);
+        res.groups.push_back(g);  // the report shows where the gap is
         return finish(Termination::Failed,
-                      which + names + ": the gap of " + durationText(g.timing.longestGap) +
+                      which + names + "the gap of " + durationText(g.timing.longestGap) +
                           " before the sample at " + place + " is longer than the limit of " +
                           durationText(limit) + " for bridging gaps; raise the limit or cut the log there");
       }
@@ -323,8 +325,9 @@ UniformGridResult resampleToUniform(const std::vector<const IdData*>& logs, cons
     if (!g.irregular) continue;
     msg += "; time stamps";
     if (res.groups.size() > 1) msg += " of " + joined(g.channels);
-    msg += ": " + g.timing.summary() + "; " + std::to_string(g.fill.filled) + " grid points filled and " +
-           std::to_string(g.fill.retimed) + " samples retimed (" + toString(o.method) + ")";
+    msg += ": " + g.timing.summary() + "; " + std::to_string(g.fill.filled) +
+           (g.fill.filled == 1 ? " grid point" : " grid points") + " filled and " + std::to_string(g.fill.retimed) +
+           (g.fill.retimed == 1 ? " sample" : " samples") + " retimed (" + toString(o.method) + ")";
     if (g.fill.pchipFallback) msg += ", " + std::to_string(g.fill.pchipFallback) + " points of long gaps by PCHIP";
   }
   if (res.filled) msg += "; longest gap bridged " + durationText(res.longestGapBridged) + " at " + format("%.6g s", res.longestGapTime);
