@@ -85,6 +85,16 @@ __attribute__((target("avx2,fma"))) inline void store4(__m256d sum, double* out,
   _mm_storeh_pd(out + 3 * os, hi);
 }
 
+// Output t is the sum of the lanes of a_t + b_t, as (0 + 1) + (2 + 3); hadd gives those pairs
+// of two outputs side by side, so the four sums come at once.
+__attribute__((target("avx2,fma"))) inline void finish4(__m256d a0, __m256d b0, __m256d a1, __m256d b1,
+                                                        __m256d a2, __m256d b2, __m256d a3, __m256d b3,
+                                                        double* out, long os) {
+  const __m256d s01 = _mm256_hadd_pd(_mm256_add_pd(a0, b0), _mm256_add_pd(a1, b1));
+  const __m256d s23 = _mm256_hadd_pd(_mm256_add_pd(a2, b2), _mm256_add_pd(a3, b3));
+  store4(_mm256_add_pd(_mm256_permute2f128_pd(s01, s23, 0x20), _mm256_permute2f128_pd(s01, s23, 0x31)), out, os);
+}
+
 // out[t os] = sum_j g[j] x[t stride + j], t = 0..3.
 __attribute__((target("avx2,fma"))) void dot4Avx2(const double* g, long len, const double* x,
                                                    long stride, double* out, long os) {
@@ -103,13 +113,7 @@ __attribute__((target("avx2,fma"))) void dot4Avx2(const double* g, long len, con
     b2 = _mm256_fmadd_pd(k, _mm256_loadu_pd(x2 + j + 4), b2);
     b3 = _mm256_fmadd_pd(k, _mm256_loadu_pd(x3 + j + 4), b3);
   }
-  a0 = _mm256_add_pd(a0, b0);
-  a1 = _mm256_add_pd(a1, b1);
-  a2 = _mm256_add_pd(a2, b2);
-  a3 = _mm256_add_pd(a3, b3);
-  // Four lane sums at once: hadd gives (0 + 1) and (2 + 3) of two outputs side by side.
-  const __m256d s01 = _mm256_hadd_pd(a0, a1), s23 = _mm256_hadd_pd(a2, a3);
-  store4(_mm256_add_pd(_mm256_permute2f128_pd(s01, s23, 0x20), _mm256_permute2f128_pd(s01, s23, 0x31)), out, os);
+  finish4(a0, b0, a1, b1, a2, b2, a3, b3, out, os);
 }
 
 // dot4Avx2 for stride 4 (e.g. 2000 -> 1500 Hz): window t at taps j..j+3 is window t + 1 at
@@ -136,12 +140,7 @@ __attribute__((target("avx2,fma"))) void dot4Stride4Avx2(const double* g, long l
     v1 = v3;
     v2 = v4;
   }
-  a0 = _mm256_add_pd(a0, b0);
-  a1 = _mm256_add_pd(a1, b1);
-  a2 = _mm256_add_pd(a2, b2);
-  a3 = _mm256_add_pd(a3, b3);
-  const __m256d s01 = _mm256_hadd_pd(a0, a1), s23 = _mm256_hadd_pd(a2, a3);
-  store4(_mm256_add_pd(_mm256_permute2f128_pd(s01, s23, 0x20), _mm256_permute2f128_pd(s01, s23, 0x31)), out, os);
+  finish4(a0, b0, a1, b1, a2, b2, a3, b3, out, os);
 }
 #endif
 

@@ -9,12 +9,6 @@
 namespace flexarm {
 namespace {
 
-std::string format(const char* fmt, double v) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, fmt, v);
-  return buf;
-}
-
 std::string plural(std::size_t n, const char* one, const char* many) {
   return std::to_string(n) + " " + (n == 1 ? one : many);
 }
@@ -79,8 +73,14 @@ bool TimingOptions::isValid(std::string* why) const {
   return true;
 }
 
+std::string formatted(const char* fmt, double v) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, fmt, v);
+  return buf;
+}
+
 std::string durationText(double seconds) {
-  return std::abs(seconds) < 1.0 ? format("%.4g ms", seconds * 1e3) : format("%.4g s", seconds);
+  return std::abs(seconds) < 1.0 ? formatted("%.4g ms", seconds * 1e3) : formatted("%.4g s", seconds);
 }
 
 std::string placeOf(const TimingEvent& e) {
@@ -90,12 +90,12 @@ std::string placeOf(const TimingEvent& e) {
 std::string TimingReport::summary() const {
   if (samples < 2) return "fewer than two samples";
   if (interval <= 0.0) return "every sample has the same time stamp";
-  const std::string grid = durationText(interval) + " interval (" + format("%.6g", rateHz()) + " Hz)";
+  const std::string grid = durationText(interval) + " interval (" + formatted("%.6g", rateHz()) + " Hz)";
   if (regular()) return "regular: " + std::to_string(samples) + " samples, " + grid;
   std::vector<std::string> parts;
   if (gaps) {
     std::string s = plural(gaps, "gap", "gaps") + " (" + plural(static_cast<std::size_t>(missing), "sample", "samples") +
-                    " missing, the longest " + durationText(longestGap) + " at " + format("%.6g s", longestGapTime);
+                    " missing, the longest " + durationText(longestGap) + " at " + formatted("%.6g s", longestGapTime);
     for (const auto& e : events)
       if (e.kind == TimingEventKind::Gap && e.size == longestGap && e.line > 0) {
         s += ", line " + std::to_string(e.line);
@@ -105,7 +105,7 @@ std::string TimingReport::summary() const {
   }
   if (jitter)
     parts.push_back(plural(jitter, "jittered sample", "jittered samples") + " (up to " +
-                    format("%.2g", 100.0 * largestJitter) + " % of the interval)");
+                    formatted("%.2g", 100.0 * largestJitter) + " % of the interval)");
   if (duplicates) parts.push_back(plural(duplicates, "duplicate time stamp", "duplicate time stamps"));
   if (reversals) parts.push_back(plural(reversals, "reversal", "reversals") + " (time running backwards)");
   std::string out;

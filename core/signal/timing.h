@@ -64,5 +64,7 @@ std::string placeOf(const TimingEvent& e);
 
 // A duration in words for messages: "1.5 ms", "2 s".
 std::string durationText(double seconds);
+// A number in a message, printf-formatted: formatted("%.6g Hz", rate).
+std::string formatted(const char* format, double value);
 
 }  // namespace flexarm

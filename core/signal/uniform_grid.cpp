@@ -10,12 +10,6 @@
 namespace flexarm {
 namespace {
 
-std::string format(const char* fmt, double v) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, fmt, v);
-  return buf;
-}
-
 // Samples of one group on a uniform grid, ready for the rate change.
 struct Source {
   std::vector<const std::vector<double>*> inputs;  // one per channel of the group
@@ -185,7 +179,7 @@ UniformGridResult resampleToUniform(const std::vector<const IdData*>& logs, cons
         return finish(Termination::Failed, which + names + "every sample has the same time stamp");
       const double limit = o.maxGapSeconds > 0.0 ? o.maxGapSeconds : 10.0 * g.timing.interval;
       if (g.timing.longestGap > limit) {
-        std::string place = format("%.6g s", g.timing.longestGapTime);
+        std::string place = formatted("%.6g s", g.timing.longestGapTime);
         for (const auto& e : g.timing.events)
           if (e.kind == TimingEventKind::Gap && e.size == g.timing.longestGap && e.line > 0)
             place += ", line " + std::to_string(e.line);
@@ -232,14 +226,14 @@ UniformGridResult resampleToUniform(const std::vector<const IdData*>& logs, cons
   }
   if (last < first)
     return finish(Termination::Failed, "the logs do not overlap in time (the latest starts at " +
-                                           format("%.6g s", first) + ", the earliest ends at " +
-                                           format("%.6g s", last) + ")");
+                                           formatted("%.6g s", first) + ", the earliest ends at " +
+                                           formatted("%.6g s", last) + ")");
   const double anchor = sources.front().start;
   const double k0 = std::max(0.0, std::ceil((first - anchor) * rate - 1e-9));
   const double start = anchor + k0 / rate;
   const double count = std::floor((last - start) * rate + 1e-9) + 1.0;
   if (!(count >= 2.0))
-    return finish(Termination::Failed, "fewer than two samples at " + format("%.6g Hz", rate) +
+    return finish(Termination::Failed, "fewer than two samples at " + formatted("%.6g Hz", rate) +
                                            " in the time all channels cover");
   const std::size_t K = static_cast<std::size_t>(count);
 
@@ -257,9 +251,9 @@ UniformGridResult resampleToUniform(const std::vector<const IdData*>& logs, cons
     const auto f = rationalFactor(g.sourceRateHz, rate);
     if (!f)
       return finish(Termination::Failed,
-                    format("%.9g Hz", g.sourceRateHz) + " to " + format("%.9g Hz", rate) +
+                    formatted("%.9g Hz", g.sourceRateHz) + " to " + formatted("%.9g Hz", rate) +
                         " is not a ratio of whole numbers up to 10000; choose a rate such as " +
-                        format("%.6g Hz", g.sourceRateHz / std::max(1.0, std::round(g.sourceRateHz / rate))));
+                        formatted("%.6g Hz", g.sourceRateHz / std::max(1.0, std::round(g.sourceRateHz / rate))));
     g.factor = *f;
     double offset = (start - s.start) / s.interval;
     if (std::abs(offset - std::round(offset)) < 1e-6) offset = std::round(offset);
@@ -294,7 +288,7 @@ UniformGridResult resampleToUniform(const std::vector<const IdData*>& logs, cons
     return rank(a) < rank(b);
   });
   out.sampleTime = base.isUniform() ? base.sampleTime * baseFactor->down / baseFactor->up : 1.0 / rate;
-  out.setMeta("sample_rate_hz", format("%.12g", rate));
+  out.setMeta("sample_rate_hz", formatted("%.12g", rate));
 
   // Ranges of the first log, by time.
   auto carry = [&](const std::optional<SampleRange>& r) -> std::optional<SampleRange> {
@@ -312,12 +306,12 @@ UniformGridResult resampleToUniform(const std::vector<const IdData*>& logs, cons
   // 4. What was done, in words.
   const ChannelGroup& g0 = res.groups.front();
   const double lowNyquist = 0.5 * std::min(rate, g0.sourceRateHz);
-  res.stopband = format("%.0f dB", o.stopbandDb) + " from " + format("%.6g Hz", lowNyquist);
+  res.stopband = formatted("%.0f dB", o.stopbandDb) + " from " + formatted("%.6g Hz", lowNyquist);
   std::string msg;
   if (g0.factor.up == g0.factor.down)
-    msg = "kept at " + format("%.6g Hz", rate);
+    msg = "kept at " + formatted("%.6g Hz", rate);
   else
-    msg = format("%.6g Hz", g0.sourceRateHz) + " -> " + format("%.6g Hz", rate) + " (up " +
+    msg = formatted("%.6g Hz", g0.sourceRateHz) + " -> " + formatted("%.6g Hz", rate) + " (up " +
           std::to_string(g0.factor.up) + ", down " + std::to_string(g0.factor.down) +
           "; anti-alias FIR, " + res.stopband + ")";
   msg += ", " + std::to_string(K) + " samples";
@@ -330,9 +324,9 @@ UniformGridResult resampleToUniform(const std::vector<const IdData*>& logs, cons
            (g.fill.retimed == 1 ? " sample" : " samples") + " retimed (" + toString(o.method) + ")";
     if (g.fill.pchipFallback) msg += ", " + std::to_string(g.fill.pchipFallback) + " points of long gaps by PCHIP";
   }
-  if (res.filled) msg += "; longest gap bridged " + durationText(res.longestGapBridged) + " at " + format("%.6g s", res.longestGapTime);
+  if (res.filled) msg += "; longest gap bridged " + durationText(res.longestGapBridged) + " at " + formatted("%.6g s", res.longestGapTime);
   if (logs.size() > 1)
-    msg += "; " + std::to_string(logs.size()) + " logs on the first log's time base from " + format("%.6g s", start);
+    msg += "; " + std::to_string(logs.size()) + " logs on the first log's time base from " + formatted("%.6g s", start);
   reportProgress(progress, 1.0, "resampled");
   return finish(Termination::Converged, msg);
 }

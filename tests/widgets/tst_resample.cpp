@@ -33,13 +33,6 @@ namespace {
 // dropped, row 5000 stamped 3 % late, row 9000 written twice, rows 10000 and 10001 swapped.
 const QString kIrregularLog = QString(FLEXARM_SAMPLE_DIR) + "/three_mass_irregular_timing.csv";
 
-QMessageBox* findBox(const char* name) {
-  for (QWidget* w : QApplication::topLevelWidgets())
-    if (auto* box = qobject_cast<QMessageBox*>(w); box && box->objectName() == name && box->isVisible())
-      return box;
-  return nullptr;
-}
-
 }  // namespace
 
 class ResampleTest : public QObject {
@@ -60,8 +53,8 @@ class ResampleTest : public QObject {
 
   void openingOffersResamplingAndShowsTheLogAsRecorded() {
     window_->openFile(kIrregularLog);
-    QTRY_VERIFY_WITH_TIMEOUT(findBox("irregularTimeBox") != nullptr, 30000);
-    QMessageBox* box = findBox("irregularTimeBox");
+    QTRY_VERIFY_WITH_TIMEOUT(test::findBox("irregularTimeBox") != nullptr, 30000);
+    QMessageBox* box = test::findBox("irregularTimeBox");
     QVERIFY2(box->text().contains("2 gaps (4 samples missing, the longest 2 ms at 3.5015 s, line 7014)"),
              qPrintable(box->text()));
     QVERIFY2(box->text().contains("1 duplicate time stamp and 1 reversal"), qPrintable(box->text()));

@@ -1,7 +1,9 @@
 #pragma once
 // Helpers shared by the widget tests: the VTK surface format, screenshots, pixel checks.
+#include <QApplication>
 #include <QDir>
 #include <QImage>
+#include <QMessageBox>
 #include <QString>
 #include <QWidget>
 
@@ -15,6 +17,14 @@ inline QString saveShot(const QImage& image, const QString& name) {
   const QString path = QString(FLEXARM_SCREENSHOT_DIR) + "/" + name + ".png";
   image.save(path);
   return path;
+}
+
+// The visible message box with this object name, or null.
+inline QMessageBox* findBox(const char* name) {
+  for (QWidget* w : QApplication::topLevelWidgets())
+    if (auto* box = qobject_cast<QMessageBox*>(w); box && box->objectName() == name && box->isVisible())
+      return box;
+  return nullptr;
 }
 
 // Fraction of pixels that look like the arm's orange paint (RGB 237,115,26 before lighting).
