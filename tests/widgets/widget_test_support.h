@@ -4,6 +4,7 @@
 #include <QDir>
 #include <QImage>
 #include <QMessageBox>
+#include <QMouseEvent>
 #include <QString>
 #include <QWidget>
 
@@ -25,6 +26,14 @@ inline QMessageBox* findBox(const char* name) {
     if (auto* box = qobject_cast<QMessageBox*>(w); box && box->objectName() == name && box->isVisible())
       return box;
   return nullptr;
+}
+
+// A mouse move delivered straight to the widget (with the buttons held), so no other window
+// can take it.
+inline void moveMouse(QWidget* w, QPoint p, Qt::MouseButtons held = Qt::NoButton) {
+  QMouseEvent move(QEvent::MouseMove, QPointF(p), w->mapToGlobal(QPointF(p)), Qt::NoButton, held,
+                   Qt::NoModifier);
+  QApplication::sendEvent(w, &move);
 }
 
 // Fraction of pixels that look like the arm's orange paint (RGB 237,115,26 before lighting).
