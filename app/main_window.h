@@ -84,6 +84,8 @@ class MainWindow : public QMainWindow {
   void rebuildRecentMenu();
   void onReadFinished();
   void showError(const QString& title, const QString& message);
+  // The log was refused for its time stamps alone: asks whether to open it for resampling.
+  void offerResampling(const QString& problem);
 
   Workspace* workspace_;
   Playhead* playhead_;

@@ -59,6 +59,22 @@ for effect in coulomb_friction backlash nonlinear_spring input_delay extra_mass;
 done
 sim effect_torque_ripple "${effect_log[@]}" --effect torque_ripple --reference-velocity 5
 
+# A log whose time stamps a logger spoiled, for resampling: the three-mass chirp log, 6 s at
+# 2 kHz, with data rows 3000 and 7000-7002 dropped, row 5000 stamped 15 us (3 %) late, row
+# 9000 written twice and rows 10000 and 10001 swapped.
+sim three_mass_irregular_timing --model three-mass --excitation chirp --duration 6 --seed 4
+awk -F, -v OFS=, '
+  /^#/ || !header { print; if (!/^#/) header = 1; next }
+  { r = row++ }
+  r == 3000 || (r >= 7000 && r <= 7002) { next }
+  r == 5000 { $1 = sprintf("%.9f", $1 + 0.000015) }
+  r == 9000 { print }
+  r == 10000 { held = $0; next }
+  { print }
+  r == 10001 { print held }
+' "$out/three_mass_irregular_timing.csv" > "$out/three_mass_irregular_timing.tmp"
+mv "$out/three_mass_irregular_timing.tmp" "$out/three_mass_irregular_timing.csv"
+
 if [[ $check -eq 1 ]]; then
   status=0
   for f in "$out"/*; do
