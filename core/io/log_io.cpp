@@ -13,6 +13,8 @@
 #include <system_error>
 #include <unistd.h>
 
+#include "core/signal/timing.h"
+
 namespace flexarm {
 namespace {
 
@@ -161,17 +163,43 @@ void splitFields(std::string_view line, char delimiter, std::vector<std::string_
   }
 }
 
-// Checks that times increase and are uniformly spaced; fills sampleTime and startTime.
+// A refusal for the time stamps: marked as such, with every irregularity counted.
+void timeFailure(LogReadResult& fail, const std::vector<double>& t, const std::vector<int>& lines,
+                 double jitter) {
+  fail.irregularTime = true;
+  TimingOptions o;
+  o.jitterTolerance = std::min(jitter, 0.49);
+  fail.error.problem += ". The time stamps have " + analyzeTiming(t, lines, o).summary() +
+                        "; resampling puts them on a uniform grid (flexarm preprocess --resample, "
+                        "or Resample in the Preprocess panel)";
+}
+
+// Checks that times increase and are uniformly spaced; fills sampleTime and startTime. With
+// keepIrregularTime, stamps that are not keep their times for a resampling step instead.
 bool checkTime(const std::string& path, const std::vector<double>& t, const std::vector<int>& lines,
-               int timeColumn, const std::string& timeName, double jitter, IdData& data,
-               LogReadResult& fail) {
+               int timeColumn, const std::string& timeName, const LogReadOptions& options,
+               IdData& data, LogReadResult& fail) {
+  const double jitter = options.maxSampleJitter;
   const std::size_t n = t.size();
+  if (options.keepIrregularTime && n >= 2) {
+    TimingOptions o;
+    o.jitterTolerance = std::min(jitter, 0.49);
+    const TimingReport report = analyzeTiming(t, lines, o);
+    if (!report.regular()) {
+      data.timeStamps = t;
+      data.sourceLines = lines;
+      data.startTime = t[0];
+      data.sampleTime = report.interval > 0.0 ? report.interval : 1.0;
+      return true;
+    }
+  }
   for (std::size_t i = 1; i < n; ++i)
     if (!(t[i] > t[i - 1])) {
       char buf[160];
       std::snprintf(buf, sizeof buf, "time %.9g does not increase (line %d has %.9g)", t[i],
                     lines[i - 1], t[i - 1]);
       fail = failure(path, lines[i], timeColumn, timeName, buf);
+      timeFailure(fail, t, lines, jitter);
       return false;
     }
   data.startTime = n ? t[0] : 0.0;
@@ -187,6 +215,7 @@ bool checkTime(const std::string& path, const std::vector<double>& t, const std:
                     "the log first)",
                     t[i - 1], t[i], step, 100.0 * std::abs(step - dt) / dt, dt, 100.0 * jitter);
       fail = failure(path, lines[i], timeColumn, timeName, buf);
+      timeFailure(fail, t, lines, jitter);
       return false;
     }
   }
@@ -320,6 +349,7 @@ LogReadResult readFlexArmCsv(const std::string& path, const LogReadOptions& opti
   for (auto& c : cols) c.reserve(estimate);
   std::vector<int> lines;
   lines.reserve(estimate);
+  bool holes = false;
   while (cursor.next(line)) {
     if (isBlank(line)) continue;
     if (trim(line)[0] == '#') continue;
@@ -331,9 +361,13 @@ LogReadResult readFlexArmCsv(const std::string& path, const LogReadOptions& opti
     for (std::size_t i = 0; i < nCols; ++i) {
       double v = 0;
       FieldStatus s = parseNumber(fields[i], v);
-      if (s != FieldStatus::Ok)
+      if (s == FieldStatus::Empty && options.keepIrregularTime && static_cast<int>(i) != timeIndex) {
+        v = std::nan("");  // this channel has no sample at this time
+        holes = true;
+      } else if (s != FieldStatus::Ok) {
         return failure(path, cursor.number(), static_cast<int>(i + 1), header[i],
                        fieldProblem(s, fields[i]));
+      }
       cols[i].push_back(v);
     }
     lines.push_back(cursor.number());
@@ -344,9 +378,13 @@ LogReadResult readFlexArmCsv(const std::string& path, const LogReadOptions& opti
     return failure(path, lines[0], 0, {}, "only one data row: at least two samples are needed");
 
   if (!checkTime(path, cols[static_cast<std::size_t>(timeIndex)], lines, timeIndex + 1,
-                 columns::kTime, options.maxSampleJitter, data, fail))
+                 columns::kTime, options, data, fail))
     return fail;
-  if (declaredRate > 0) {
+  if (holes && data.timeStamps.empty()) {  // channels at different rates: stamps and NaN holes
+    data.timeStamps = cols[static_cast<std::size_t>(timeIndex)];
+    data.sourceLines = lines;
+  }
+  if (declaredRate > 0 && data.timeStamps.empty()) {
     const double measured = 1.0 / data.sampleTime;
     if (std::abs(measured - declaredRate) > options.maxSampleJitter * declaredRate) {
       char buf[200];
@@ -433,7 +471,7 @@ LogReadResult readTable(const std::string& path, const LogReadOptions& options) 
   data.sampleTime = options.sampleTime;
   if (options.timeColumn > 0) {
     if (!checkTime(path, cols[static_cast<std::size_t>(options.timeColumn - 1)], lines,
-                   options.timeColumn, "time", options.maxSampleJitter, data, fail))
+                   options.timeColumn, "time", options, data, fail))
       return fail;
   }
   for (std::size_t i = 0; i < cols.size(); ++i) {
@@ -557,7 +595,7 @@ LogReadResult readMat(const std::string& path, const LogReadOptions& options) {
       return failure(path, 0, 0, columns::kTime, "has a different length than the signals");
     std::vector<int> idx(t.size());
     for (std::size_t i = 0; i < idx.size(); ++i) idx[i] = static_cast<int>(i + 1);
-    if (!checkTime(path, t, idx, 0, columns::kTime, options.maxSampleJitter, data, fail)) {
+    if (!checkTime(path, t, idx, 0, columns::kTime, options, data, fail)) {
       fail.error.problem = "sample " + std::to_string(fail.error.line) + ": " + fail.error.problem;
       fail.error.line = 0;
       return fail;
