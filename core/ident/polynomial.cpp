@@ -13,11 +13,15 @@ Eigen::VectorXd filter(const Poly& num, const Poly& den, const Eigen::VectorXd& 
   Eigen::VectorXd y(n);
   const int nb = static_cast<int>(num.size());
   const int na = static_cast<int>(den.size());
+  // Leading zeros of the numerator are a pure delay (B of (4.10) holds nk of them): they are
+  // skipped, so a long delay costs nothing per sample.
+  int k0 = 0;
+  while (k0 < nb && num[static_cast<std::size_t>(k0)] == 0.0) ++k0;
   const double inv0 = 1.0 / den[0];
   for (Eigen::Index t = 0; t < n; ++t) {
     double s = 0.0;
     const int kb = static_cast<int>(std::min<Eigen::Index>(nb - 1, t));
-    for (int k = 0; k <= kb; ++k) s += num[k] * x[t - k];
+    for (int k = k0; k <= kb; ++k) s += num[k] * x[t - k];
     const int ka = static_cast<int>(std::min<Eigen::Index>(na - 1, t));
     for (int k = 1; k <= ka; ++k) s -= den[k] * y[t - k];
     y[t] = s * inv0;
