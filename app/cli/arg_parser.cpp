@@ -1,6 +1,7 @@
 #include <algorithm>
 #include <charconv>
 #include <cmath>
+#include <string>
 
 #include "app/cli/cli.h"
 
@@ -92,6 +93,23 @@ bool ArgParser::integer(const std::string& name, long& out) {
     return false;
   }
   out = x;
+  return true;
+}
+
+bool ArgParser::integer(const std::string& name, int& out, int min, int max) {
+  auto v = value(name);
+  if (!v) return true;
+  long long x = 0;
+  const char* b = v->data();
+  const char* e = v->data() + v->size();
+  if (b != e && *b == '+') ++b;
+  const auto res = std::from_chars(b, e, x);
+  if (res.ec != std::errc() || res.ptr != e || x < min || x > max) {
+    error_ = "--" + name + " expects a whole number from " + std::to_string(min) + " to " +
+             std::to_string(max) + ", got '" + *v + "'";
+    return false;
+  }
+  out = static_cast<int>(x);
   return true;
 }
 

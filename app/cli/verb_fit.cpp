@@ -243,9 +243,11 @@ int prepareAndFit(ArgParser& args, const std::string& verb, FitOutcome& out, std
                   "models only\n";
     return kExitUsage;
   }
-  long decimation = 1, maxIter = 100, starts = 0, seed = 1;
-  if (!args.integer("decimate", decimation) || !args.integer("max-iterations", maxIter) ||
-      !args.integer("starts", starts) || !args.integer("seed", seed)) {
+  int decimation = 1, maxIter = 100, starts = 0;
+  long seed = 1;
+  if (!args.integer("decimate", decimation, 1, 1000000) ||
+      !args.integer("max-iterations", maxIter, 0, 100000) ||
+      !args.integer("starts", starts, 0, 1000) || !args.integer("seed", seed)) {
     err << pre << args.error() << "\n";
     return kExitUsage;
   }
@@ -415,6 +417,10 @@ int prepareAndFit(ArgParser& args, const std::string& verb, FitOutcome& out, std
     return kExitOk;
   }
   if (!out.spec.physical) {
+    if (!out.spec.orders.fitsData(out.spec.structure, out.yEst.size(), &why)) {
+      err << pre << why << "\n";
+      return kExitUsage;
+    }
     PolyEstimateOptions po;
     po.maxIterations = static_cast<int>(maxIter);
     try {

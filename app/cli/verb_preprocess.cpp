@@ -51,12 +51,10 @@ int runPreprocess(const std::vector<std::string>& argv, std::ostream& out, std::
     return kExitUsage;
   }
   PreprocessOptions p;
-  long factor = 1;
-  if (!args.integer("decimate", factor)) {
+  if (!args.integer("decimate", p.decimation.factor, 1, 1000000)) {
     err << "flexarm preprocess: " << args.error() << "\n";
     return kExitUsage;
   }
-  p.decimation.factor = static_cast<int>(factor);
   if (auto f = args.value("filter")) {
     auto parsed = antiAliasFilterFromString(*f);
     if (!parsed) {

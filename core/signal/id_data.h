@@ -46,6 +46,8 @@ struct SampleRange {
 
 class IdData {
  public:
+  // The finest sample time FlexArm handles (1 MHz): its logs hold time with 9 decimals.
+  static constexpr double kMinSampleTime = 1e-6;
   double sampleTime = 1.0;  // seconds between samples
   double startTime = 0.0;   // time of sample 0, seconds
   std::vector<Channel> channels;
@@ -82,7 +84,7 @@ class IdData {
   IdData select(SampleRange r) const;
 
   // True when every channel has the same length, every value is finite and the sample time
-  // is positive; otherwise says why.
+  // is finite and at least kMinSampleTime; otherwise says why.
   bool isValid(std::string* why = nullptr) const;
 };
 

@@ -1,0 +1,151 @@
+#include "core/io/input_file.h"
+
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
+
+namespace flexarm {
+namespace {
+
+const char* kindOf(mode_t mode) {
+  if (S_ISDIR(mode)) return "a directory";
+  if (S_ISCHR(mode)) return "a character device";
+  if (S_ISBLK(mode)) return "a block device";
+  if (S_ISFIFO(mode)) return "a pipe";
+  if (S_ISSOCK(mode)) return "a socket";
+  return "not a regular file";
+}
+
+std::string notRegular(mode_t mode) {
+  return std::string("is ") + kindOf(mode) +
+         ", not a regular file; FlexArm reads logs and sessions from regular files only "
+         "(copy the data into a file first)";
+}
+
+std::string sizeProblem(std::uint64_t size, std::uint64_t maxBytes) {
+  return "the file is " + humanBytes(size) + ", larger than the " + humanBytes(maxBytes) +
+         " FlexArm reads at once; cut it into shorter logs or decimate it first";
+}
+
+std::string openProblem(int error) {
+  if (error == ENOENT || error == ENOTDIR) return "the file does not exist";
+  return std::string("cannot open the file: ") + std::strerror(error);
+}
+
+}  // namespace
+
+std::string humanBytes(std::uint64_t n) {
+  char buf[64];
+  if (n >= (1ull << 30))
+    std::snprintf(buf, sizeof buf, "%.1f GiB", static_cast<double>(n) / (1ull << 30));
+  else if (n >= (1ull << 20))
+    std::snprintf(buf, sizeof buf, "%.1f MiB", static_cast<double>(n) / (1ull << 20));
+  else
+    std::snprintf(buf, sizeof buf, "%llu bytes", static_cast<unsigned long long>(n));
+  return buf;
+}
+
+bool checkInputFile(const std::string& path, std::uint64_t maxBytes, std::uint64_t* size,
+                    std::string* problem) {
+  struct stat st {};
+  if (::stat(path.c_str(), &st) != 0) {
+    if (problem) *problem = openProblem(errno);
+    return false;
+  }
+  if (!S_ISREG(st.st_mode)) {
+    if (problem) *problem = notRegular(st.st_mode);
+    return false;
+  }
+  const auto bytes = static_cast<std::uint64_t>(st.st_size);
+  if (bytes > maxBytes) {
+    if (problem) *problem = sizeProblem(bytes, maxBytes);
+    return false;
+  }
+  if (size) *size = bytes;
+  return true;
+}
+
+bool readInputFile(const std::string& path, std::uint64_t maxBytes, FileBytes& out,
+                   std::string* problem) {
+  // O_NONBLOCK: opening a pipe must not wait for a writer; it is refused just below.
+  const int fd = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC);
+  if (fd < 0) {
+    if (problem) *problem = openProblem(errno);
+    return false;
+  }
+  struct Close {
+    int fd;
+    ~Close() { ::close(fd); }
+  } closer{fd};
+  struct stat st {};
+  if (::fstat(fd, &st) != 0) {
+    if (problem) *problem = openProblem(errno);
+    return false;
+  }
+  if (!S_ISREG(st.st_mode)) {
+    if (problem) *problem = notRegular(st.st_mode);
+    return false;
+  }
+  const auto bytes = static_cast<std::uint64_t>(st.st_size);
+  if (bytes > maxBytes) {
+    if (problem) *problem = sizeProblem(bytes, maxBytes);
+    return false;
+  }
+  out.size = 0;
+  out.data.reset(new char[bytes + 1]);
+  std::size_t got = 0;
+  while (got < bytes) {
+    const ssize_t r = ::read(fd, out.data.get() + got, static_cast<std::size_t>(bytes - got));
+    if (r < 0 && errno == EINTR) continue;
+    if (r < 0) {
+      if (problem) *problem = std::string("reading the file failed: ") + std::strerror(errno);
+      out.data.reset();
+      return false;
+    }
+    if (r == 0) break;  // the file shrank meanwhile: what is there is read
+    got += static_cast<std::size_t>(r);
+  }
+  out.data[got] = '\0';
+  out.size = got;
+  return true;
+}
+
+std::string textEncodingProblem(std::string_view head) {
+  auto starts = [&](std::initializer_list<unsigned char> bytes) {
+    if (head.size() < bytes.size()) return false;
+    std::size_t i = 0;
+    for (unsigned char b : bytes)
+      if (static_cast<unsigned char>(head[i++]) != b) return false;
+    return true;
+  };
+  const char* save =
+      "; save it as plain text (ASCII or UTF-8 without byte-order mark, e.g. 'CSV' rather "
+      "than 'Unicode text')";
+  if (starts({0xFF, 0xFE, 0x00, 0x00}) || starts({0x00, 0x00, 0xFE, 0xFF}))
+    return std::string("the file is UTF-32 text (it starts with a UTF-32 byte-order mark), "
+                       "which FlexArm does not read") + save;
+  if (starts({0xFF, 0xFE}) || starts({0xFE, 0xFF}))
+    return std::string("the file is UTF-16 text (it starts with a UTF-16 byte-order mark), "
+                       "which FlexArm does not read") + save;
+  if (starts({0xEF, 0xBB, 0xBF}))
+    return std::string("the file starts with a UTF-8 byte-order mark (BOM), which FlexArm "
+                       "logs do not have") + save;
+  const std::size_t n = std::min<std::size_t>(head.size(), 4096);
+  std::size_t zeros = 0, oddZeros = 0, evenZeros = 0;
+  for (std::size_t i = 0; i < n; ++i)
+    if (head[i] == '\0') {
+      ++zeros;
+      (i % 2 ? oddZeros : evenZeros)++;
+    }
+  if (zeros == 0) return {};
+  if (n >= 4 && (oddZeros >= n / 2 - 1 || evenZeros >= n / 2 - 1) && zeros <= n / 2 + 1)
+    return std::string("the file looks like UTF-16 text (every other byte is zero), which "
+                       "FlexArm does not read") + save;
+  return "the file holds binary data (zero bytes), not text";
+}
+
+}  // namespace flexarm
