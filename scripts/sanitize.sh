@@ -40,7 +40,7 @@ ctest --test-dir "$build" --output-on-failure -j "$jobs" --timeout 900
 # The tests that run threads (FFT planning, the split CSV parse, discovery's parallel
 # candidates, replays) again, several times, where a race has the best chance to show.
 ctest --test-dir "$build" --output-on-failure -j "$jobs" --timeout 900 \
-  -R "$(cat "$here/tests/threaded_tests.txt" | paste -sd '|')" --repeat until-fail:3
+  -R "$(paste -sd '|' "$here/tests/threaded_tests.txt")" --repeat until-fail:3
 
 seconds="${FUZZ_SECONDS:-20}"
 if [ "$seconds" != 0 ]; then

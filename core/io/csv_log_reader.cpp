@@ -71,17 +71,18 @@ struct Chunk {
 void parseChunk(Chunk& c, const char* textStart, std::size_t nCols, std::vector<std::vector<double>>& cols) {
   std::vector<double*> out(nCols);
   for (std::size_t i = 0; i < nCols; ++i) out[i] = cols[i].data() + c.base;
-  std::vector<double> row(nCols);
+  std::vector<double> row(nCols);  // the careful path's values
   std::vector<std::string_view> fields;
   const char* p = c.begin;
   const char* const end = c.end;
   std::size_t r = 0;
   while (p < end) {
     const char* const lineStart = p;
-    // Fast path: number, ',', number, ..., number, end of line. No blanks, no '+'.
+    // Fast path: number, ',', number, ..., number, end of line. No blanks, no '+'. Values
+    // go straight to their column; a line that leaves the fast path is parsed again.
     bool fast = r < c.cap;
     for (std::size_t i = 0; fast && i < nCols; ++i) {
-      double v;
+      double& v = out[i][r];
       const auto res = std::from_chars(p, end, v);
       if (res.ec != std::errc() || !std::isfinite(v)) {
         fast = false;
@@ -99,10 +100,8 @@ void parseChunk(Chunk& c, const char* textStart, std::size_t nCols, std::vector<
         fast = false;
         break;
       }
-      row[i] = v;
     }
     if (fast) {
-      for (std::size_t i = 0; i < nCols; ++i) out[i][r] = row[i];
       ++r;
       continue;
     }
@@ -135,6 +134,15 @@ void parseChunk(Chunk& c, const char* textStart, std::size_t nCols, std::vector<
 std::size_t rowBound(const char* b, const char* e, std::size_t nCols) {
   const auto lines = static_cast<std::size_t>(std::count(b, e, '\n')) + 1;
   return std::min(lines, static_cast<std::size_t>(e - b) / (2 * nCols) + 1);
+}
+
+// Runs work(0..n-1), each on its own thread (the last on the calling one).
+template <class Work>
+void inParallel(unsigned n, Work work) {
+  std::vector<std::thread> pool;
+  for (unsigned k = 0; k + 1 < n; ++k) pool.emplace_back(work, k);
+  work(n - 1);
+  for (auto& t : pool) t.join();
 }
 
 }  // namespace
@@ -225,7 +233,6 @@ LogReadResult readFlexArmCsvText(std::string_view text, const std::string& path,
     threads = std::clamp(std::thread::hardware_concurrency(), 1u, 8u);
   std::vector<Chunk> chunks(threads);
   const char* b = dataBegin;
-  std::size_t base = 0;
   for (unsigned k = 0; k < threads; ++k) {
     const char* e = k + 1 == threads ? dataEnd : dataBegin + dataBytes * (k + 1) / threads;
     if (e < b) e = b;
@@ -235,22 +242,19 @@ LogReadResult readFlexArmCsvText(std::string_view text, const std::string& path,
     }
     chunks[k].begin = b;
     chunks[k].end = e;
-    chunks[k].base = base;
-    chunks[k].cap = rowBound(b, e, nCols);
-    base += chunks[k].cap;
     b = e;
+  }
+  // Each chunk's rows are bounded (counted in parallel), the columns sized once, then every
+  // chunk parses into its own stretch of them.
+  inParallel(threads, [&](unsigned k) { chunks[k].cap = rowBound(chunks[k].begin, chunks[k].end, nCols); });
+  std::size_t base = 0;
+  for (auto& c : chunks) {
+    c.base = base;
+    base += c.cap;
   }
   std::vector<std::vector<double>> cols(nCols);
   for (auto& c : cols) c.resize(base);
-  if (threads == 1) {
-    parseChunk(chunks[0], textStart, nCols, cols);
-  } else {
-    std::vector<std::thread> pool;
-    for (unsigned k = 1; k < threads; ++k)
-      pool.emplace_back([&, k] { parseChunk(chunks[k], textStart, nCols, cols); });
-    parseChunk(chunks[0], textStart, nCols, cols);
-    for (auto& t : pool) t.join();
-  }
+  inParallel(threads, [&](unsigned k) { parseChunk(chunks[k], textStart, nCols, cols); });
   for (const auto& c : chunks)
     if (c.failed)
       return failure(path, io::lineAt(text, c.error.lineStart), c.error.column,
