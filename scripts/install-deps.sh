@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
 # Installs every Debian package FlexArm needs to build, run and test.
+# With --bench: the peers of the benchmarks instead (scripts/bench.sh; not needed by CI).
 # Idempotent: packages already present are skipped, so a second run is quick.
 set -euo pipefail
 
@@ -16,6 +17,11 @@ PACKAGES=(
 # clang and libclang-rt-14-dev (its sanitizer and libFuzzer runtimes, only recommended by
 # clang-14) build the AddressSanitizer/UBSan tests and the fuzz targets (scripts/sanitize.sh,
 # scripts/fuzz.sh); python3-pandas is the peer of bench/bench_csv_read.
+
+if [ "${1:-}" = "--bench" ]; then
+  PACKAGES=(python3-numpy python3-scipy python3-pandas python3-matplotlib
+            octave octave-control octave-signal)
+fi
 
 missing=()
 for p in "${PACKAGES[@]}"; do
