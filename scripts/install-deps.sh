@@ -11,12 +11,12 @@ PACKAGES=(
   libmatio-dev libfftw3-dev nlohmann-json3-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   xvfb xauth libgl1-mesa-dri
-  poppler-utils python3-scipy python3-pandas zlib1g-dev
+  poppler-utils python3-scipy zlib1g-dev
   clang libclang-rt-14-dev
 )
 # clang and libclang-rt-14-dev (its sanitizer and libFuzzer runtimes, only recommended by
 # clang-14) build the AddressSanitizer/UBSan tests and the fuzz targets (scripts/sanitize.sh,
-# scripts/fuzz.sh); python3-pandas is the peer of bench/bench_csv_read.
+# scripts/fuzz.sh).
 
 if [ "${1:-}" = "--bench" ]; then
   PACKAGES=(python3-numpy python3-scipy python3-pandas python3-matplotlib

@@ -19,7 +19,7 @@ fi
 jobs="${JOBS:-$(nproc)}"
 
 flags="-fsanitize=address,undefined -fno-sanitize-recover=undefined -fno-omit-frame-pointer"
-flags="$flags -fsanitize=fuzzer-no-link -O1 -g1"
+flags="$flags -O1 -g1"  # (the readers also get -fsanitize=fuzzer-no-link: core/CMakeLists.txt)
 launcher=()
 if command -v ccache > /dev/null; then launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache -DCMAKE_C_COMPILER_LAUNCHER=ccache); fi
 cmake -S "$here" -B "$build" -G Ninja "${launcher[@]}" \

@@ -57,83 +57,81 @@ bool parseLineCarefully(std::string_view line, std::size_t nCols, std::vector<st
   return true;
 }
 
-// Parses the data lines of [begin, end) (whole lines) into cols at rows [base, base + cap).
+// Parses the data lines of [begin, end) (whole lines) into its own columns.
 struct Chunk {
   const char* begin = nullptr;
   const char* end = nullptr;
-  std::size_t base = 0;
-  std::size_t cap = 0;
-  std::size_t rows = 0;
+  std::vector<std::vector<double>> cols;
   bool failed = false;
   RowError error;
 };
 
-void parseChunk(Chunk& c, const char* textStart, std::size_t nCols, std::vector<std::vector<double>>& cols) {
-  std::vector<double*> out(nCols);
-  for (std::size_t i = 0; i < nCols; ++i) out[i] = cols[i].data() + c.base;
-  std::vector<double> row(nCols);  // the careful path's values
+void parseChunk(Chunk& c, const char* textStart, std::size_t nCols, std::size_t reserve) {
+  c.cols.resize(nCols);
+  for (auto& col : c.cols) {
+    col.reserve(reserve);  // address space only: pages come on use
+    preferHugePages(col.data(), reserve * sizeof(double));
+  }
+  std::vector<double> row(nCols);
   std::vector<std::string_view> fields;
   const char* p = c.begin;
   const char* const end = c.end;
-  std::size_t r = 0;
   while (p < end) {
     const char* const lineStart = p;
-    // Fast path: number, ',', number, ..., number, end of line. No blanks, no '+'. Values
-    // go straight to their column; a line that leaves the fast path is parsed again.
-    bool fast = r < c.cap;
-    for (std::size_t i = 0; fast && i < nCols; ++i) {
-      double& v = out[i][r];
-      const auto res = std::from_chars(p, end, v);
-      if (res.ec != std::errc() || !std::isfinite(v)) {
+    // Fast path: number, ',', number, ..., number, end of line. No blanks, no '+'.
+    bool fast = true;
+    for (std::size_t i = 0; i < nCols; ++i) {
+      const char* q = io::parseDouble(p, end, row[i]);
+      if (!q || !std::isfinite(row[i])) {
         fast = false;
         break;
       }
-      p = res.ptr;
-      const char want = i + 1 < nCols ? ',' : '\n';
-      if (p < end && *p == want) {
-        ++p;
-      } else if (i + 1 == nCols && (p == end || (*p == '\r' && p + 1 < end && p[1] == '\n'))) {
-        p += p == end ? 0 : 2;
-      } else if (i + 1 == nCols && *p == '\r' && p + 1 == end) {
-        ++p;
-      } else {
-        fast = false;
-        break;
+      p = q;
+      if (i + 1 < nCols) {
+        if (p < end && *p == ',') {
+          ++p;
+          continue;
+        }
+      } else if (p == end || *p == '\n') {
+        p += p == end ? 0 : 1;
+        continue;
+      } else if (*p == '\r' && (p + 1 == end || p[1] == '\n')) {
+        p += p + 1 == end ? 1 : 2;
+        continue;
       }
-    }
-    if (fast) {
-      ++r;
-      continue;
-    }
-    // Careful path for this line.
-    const char* nl = static_cast<const char*>(std::memchr(lineStart, '\n', static_cast<std::size_t>(end - lineStart)));
-    const char* lineEnd = nl ? nl : end;
-    std::string_view line(lineStart, static_cast<std::size_t>(lineEnd - lineStart));
-    if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
-    p = nl ? nl + 1 : end;
-    bool isRow = false;
-    if (!parseLineCarefully(line, nCols, fields, row.data(), c.error, isRow)) {
-      c.failed = true;
-      c.error.lineStart = static_cast<std::size_t>(lineStart - textStart);
+      fast = false;
       break;
     }
-    if (!isRow) continue;
-    if (r >= c.cap) {  // cannot happen: every row takes at least 2 nCols bytes
-      c.failed = true;
-      c.error = {static_cast<std::size_t>(lineStart - textStart), 0, "internal: row estimate exceeded"};
-      break;
+    if (!fast) {  // the careful path for this line
+      const char* nl = static_cast<const char*>(std::memchr(lineStart, '\n', static_cast<std::size_t>(end - lineStart)));
+      std::string_view line(lineStart, static_cast<std::size_t>((nl ? nl : end) - lineStart));
+      if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
+      p = nl ? nl + 1 : end;
+      bool isRow = false;
+      if (!parseLineCarefully(line, nCols, fields, row.data(), c.error, isRow)) {
+        c.failed = true;
+        c.error.lineStart = static_cast<std::size_t>(lineStart - textStart);
+        return;
+      }
+      if (!isRow) continue;
     }
-    for (std::size_t i = 0; i < nCols; ++i) out[i][r] = row[i];
-    ++r;
+    for (std::size_t i = 0; i < nCols; ++i) c.cols[i].push_back(row[i]);
   }
-  c.rows = r;
 }
 
-// Upper bound on the data rows in [b, e): lines, and bytes / (2 nCols) (a row of nCols
-// numbers takes at least nCols digits and nCols - 1 commas and a line end).
-std::size_t rowBound(const char* b, const char* e, std::size_t nCols) {
-  const auto lines = static_cast<std::size_t>(std::count(b, e, '\n')) + 1;
-  return std::min(lines, static_cast<std::size_t>(e - b) / (2 * nCols) + 1);
+// Rows expected in `bytes` of data from the mean length of the first lines (each row takes
+// at least 2 nCols bytes: a digit and a delimiter per field), with a small margin.
+std::size_t expectedRows(const char* b, const char* e, std::size_t bytes, std::size_t nCols) {
+  std::size_t lines = 0;
+  const char* p = b;
+  while (p < e && lines < 64) {
+    const void* nl = std::memchr(p, '\n', static_cast<std::size_t>(e - p));
+    p = nl ? static_cast<const char*>(nl) + 1 : e;
+    ++lines;
+  }
+  const double mean = std::max<double>(2.0 * static_cast<double>(nCols),
+                                        lines ? static_cast<double>(p - b) / static_cast<double>(lines) : 1.0);
+  return static_cast<std::size_t>(1.05 * static_cast<double>(bytes) / mean) + 16;
 }
 
 // Runs work(0..n-1), each on its own thread (the last on the calling one).
@@ -244,34 +242,25 @@ LogReadResult readFlexArmCsvText(std::string_view text, const std::string& path,
     chunks[k].end = e;
     b = e;
   }
-  // Each chunk's rows are bounded (counted in parallel), the columns sized once, then every
-  // chunk parses into its own stretch of them.
-  inParallel(threads, [&](unsigned k) { chunks[k].cap = rowBound(chunks[k].begin, chunks[k].end, nCols); });
-  std::size_t base = 0;
-  for (auto& c : chunks) {
-    c.base = base;
-    base += c.cap;
-  }
-  std::vector<std::vector<double>> cols(nCols);
-  for (auto& c : cols) c.resize(base);
-  inParallel(threads, [&](unsigned k) { parseChunk(chunks[k], textStart, nCols, cols); });
+  // Every chunk parses into its own columns; the first reserves room for the whole log, so
+  // the others are appended to it without moving it.
+  inParallel(threads, [&](unsigned k) {
+    const auto bytes = static_cast<std::size_t>(k == 0 ? dataBytes : chunks[k].end - chunks[k].begin);
+    parseChunk(chunks[k], textStart, nCols, expectedRows(dataBegin, dataEnd, bytes, nCols));
+  });
   for (const auto& c : chunks)
     if (c.failed)
       return failure(path, io::lineAt(text, c.error.lineStart), c.error.column,
                      c.error.column > 0 ? header[static_cast<std::size_t>(c.error.column - 1)]
                                         : std::string(),
                      c.error.problem);
-  // Close the gaps left by chunks that held fewer rows than their bound.
-  std::size_t rows = 0;
-  for (const auto& c : chunks) {
-    if (c.base != rows)
-      for (auto& col : cols)
-        std::copy(col.begin() + static_cast<std::ptrdiff_t>(c.base),
-                  col.begin() + static_cast<std::ptrdiff_t>(c.base + c.rows),
-                  col.begin() + static_cast<std::ptrdiff_t>(rows));
-    rows += c.rows;
-  }
-  for (auto& col : cols) col.resize(rows);
+  std::vector<std::vector<double>> cols = std::move(chunks[0].cols);
+  for (unsigned k = 1; k < threads; ++k)
+    for (std::size_t i = 0; i < nCols; ++i) {
+      cols[i].insert(cols[i].end(), chunks[k].cols[i].begin(), chunks[k].cols[i].end());
+      std::vector<double>().swap(chunks[k].cols[i]);
+    }
+  const std::size_t rows = cols[0].size();
 
   auto lineOf = [&](std::size_t row) { return io::lineOfRow(text, dataStart, headerLine + 1, row, "#"); };
   if (rows == 0)

@@ -10,13 +10,23 @@
 
 namespace flexarm {
 
+// Releases a FileBytes buffer: a mapping of `mapped` bytes, or new[] when mapped is 0.
+struct FileBufferDeleter {
+  std::size_t mapped = 0;
+  void operator()(char* p) const;
+};
+
 // The bytes of a whole file, read once (not zero-filled first: large logs are read at the
 // speed of the disk cache).
 struct FileBytes {
-  std::unique_ptr<char[]> data;
+  std::unique_ptr<char, FileBufferDeleter> data;
   std::size_t size = 0;
   std::string_view view() const { return {data.get(), size}; }
 };
+
+// Asks the kernel to back [p, p + bytes) with huge pages where it can (a large buffer then
+// costs hundreds of page faults instead of hundreds of thousands); no effect on small ones.
+void preferHugePages(void* p, std::size_t bytes);
 
 // Checks that path names an existing regular file of at most maxBytes and gives its size;
 // otherwise false with a sentence ("the file does not exist", "is a character device, not a

@@ -34,9 +34,8 @@ FieldStatus parseNumber(std::string_view field, double& value) {
   const char* first = field.data() + b;
   const char* last = field.data() + e;
   if (*first == '+') ++first;  // from_chars does not accept a leading '+'
-  auto res = std::from_chars(first, last, value);
-  if (res.ec == std::errc::result_out_of_range) return FieldStatus::NotFinite;
-  if (res.ec != std::errc() || res.ptr != last) return FieldStatus::NotNumber;
+  const char* end = parseDouble(first, last, value);
+  if (end != last) return FieldStatus::NotNumber;
   if (!std::isfinite(value)) return FieldStatus::NotFinite;
   return FieldStatus::Ok;
 }

@@ -1,12 +1,21 @@
 #pragma once
 // Pieces the log readers share (internal to core/io): failures as ReadError, numbers and
 // fields of a text line, line counting, and the checks of the time column.
+#include <charconv>
+#include <cmath>
 #include <cstddef>
 #include <string>
 #include <string_view>
 #include <vector>
 
 #include "core/io/log_io.h"
+
+#if __has_include(<fast_float/fast_float.h>)
+#include <fast_float/fast_float.h>
+#define FLEXARM_HAVE_FAST_FLOAT 1
+#else
+#define FLEXARM_HAVE_FAST_FLOAT 0
+#endif
 
 namespace flexarm::io {
 
@@ -15,6 +24,24 @@ LogReadResult failure(const std::string& file, int line, int column, std::string
 
 std::string trim(std::string_view s);
 bool isBlank(std::string_view s);
+
+// One decimal number at [first, last): the end of what was read, or nullptr when nothing
+// there is a number. Every reader parses through this one primitive (fast_float when the
+// build has it, std::from_chars otherwise), so the fast and the careful path agree on every
+// input; an overflow gives an infinite value, which the callers refuse.
+inline const char* parseDouble(const char* first, const char* last, double& value) {
+#if FLEXARM_HAVE_FAST_FLOAT
+  const auto r = fast_float::from_chars(first, last, value);
+  return r.ec == std::errc() ? r.ptr : nullptr;
+#else
+  const auto r = std::from_chars(first, last, value);
+  if (r.ec == std::errc::result_out_of_range) {
+    value = HUGE_VAL;  // the magnitude does not matter: it is refused as not finite
+    return r.ptr;
+  }
+  return r.ec == std::errc() ? r.ptr : nullptr;
+#endif
+}
 
 enum class FieldStatus { Ok, Empty, NotNumber, NotFinite };
 // A C-locale decimal, blanks around it allowed, a leading '+' allowed; finite only.
