@@ -11,7 +11,7 @@ PACKAGES=(
   libmatio-dev libfftw3-dev nlohmann-json3-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   xvfb xauth libgl1-mesa-dri
-  poppler-utils python3-scipy zlib1g-dev
+  poppler-utils python3-scipy zlib1g-dev libfast-float-dev
   clang libclang-rt-14-dev
 )
 # clang and libclang-rt-14-dev (its sanitizer and libFuzzer runtimes, only recommended by

@@ -34,13 +34,14 @@ cmake --build "$build" -j "$jobs"
 # Leaks are errors; a failed check stops the test with a stack.
 export ASAN_OPTIONS="detect_leaks=1:abort_on_error=1:strict_string_checks=1:detect_stack_use_after_return=1"
 export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1"
+export LSAN_OPTIONS="suppressions=$here/tests/sanitizer/lsan.supp"
 export FLEXARM_TEST_REDUCED=1
 export XDG_CONFIG_HOME="$build/test-config"
 ctest --test-dir "$build" --output-on-failure -j "$jobs" --timeout 900
 # The tests that run threads (FFT planning, the split CSV parse, discovery's parallel
 # candidates, replays) again, several times, where a race has the best chance to show.
 ctest --test-dir "$build" --output-on-failure -j "$jobs" --timeout 900 \
-  -R "$(paste -sd '|' "$here/tests/threaded_tests.txt")" --repeat until-fail:3
+  -R "$(paste -sd '|' "$here/tests/threaded_tests.txt")" --repeat until-fail:2
 
 seconds="${FUZZ_SECONDS:-20}"
 if [ "$seconds" != 0 ]; then

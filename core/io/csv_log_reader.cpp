@@ -162,9 +162,9 @@ LogReadResult readFlexArmCsvText(std::string_view text, const std::string& path,
   int metadataLines = 0;
   while (cursor.next(line)) {
     if (io::isBlank(line)) continue;
-    std::string t = io::trim(line);
-    if (t[0] == '#') {
-      std::string body = io::trim(std::string_view(t).substr(1));
+    const std::size_t first = line.find_first_not_of(" \t\r");
+    if (line[first] == '#') {
+      std::string body = io::trim(line.substr(first + 1));
       std::size_t colon = body.find(':');
       if (colon != std::string::npos) {
         if (++metadataLines > LogReadOptions::kMaxMetadata)

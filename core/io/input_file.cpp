@@ -16,17 +16,8 @@
 namespace flexarm {
 namespace {
 
-const char* kindOf(mode_t mode) {
-  if (S_ISDIR(mode)) return "a directory";
-  if (S_ISCHR(mode)) return "a character device";
-  if (S_ISBLK(mode)) return "a block device";
-  if (S_ISFIFO(mode)) return "a pipe";
-  if (S_ISSOCK(mode)) return "a socket";
-  return "not a regular file";
-}
-
 std::string notRegular(mode_t mode) {
-  return std::string("is ") + kindOf(mode) +
+  return std::string("is ") + fileKind(mode) +
          ", not a regular file; FlexArm reads logs and sessions from regular files only "
          "(copy the data into a file first)";
 }
@@ -42,6 +33,15 @@ std::string openProblem(int error) {
 }
 
 }  // namespace
+
+const char* fileKind(unsigned mode) {
+  if (S_ISDIR(mode)) return "a directory";
+  if (S_ISCHR(mode)) return "a character device";
+  if (S_ISBLK(mode)) return "a block device";
+  if (S_ISFIFO(mode)) return "a pipe";
+  if (S_ISSOCK(mode)) return "a socket";
+  return "not a regular file";
+}
 
 std::string humanBytes(std::uint64_t n) {
   char buf[64];
@@ -86,10 +86,12 @@ std::unique_ptr<char, FileBufferDeleter> allocateBuffer(std::size_t n) {
 
 }  // namespace
 
-bool checkInputFile(const std::string& path, std::uint64_t maxBytes, std::uint64_t* size,
-                    std::string* problem) {
-  struct stat st {};
-  if (::stat(path.c_str(), &st) != 0) {
+namespace {
+
+// The checks on what stat says: a regular file of at most maxBytes.
+bool acceptable(int statResult, const struct stat& st, std::uint64_t maxBytes, std::uint64_t& size,
+                std::string* problem) {
+  if (statResult != 0) {
     if (problem) *problem = openProblem(errno);
     return false;
   }
@@ -97,11 +99,21 @@ bool checkInputFile(const std::string& path, std::uint64_t maxBytes, std::uint64
     if (problem) *problem = notRegular(st.st_mode);
     return false;
   }
-  const auto bytes = static_cast<std::uint64_t>(st.st_size);
-  if (bytes > maxBytes) {
-    if (problem) *problem = sizeProblem(bytes, maxBytes);
+  size = static_cast<std::uint64_t>(st.st_size);
+  if (size > maxBytes) {
+    if (problem) *problem = sizeProblem(size, maxBytes);
     return false;
   }
+  return true;
+}
+
+}  // namespace
+
+bool checkInputFile(const std::string& path, std::uint64_t maxBytes, std::uint64_t* size,
+                    std::string* problem) {
+  struct stat st {};
+  std::uint64_t bytes = 0;
+  if (!acceptable(::stat(path.c_str(), &st), st, maxBytes, bytes, problem)) return false;
   if (size) *size = bytes;
   return true;
 }
@@ -119,19 +131,8 @@ bool readInputFile(const std::string& path, std::uint64_t maxBytes, FileBytes& o
     ~Close() { ::close(fd); }
   } closer{fd};
   struct stat st {};
-  if (::fstat(fd, &st) != 0) {
-    if (problem) *problem = openProblem(errno);
-    return false;
-  }
-  if (!S_ISREG(st.st_mode)) {
-    if (problem) *problem = notRegular(st.st_mode);
-    return false;
-  }
-  const auto bytes = static_cast<std::uint64_t>(st.st_size);
-  if (bytes > maxBytes) {
-    if (problem) *problem = sizeProblem(bytes, maxBytes);
-    return false;
-  }
+  std::uint64_t bytes = 0;
+  if (!acceptable(::fstat(fd, &st), st, maxBytes, bytes, problem)) return false;
   out.size = 0;
   out.data = allocateBuffer(static_cast<std::size_t>(bytes));
   // A large file is read in parts by several threads at once: copying from the disk cache is

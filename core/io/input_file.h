@@ -44,6 +44,9 @@ bool readInputFile(const std::string& path, std::uint64_t maxBytes, FileBytes& o
 // first bytes; empty for plain text.
 std::string textEncodingProblem(std::string_view head);
 
+// What a stat mode names when it is not a regular file: "a character device", "a pipe", ...
+const char* fileKind(unsigned mode);
+
 // "3.0 GiB", "12.5 MiB", "512 bytes".
 std::string humanBytes(std::uint64_t n);
 

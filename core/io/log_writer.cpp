@@ -11,19 +11,11 @@
 #include <cstdio>
 #include <cstring>
 
+#include "core/io/input_file.h"
 #include "core/io/log_io.h"
 
 namespace flexarm {
 namespace {
-
-const char* kindOf(mode_t mode) {
-  if (S_ISDIR(mode)) return "a directory";
-  if (S_ISCHR(mode)) return "a character device";
-  if (S_ISBLK(mode)) return "a block device";
-  if (S_ISFIFO(mode)) return "a pipe";
-  if (S_ISSOCK(mode)) return "a socket";
-  return "not a regular file";
-}
 
 std::string writeProblem(const std::string& path, int error) {
   std::string s = "writing " + path + " failed: " + std::strerror(error);
@@ -44,7 +36,7 @@ bool writeFileAtomically(
   };
   struct stat st {};
   if (::stat(path.c_str(), &st) == 0 && !S_ISREG(st.st_mode))
-    return fail(path + " is " + kindOf(st.st_mode) +
+    return fail(path + " is " + fileKind(st.st_mode) +
                 ", not a regular file; FlexArm writes only regular files and does not replace it");
   static std::atomic<unsigned> counter{0};
   const std::string tmp =
