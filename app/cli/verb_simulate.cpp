@@ -143,7 +143,8 @@ int runSimulate(const std::vector<std::string>& argv, std::ostream& out, std::os
     if (!kind) return usage("--excitation must be chirp, multisine, prbs or none, not '" + *e + "'");
     o.excitation.kind = *kind;
   }
-  long seed = 1, counts = o.disturbance.encoderCountsPerRev, substeps = o.substeps;
+  long seed = 1;
+  int counts = static_cast<int>(o.disturbance.encoderCountsPerRev);
   double prbsClock = o.excitation.prbsClockS;
   if (!args.number("amplitude", o.excitation.amplitude) ||
       !args.number("multisine-period", o.excitation.multisinePeriodS) ||
@@ -154,13 +155,13 @@ int runSimulate(const std::vector<std::string>& argv, std::ostream& out, std::os
       !args.number("ti", o.controller.ti) ||
       !args.number("torque-noise", o.disturbance.torqueNoiseStd) ||
       !args.number("load-noise", o.disturbance.loadTorqueStd) || !args.integer("seed", seed) ||
-      !args.integer("encoder-counts", counts) || !args.integer("substeps", substeps))
+      !args.integer("encoder-counts", counts, 0, 1 << 30) ||
+      !args.integer("substeps", o.substeps, 1, 10000))
     return usage(args.error());
   o.excitation.prbsClockS = prbsClock;
+  o.disturbance.encoderCountsPerRev = counts;
   if (seed < 0) return usage("--seed must be >= 0");
   o.seed = static_cast<std::uint64_t>(seed);
-  o.disturbance.encoderCountsPerRev = counts;
-  o.substeps = static_cast<int>(substeps);
   o.logRateHz = o.controller.rateHz;
   if (!args.number("rate", o.logRateHz)) return usage(args.error());
   if (auto c = args.value("chirp");

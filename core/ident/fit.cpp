@@ -306,7 +306,14 @@ FitResult fitModel(const FitOptions& options, const ProgressCallback& progress) 
       case FitModelKind::Physical:
         if (!fit_detail::fitPhysical(options, r, progress)) return finish(r.termination, r.message);
         break;
-      case FitModelKind::BlackBox: fitBlackBox(options, r, progress); break;
+      case FitModelKind::BlackBox: {
+        std::string tooMuch;
+        r.badRequest = !options.model.orders.fitsData(
+            options.model.structure, static_cast<long long>(r.data.estimationOutput().size()), &tooMuch);
+        if (r.badRequest) return finish(Termination::Failed, tooMuch);
+        fitBlackBox(options, r, progress);
+        break;
+      }
       case FitModelKind::Spa:
       case FitModelKind::Etfe: fitNonparametric(options, r); break;
     }

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <complex>
+#include <set>
 
 #include "core/models/analysis.h"
 #include "core/session/discovery_part.h"
@@ -34,8 +35,19 @@ class ModelsPart : public SessionPart {
       if (why) *why = "must be a list of models";
       return false;
     }
-    for (const auto& m : section)
-      if (!modelFromJson(m, why)) return false;
+    if (section.size() > kMaxPartItems) {
+      if (why) *why = "more than " + std::to_string(kMaxPartItems) + " models";
+      return false;
+    }
+    std::set<std::string> names;
+    for (const auto& m : section) {
+      auto spec = modelFromJson(m, why);
+      if (!spec) return false;
+      if (!names.insert(spec->name).second) {
+        if (why) *why = "the model name '" + spec->name + "' is used twice";
+        return false;
+      }
+    }
     return true;
   }
 

@@ -13,7 +13,7 @@
 namespace flexarm {
 
 namespace {
-bool failWith(std::string* why, const char* text) {
+bool failWith(std::string* why, const std::string& text) {
   if (why) *why = text;
   return false;
 }
@@ -49,6 +49,18 @@ bool SimulationOptions::isValid(std::string* why) const {
   if (ratio < 1.0 - 1e-9 || std::abs(ratio - std::round(ratio)) > 1e-9)
     return failWith(why, "the log rate must divide the controller rate");
   if (substeps < 1 || substeps > 10000) return failWith(why, "substeps must be in 1..10000");
+  // Memory and time grow with the samples and controller ticks: bounded before allocating.
+  if (durationS * logRateHz > kMaxSamples)
+    return failWith(why, "the log would have " + std::to_string(std::llround(durationS * logRateHz)) +
+                             " samples (duration x log rate), more than the " +
+                             std::to_string(static_cast<long long>(kMaxSamples)) +
+                             " one simulation writes; shorten the duration or lower the rate");
+  if (durationS * controller.rateHz > kMaxTicks)
+    return failWith(why, "the simulation would run " +
+                             std::to_string(std::llround(durationS * controller.rateHz)) +
+                             " controller ticks (duration x controller rate), more than " +
+                             std::to_string(static_cast<long long>(kMaxTicks)) +
+                             "; shorten the duration or lower the controller rate");
   if (!std::isfinite(referenceVelocity)) return failWith(why, "reference velocity must be finite");
   if (why) why->clear();
   return true;

@@ -93,8 +93,9 @@ TEST(ClosedLoop, EncoderQuantizesTheMeasuredAngle) {
   SimulationOptions o = shortRun();
   o.disturbance.encoderCountsPerRev = 4096;
   const double q = 2.0 * M_PI / 4096;
-  for (double v : channel(simulateClosedLoop(*m, {}, o), columns::kMotorAngle))
-    EXPECT_NEAR(v / q, std::round(v / q), 1e-6);
+  // The result is kept by name: a range-for over a member of a temporary reads freed memory.
+  const SimulationResult r = simulateClosedLoop(*m, {}, o);
+  for (double v : channel(r, columns::kMotorAngle)) EXPECT_NEAR(v / q, std::round(v / q), 1e-6);
 }
 
 TEST(ClosedLoop, RandomIsReproducibleAndNormal) {
