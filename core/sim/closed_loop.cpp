@@ -52,6 +52,10 @@ bool SimulationOptions::isValid(std::string* why) const {
     return failWith(why, "the log rate must divide the controller rate");
   if (substeps < 1 || substeps > 10000) return failWith(why, "substeps must be in 1..10000");
   if (!std::isfinite(referenceVelocity)) return failWith(why, "reference velocity must be finite");
+  if (!referenceSignal.empty() && !(referenceSampleTime > 0.0 && std::isfinite(referenceSampleTime)))
+    return failWith(why, "a given reference signal needs a sample time > 0");
+  for (double v : referenceSignal)
+    if (!std::isfinite(v)) return failWith(why, "the given reference signal holds a non-finite value");
   for (const auto& s : parameterSteps)
     if (s.name.empty() || !std::isfinite(s.value) || !(s.timeS >= 0.0) || !std::isfinite(s.timeS))
       return failWith(why, "a parameter step needs a name, a finite value and a time >= 0");
@@ -104,7 +108,16 @@ SimulationResult simulateClosedLoop(const PhysicalModel& model, const std::vecto
   SimulationResult result;
 
   // Separate streams: the excitation must not change when the noise settings change.
-  const std::vector<double> excitation = makeExcitation(o.excitation, Tc, ticks, o.seed);
+  const bool given = !o.referenceSignal.empty();
+  const std::vector<double> excitation =
+      given ? std::vector<double>{} : makeExcitation(o.excitation, Tc, ticks, o.seed);
+  auto givenReference = [&o](double t) {
+    const double pos = t / o.referenceSampleTime;
+    const std::size_t i = static_cast<std::size_t>(pos);
+    if (i + 1 >= o.referenceSignal.size()) return o.referenceSignal.back();
+    const double f = pos - static_cast<double>(i);
+    return (1.0 - f) * o.referenceSignal[i] + f * o.referenceSignal[i + 1];
+  };
   Random noise(o.seed * 0x9E3779B97F4A7C15ull + 0x632BE59BD9B4E019ull);
 
   std::vector<double> applied(ticks, 0.0);  // torque reference + noise, per tick
@@ -143,7 +156,7 @@ SimulationResult simulateClosedLoop(const PhysicalModel& model, const std::vecto
     while (segment + 1 < schedule.plants.size() && t >= schedule.startTimes[segment + 1] - 1e-9 * Tc)
       active = schedule.plants[++segment].get();
     const NonlinearPlant& plant = *active;
-    const double reference = o.referenceVelocity * t + excitation[k];
+    const double reference = given ? givenReference(t) : o.referenceVelocity * t + excitation[k];
     const double angle = measure(plant.motorAngle(x));
     const double velocity = k == 0 ? 0.0 : (angle - previousAngle) / Tc;
     previousAngle = angle;
@@ -206,7 +219,7 @@ SimulationResult simulateClosedLoop(const PhysicalModel& model, const std::vecto
   d.setMeta("generator", "FlexArm simulator (closed loop, Figure 5.1)");
   d.setMeta("model", model.structureName());
   d.setMeta("effects", effectList.empty() ? "none" : effectList);
-  d.setMeta("excitation", toString(o.excitation.kind));
+  d.setMeta("excitation", given ? "given reference signal" : toString(o.excitation.kind));
   d.setMeta("seed", std::to_string(o.seed));
   if (!o.parameterSteps.empty()) {
     std::string steps;

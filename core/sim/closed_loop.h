@@ -61,6 +61,12 @@ struct SimulationOptions {
   bool logMotorVelocity = false;    // adds motor_velocity_rad_s (true velocity)
   bool logArmAcceleration = false;  // adds arm_accel_rad_s2 (true acceleration)
   bool logGear = false;             // adds gear_deflection_rad and gear_torque_nm
+  // A given position reference phi_ref (rad, motor side), sampled every referenceSampleTime s
+  // from t = 0 and interpolated linearly at the controller rate (held after its last sample),
+  // in place of the excitation and the reference velocity: to run the loop of a log again
+  // with the log's own reference. Empty: the excitation.
+  std::vector<double> referenceSignal;
+  double referenceSampleTime = 0.0;
   // Parameters that change during the run, applied in time order at the first controller
   // tick at or after their time. Empty: the model is the same throughout.
   std::vector<ParameterStep> parameterSteps;

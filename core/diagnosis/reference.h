@@ -1,0 +1,98 @@
+#pragma once
+// The fault-free reference a diagnosis compares with (the seed's Sections 6.5 and 7.5: "the
+// nominal parameters are estimated using the off-line identification procedure", on another
+// data set than the one diagnosed).
+//
+// theta_0 is the output-error fit of the physical model from the torque reference to the
+// motor velocity of a fault-free log (FlexArm's fit, direct): the criterion the recursive
+// estimator minimises sample by sample, so that on a healthy axis its estimates scatter
+// around theta_0 even where closed-loop data bias both alike ((4.43); on the sample logs the
+// direct fit puts f_m near 0.075 for a true 0.0355). The Monte-Carlo calibration needs the arm
+// itself, so the closed-loop fit that is free of that bias (two-stage, when the log has a
+// reference) is kept beside it as the plant to simulate.
+//
+// From a model instead of a log (a model of the list, typed values): the model is the plant,
+// and theta_0 is fitted as above on a fault-free run of it simulated under the monitored log's
+// controller and reference (diagnosis/simulate_like.h); without those, theta_0 is the model
+// itself and a sentence says that closed-loop bias then shows as a deviation.
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "core/common/progress.h"
+#include "core/diagnosis/diagnosis_data.h"
+#include "core/diagnosis/diagnosis_options.h"
+#include "core/models/physical_models.h"
+
+namespace flexarm {
+
+struct DiagnosisReference {
+  Termination termination = Termination::Failed;
+  std::string message;  // how it was made, or why it could not be
+  double seconds = 0.0;
+
+  // theta_0: the model the estimators run with; its monitored values are the tests' centre.
+  std::shared_ptr<const PhysicalModel> nominal;
+  // The arm the calibration simulates.
+  std::shared_ptr<const PhysicalModel> plant;
+  // Standard deviation of theta_0,i per monitored parameter in the estimator's form (J_a^-1),
+  // from the fit's covariance (7.4); 0 where the fit held the parameter (k_T).
+  std::vector<double> sigma0;
+  // lambda_0: mean squared output error of theta_0 on the fault-free data (0: not known).
+  double noiseVariance = 0.0;
+  // Mean squared output error of the plant on the fault-free data: the noise level the
+  // calibration reproduces (0: not known).
+  double plantNoiseVariance = 0.0;
+  // diag P(0) of the estimator of every monitored parameter and of each one alone (the bank of
+  // Section 7.5.2), from the seed's pre-run (Section 6.6.2) on the fault-free data; empty: to be
+  // formed on the monitored log.
+  std::vector<double> p0;
+  std::vector<double> p0Single;
+  std::string source;  // one sentence: where theta_0 came from
+
+  bool ok() const { return termination == Termination::Converged && nominal != nullptr; }
+};
+
+struct ReferenceOptions {
+  int maxIterations = 60;  // of each fit
+  bool fitPlant = true;    // also the closed-loop fit of the plant (for the calibration)
+  bool isValid(std::string* why) const;
+};
+
+// The fit of the physical model `start` (its free flags say what is fitted) as the diagnosis
+// uses it: output error on (u, y) (direct) for theta_0, or two-stage on (u, y, r) for the plant.
+// This is the one place the diagnosis calls FlexArm's fit. Data failures end as Failed with a
+// sentence.
+struct NominalFit {
+  Termination termination = Termination::Failed;
+  std::string message;
+  std::shared_ptr<const PhysicalModel> model;
+  std::vector<std::string> freeNames;
+  Eigen::MatrixXd covariance;  // of the free parameters, freeNames order
+  double loss = 0.0;           // mean squared output error on the data
+};
+NominalFit fitNominalModel(const PhysicalModel& start, const DiagnosisSignals& data, bool closedLoop,
+                           int maxIterations, const ProgressCallback& progress = {});
+
+// The reference from fault-free signals (a log's, or a simulated run's).
+DiagnosisReference referenceFromSignals(const PhysicalModel& start, const DiagnosisSignals& healthy,
+                                        const DiagnosisOptions& options,
+                                        const ReferenceOptions& referenceOptions = {},
+                                        const ProgressCallback& progress = {});
+// The reference from a fault-free log; a log the diagnosis cannot use is a Failed reference
+// with a sentence.
+DiagnosisReference referenceFromLog(const PhysicalModel& start, const IdData& healthy,
+                                    const DiagnosisOptions& options,
+                                    const ReferenceOptions& referenceOptions = {},
+                                    const ProgressCallback& progress = {});
+// The reference from a model believed fault-free, with the monitored log's controller and
+// reference signal to simulate it (see above).
+DiagnosisReference referenceFromModel(const PhysicalModel& model, const IdData& monitored,
+                                      const DiagnosisOptions& options,
+                                      const ReferenceOptions& referenceOptions = {},
+                                      const ProgressCallback& progress = {});
+
+// Output error (the simulated motor velocity from u) of a model on the signals.
+Eigen::VectorXd outputErrors(const PhysicalModel& model, const DiagnosisSignals& data);
+
+}  // namespace flexarm
