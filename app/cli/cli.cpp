@@ -21,6 +21,8 @@ const std::vector<Verb>& verbs() {
       {"run", "replay a saved session headless and write its PDF/HTML report", runRun},
       {"discover", "find the effect a physical model misses and show the gap shrink",
        runDiscover},
+      {"diagnose", "detect and isolate a fault in k_T, J_a or f_m from recursive estimates",
+       runDiagnose},
   };
   return kVerbs;
 }

@@ -71,5 +71,6 @@ int runBode(const std::vector<std::string>& args, std::ostream& out, std::ostrea
 int runLqg(const std::vector<std::string>& args, std::ostream& out, std::ostream& err);
 int runRun(const std::vector<std::string>& args, std::ostream& out, std::ostream& err);
 int runDiscover(const std::vector<std::string>& args, std::ostream& out, std::ostream& err);
+int runDiagnose(const std::vector<std::string>& args, std::ostream& out, std::ostream& err);
 
 }  // namespace flexarm::cli

@@ -138,6 +138,10 @@ DiagnosisReference completeReference(const DiagnosisReference& reference,
   DiagnosisReference ref = reference;
   if (!ref.ok()) return ref;
   const std::size_t n = options.parameters.size();
+  if (ref.predictor != monitored.predictor)
+    throw std::invalid_argument("diagnosis: the reference was fitted with the " +
+                                std::string(toString(ref.predictor)) + " predictor, the log is read with the " +
+                                toString(monitored.predictor) + " one");
   if (ref.noiseVariance <= 0.0 && options.estimator.noiseVariance <= 0.0) {
     const Eigen::VectorXd e = outputErrors(*ref.nominal, monitored);
     const Eigen::Index quarter = std::max<Eigen::Index>(1, e.size() / 4);
@@ -147,7 +151,8 @@ DiagnosisReference completeReference(const DiagnosisReference& reference,
     ref.noiseVariance = quietest;
   }
   if (ref.p0.size() != n || ref.p0Single.size() != n) {
-    const auto all = steadyStateCovariance(*ref.nominal, monitored.u, monitored.y,
+    const auto predictor = predictorModel(*ref.nominal, monitored);
+    const auto all = steadyStateCovariance(*predictor, monitored.input, monitored.output,
                                            monitored.sampleTime,
                                            estimatorOptions(options, options.parameters));
     if (all.termination != Termination::Converged) {
@@ -158,7 +163,7 @@ DiagnosisReference completeReference(const DiagnosisReference& reference,
     ref.p0.assign(all.p0.data(), all.p0.data() + all.p0.size());
     ref.p0Single.clear();
     for (const auto& name : options.parameters) {
-      const auto one = steadyStateCovariance(*ref.nominal, monitored.u, monitored.y,
+      const auto one = steadyStateCovariance(*predictor, monitored.input, monitored.output,
                                              monitored.sampleTime, estimatorOptions(options, {name}));
       if (one.termination != Termination::Converged || one.p0.size() != 1) {
         ref.termination = Termination::Failed;
@@ -194,7 +199,7 @@ DiagnosisResult diagnoseSignals(const DiagnosisReference& reference, const Diagn
   };
   if (!ref.ok()) return finish(Termination::Failed, ref.message);
 
-  DiagnosisMonitor monitor(ref, data.sampleTime, options, data.startTime);
+  DiagnosisMonitor monitor(ref, data, options);
   r.parameters = monitor.estimator().parameters();
   r.faults.clear();
   for (const auto& p : r.parameters) {
@@ -224,7 +229,7 @@ DiagnosisResult diagnoseSignals(const DiagnosisReference& reference, const Diagn
   std::string message;
   for (std::size_t i = 0; i < n; ++i) {
     const auto idx = static_cast<Eigen::Index>(i);
-    const RecursiveStep& step = monitor.update(data.u(idx), data.y(idx));
+    const RecursiveStep& step = monitor.update(data.input(idx), data.output(idx));
     if (!monitor.ok()) {
       ending = Termination::Diverged;
       message = "a recursive estimator left its bounds at " + seconds2(data.timeAt(idx)) + ": " +
@@ -262,7 +267,8 @@ DiagnosisResult diagnoseSignals(const DiagnosisReference& reference, const Diagn
 DiagnosisResult diagnose(const DiagnosisReference& reference, const IdData& log,
                          const DiagnosisOptions& options, const ProgressCallback& progress) {
   std::string why;
-  const auto data = diagnosisSignals(log, &why);
+  // Read as the reference was: the two predictors settle on different values.
+  const auto data = diagnosisSignals(log, reference.predictor, &why);
   if (!data) {
     DiagnosisResult r;
     r.options = options;

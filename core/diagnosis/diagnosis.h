@@ -94,9 +94,11 @@ struct DiagnosisResult {
 class DiagnosisMonitor {
  public:
   // The reference must be ok() with P(0) (p0, p0Single) and lambda_0 (or the estimator's own
-  // noiseVariance) set; throws std::invalid_argument otherwise or for invalid options.
-  DiagnosisMonitor(const DiagnosisReference& reference, double sampleTime,
-                   const DiagnosisOptions& options, double startTime = 0.0);
+  // noiseVariance) set; throws std::invalid_argument otherwise or for invalid options. Of the
+  // signals only the predictor, its controller, the sample time and the start time are used:
+  // update() is then fed their input and output sample by sample.
+  DiagnosisMonitor(const DiagnosisReference& reference, const DiagnosisSignals& signals,
+                   const DiagnosisOptions& options);
   ~DiagnosisMonitor();
   DiagnosisMonitor(const DiagnosisMonitor&) = delete;
   DiagnosisMonitor& operator=(const DiagnosisMonitor&) = delete;

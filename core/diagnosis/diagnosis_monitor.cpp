@@ -22,9 +22,10 @@ struct DiagnosisMonitor::Impl {
   std::vector<double> errors;
 };
 
-DiagnosisMonitor::DiagnosisMonitor(const DiagnosisReference& reference, double sampleTime,
-                                   const DiagnosisOptions& options, double startTime)
+DiagnosisMonitor::DiagnosisMonitor(const DiagnosisReference& reference,
+                                   const DiagnosisSignals& signals, const DiagnosisOptions& options)
     : impl_(std::make_unique<Impl>()) {
+  const double sampleTime = signals.sampleTime, startTime = signals.startTime;
   std::string why;
   if (!options.isValid(&why)) throw std::invalid_argument("diagnosis: " + why);
   if (!reference.ok()) throw std::invalid_argument("diagnosis: the reference is not usable: " + reference.message);
@@ -35,11 +36,12 @@ DiagnosisMonitor::DiagnosisMonitor(const DiagnosisReference& reference, double s
   Impl& m = *impl_;
   m.options = options;
   m.sampleTime = sampleTime;
+  const auto predictor = predictorModel(*reference.nominal, signals);
   auto estimator = [&](const std::vector<std::string>& names, std::vector<double> p0) {
     RecursiveOptions e = estimatorOptions(options, names);
     e.p0 = std::move(p0);
     if (e.noiseVariance == 0.0) e.noiseVariance = reference.noiseVariance;
-    return RecursiveEstimator(*reference.nominal, sampleTime, e, startTime);
+    return RecursiveEstimator(*predictor, sampleTime, e, startTime);
   };
   m.full = std::make_unique<RecursiveEstimator>(estimator(options.parameters, reference.p0));
   const auto& params = m.full->parameters();

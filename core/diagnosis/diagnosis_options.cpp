@@ -59,6 +59,21 @@ std::optional<std::vector<DiagnosisTest>> diagnosisTestsFromList(std::string_vie
   return tests;
 }
 
+const char* toString(DiagnosisPredictor p) {
+  switch (p) {
+    case DiagnosisPredictor::Auto: return "auto";
+    case DiagnosisPredictor::Loop: return "loop";
+    case DiagnosisPredictor::Direct: return "direct";
+  }
+  return "auto";
+}
+
+std::optional<DiagnosisPredictor> diagnosisPredictorFromString(std::string_view s) {
+  for (auto p : {DiagnosisPredictor::Auto, DiagnosisPredictor::Loop, DiagnosisPredictor::Direct})
+    if (s == toString(p)) return p;
+  return std::nullopt;
+}
+
 const char* toString(HypothesisWindow w) {
   return w == HypothesisWindow::Cumulative ? "cumulative" : "sliding";
 }

@@ -34,6 +34,15 @@ enum class HypothesisWindow { Cumulative, Sliding };
 const char* toString(HypothesisWindow w);  // "cumulative", "sliding"
 std::optional<HypothesisWindow> hypothesisWindowFromString(std::string_view s);
 
+// What the recursive estimators predict (see diagnosis_data.h):
+//  Direct: the motor velocity from the torque reference, as the seed (Section 6.1);
+//  Loop:   the motor angle from the position reference through the log's controller
+//          (loop_model.h), free of closed-loop bias;
+//  Auto:   Loop when the log has a reference channel and names its controller, else Direct.
+enum class DiagnosisPredictor { Auto, Loop, Direct };
+const char* toString(DiagnosisPredictor p);  // "auto", "loop", "direct"
+std::optional<DiagnosisPredictor> diagnosisPredictorFromString(std::string_view s);
+
 struct DiagnosisOptions {
   // The monitored parameters, by the model's names, each standing for one fault; those in
   // `inverted` are estimated as inverses (the seed's J_a^-1).
@@ -43,6 +52,7 @@ struct DiagnosisOptions {
   // `thetaStart` are set by the diagnosis (theta(0) = theta_0); the rest is used as given
   // (seed: forgetting factor, lambda = 0.995; P(0) from the reference's pre-run).
   RecursiveOptions estimator;
+  DiagnosisPredictor predictor = DiagnosisPredictor::Auto;
 
   std::vector<DiagnosisTest> tests = allDiagnosisTests();  // computed and reported
   // The tests whose alarms the decision structure combines into the verdict (a subset of

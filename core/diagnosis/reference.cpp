@@ -46,7 +46,7 @@ bool ReferenceOptions::isValid(std::string* why) const {
 }
 
 Eigen::VectorXd outputErrors(const PhysicalModel& model, const DiagnosisSignals& data) {
-  return data.y - simulate(model, data.u, data.sampleTime);
+  return data.output - simulate(*predictorModel(model, data), data.input, data.sampleTime);
 }
 
 NominalFit fitNominalModel(const PhysicalModel& start, const DiagnosisSignals& data, bool closedLoop,
@@ -64,14 +64,18 @@ NominalFit fitNominalModel(const PhysicalModel& start, const DiagnosisSignals& d
     ClosedLoopPemOptions o;
     o.method = ClosedLoopMethod::TwoStage;
     o.pem = pemOptions;
-    r = pemClosedLoop(start, data.u, data.y, data.r, data.sampleTime, o, progress).pem;
+    DiagnosisSignals direct = data;
+    direct.predictor = DiagnosisPredictor::Direct;
+    r = pemClosedLoop(*predictorModel(start, direct), data.u, data.velocity, data.r,
+                      data.sampleTime, o, progress).pem;
   } else {
-    r = pem(start, data.u, data.y, data.sampleTime, pemOptions, progress);
+    r = pem(*predictorModel(start, data), data.input, data.output, data.sampleTime, pemOptions,
+            progress);
   }
   fit.termination = r.summary.ok() ? Termination::Converged : r.summary.termination;
   fit.message = r.summary.message;
   if (!r.summary.ok() || !r.model) return fit;
-  fit.model = physicalCopy(*r.model);
+  fit.model = std::shared_ptr<const PhysicalModel>(plantOf(*r.model));
   fit.freeNames = r.freeNames;
   fit.covariance = r.covariance;
   fit.loss = outputErrors(*fit.model, data).squaredNorm() / static_cast<double>(data.size());
@@ -108,6 +112,7 @@ DiagnosisReference referenceFromSignals(const PhysicalModel& start, const Diagno
     return ref;
   }
   ref.nominal = nominal.model;
+  ref.predictor = healthy.predictor;
   ref.noiseVariance = nominal.loss;
   for (const auto& name : options.parameters) {
     const auto at = std::find(nominal.freeNames.begin(), nominal.freeNames.end(), name);
@@ -151,7 +156,8 @@ DiagnosisReference referenceFromSignals(const PhysicalModel& start, const Diagno
     ref.message = "cancelled";
     return ref;
   }
-  const InitialCovariance all = steadyStateCovariance(*ref.nominal, healthy.u, healthy.y,
+  const auto predictor = predictorModel(*ref.nominal, healthy);
+  const InitialCovariance all = steadyStateCovariance(*predictor, healthy.input, healthy.output,
                                                       healthy.sampleTime,
                                                       estimatorOptions(options, options.parameters));
   if (all.termination != Termination::Converged) {
@@ -163,7 +169,7 @@ DiagnosisReference referenceFromSignals(const PhysicalModel& start, const Diagno
   ref.p0.assign(all.p0.data(), all.p0.data() + all.p0.size());
   for (const auto& name : options.parameters) {
     const InitialCovariance one = steadyStateCovariance(
-        *ref.nominal, healthy.u, healthy.y, healthy.sampleTime, estimatorOptions(options, {name}));
+        *predictor, healthy.input, healthy.output, healthy.sampleTime, estimatorOptions(options, {name}));
     if (one.termination != Termination::Converged || one.p0.size() != 1) {
       ref.termination = Termination::Failed;
       ref.message = "P(0) for " + name + " alone could not be formed: " + one.message;
@@ -173,8 +179,8 @@ DiagnosisReference referenceFromSignals(const PhysicalModel& start, const Diagno
     ref.p0Single.push_back(one.p0(0));
   }
   ref.termination = Termination::Converged;
-  ref.source = "theta_0 from the output-error fit (direct, the recursive estimator's criterion) of " +
-               std::to_string(healthy.size()) + " fault-free samples; the plant for the calibration: " +
+  ref.source = "theta_0 from the output-error fit of " + std::to_string(healthy.size()) +
+               " fault-free samples, " + healthy.description + "; the plant for the calibration: " +
                plantNote;
   ref.message = ref.source;
   ref.seconds = seconds(begin);
@@ -186,7 +192,7 @@ DiagnosisReference referenceFromLog(const PhysicalModel& start, const IdData& he
                                     const ReferenceOptions& referenceOptions,
                                     const ProgressCallback& progress) {
   std::string why;
-  const auto signals = diagnosisSignals(healthy, &why);
+  const auto signals = diagnosisSignals(healthy, options.predictor, &why);
   if (!signals) {
     DiagnosisReference ref;
     ref.message = "the fault-free log cannot be used: " + why;
@@ -202,11 +208,12 @@ DiagnosisReference referenceFromModel(const PhysicalModel& model, const IdData& 
   const auto begin = std::chrono::steady_clock::now();
   std::string why;
   const auto conditions = logConditions(monitored, &why);
-  const auto signals = diagnosisSignals(monitored, nullptr);
+  const auto signals = diagnosisSignals(monitored, options.predictor, nullptr);
   if (!conditions || !signals) {
     // Nothing to simulate it with: the model itself, P(0) and lambda_0 from the monitored log.
     DiagnosisReference ref;
     ref.nominal = ref.plant = physicalCopy(model);
+    if (signals) ref.predictor = signals->predictor;
     ref.sigma0.assign(options.parameters.size(), 0.0);
     ref.termination = Termination::Converged;
     ref.source = "theta_0 is the model as given (" + (conditions ? std::string("the log has no usable signals") : why) +
@@ -224,10 +231,11 @@ DiagnosisReference referenceFromModel(const PhysicalModel& model, const IdData& 
   for (Eigen::Index q = 0; q + quarter <= e.size(); q += quarter)
     quietest = std::min(quietest, e.segment(q, quarter).squaredNorm() / static_cast<double>(quarter));
   std::string noiseNote;
-  const double scale = matchNoiseScale(model, *conditions, quietest, &noiseNote);
+  const double scale = matchNoiseScale(model, *conditions, signals->predictor, quietest, &noiseNote);
   const auto run = simulateClosedLoop(model, {}, runOptions(*conditions, scale, 20240601));
-  const auto healthy = run.termination == Termination::Converged ? diagnosisSignals(run.data, &why)
-                                                                   : std::nullopt;
+  const auto healthy = run.termination == Termination::Converged
+                           ? diagnosisSignals(run.data, signals->predictor, &why)
+                           : std::nullopt;
   if (!healthy) {
     DiagnosisReference ref;
     ref.message = "the model could not be simulated under the log's conditions: " +
@@ -240,9 +248,9 @@ DiagnosisReference referenceFromModel(const PhysicalModel& model, const IdData& 
   if (!ref.ok()) return ref;
   ref.plant = physicalCopy(model);
   ref.plantNoiseVariance = quietest;
-  ref.source = "theta_0 from the output-error fit (direct, the recursive estimator's criterion) of "
-               "a fault-free run of the given model simulated with " + conditions->note + " and " +
-               noiseNote + "; the plant for the calibration: the given model";
+  ref.source = "theta_0 from the output-error fit of a fault-free run of the given model simulated "
+               "with " + conditions->note + " and " + noiseNote + ", " + healthy->description +
+               "; the plant for the calibration: the given model";
   ref.message = ref.source;
   ref.seconds = seconds(begin);
   return ref;

@@ -3,13 +3,14 @@
 // nominal parameters are estimated using the off-line identification procedure", on another
 // data set than the one diagnosed).
 //
-// theta_0 is the output-error fit of the physical model from the torque reference to the
-// motor velocity of a fault-free log (FlexArm's fit, direct): the criterion the recursive
-// estimator minimises sample by sample, so that on a healthy axis its estimates scatter
-// around theta_0 even where closed-loop data bias both alike ((4.43); on the sample logs the
-// direct fit puts f_m near 0.075 for a true 0.0355). The Monte-Carlo calibration needs the arm
-// itself, so the closed-loop fit that is free of that bias (two-stage, when the log has a
-// reference) is kept beside it as the plant to simulate.
+// theta_0 is the output-error fit (FlexArm's prediction-error fit, pem) of the physical model
+// inside the diagnosis' predictor (diagnosis_data.h) on a fault-free log: the criterion the
+// recursive estimator minimises sample by sample, so that on a healthy axis its estimates
+// scatter around theta_0 even where the predictor is biased. With the direct predictor of the
+// seed, closed-loop data bias both alike ((4.43); on the sample logs the direct fit puts f_m
+// near 0.075 for a true 0.0355); the loop predictor is free of that bias. The Monte-Carlo
+// calibration needs the arm itself, so the two-stage closed-loop fit (when the log has a
+// reference) is kept beside theta_0 as the plant to simulate.
 //
 // From a model instead of a log (a model of the list, typed values): the model is the plant,
 // and theta_0 is fitted as above on a fault-free run of it simulated under the monitored log's
@@ -31,8 +32,12 @@ struct DiagnosisReference {
   std::string message;  // how it was made, or why it could not be
   double seconds = 0.0;
 
-  // theta_0: the model the estimators run with; its monitored values are the tests' centre.
+  // theta_0: the plant the estimators run with (inside the predictor); its monitored values
+  // are the tests' centre.
   std::shared_ptr<const PhysicalModel> nominal;
+  // The predictor theta_0 was fitted with (Loop or Direct): the monitored log is read the same
+  // way, since the two settle on different values.
+  DiagnosisPredictor predictor = DiagnosisPredictor::Direct;
   // The arm the calibration simulates.
   std::shared_ptr<const PhysicalModel> plant;
   // Standard deviation of theta_0,i per monitored parameter in the estimator's form (J_a^-1),
@@ -60,9 +65,9 @@ struct ReferenceOptions {
 };
 
 // The fit of the physical model `start` (its free flags say what is fitted) as the diagnosis
-// uses it: output error on (u, y) (direct) for theta_0, or two-stage on (u, y, r) for the plant.
-// This is the one place the diagnosis calls FlexArm's fit. Data failures end as Failed with a
-// sentence.
+// uses it: output error of the predictor (input to output) for theta_0, or two-stage on
+// (u, velocity, r) for the plant. This is the one place the diagnosis calls FlexArm's fit.
+// Data failures end as Failed with a sentence.
 struct NominalFit {
   Termination termination = Termination::Failed;
   std::string message;
@@ -92,7 +97,7 @@ DiagnosisReference referenceFromModel(const PhysicalModel& model, const IdData& 
                                       const ReferenceOptions& referenceOptions = {},
                                       const ProgressCallback& progress = {});
 
-// Output error (the simulated motor velocity from u) of a model on the signals.
+// Output error of the plant inside the signals' predictor (simulated from the input).
 Eigen::VectorXd outputErrors(const PhysicalModel& model, const DiagnosisSignals& data);
 
 }  // namespace flexarm

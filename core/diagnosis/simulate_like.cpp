@@ -55,11 +55,11 @@ SimulationOptions runOptions(const LogConditions& conditions, double noiseScale,
 }
 
 double matchNoiseScale(const PhysicalModel& plant, const LogConditions& conditions,
-                       double targetMeanSquare, std::string* note) {
+                       DiagnosisPredictor predictor, double targetMeanSquare, std::string* note) {
   auto meanSquare = [&](double scale) -> double {
     const auto run = simulateClosedLoop(plant, {}, runOptions(conditions, scale, 1));
     if (run.termination != Termination::Converged) return NAN;
-    auto s = diagnosisSignals(run.data, nullptr);
+    auto s = diagnosisSignals(run.data, predictor, nullptr);
     return s ? outputErrors(plant, *s).squaredNorm() / static_cast<double>(s->size()) : NAN;
   };
   const double quiet = meanSquare(0.0), loud = meanSquare(1.0);
@@ -72,7 +72,7 @@ double matchNoiseScale(const PhysicalModel& plant, const LogConditions& conditio
     char buf[160];
     std::snprintf(buf, sizeof buf,
                   "torque and load noise %.3g times the simulator's defaults (output error RMS %.3g "
-                  "rad/s as on the fault-free log)",
+                  "as on the fault-free log)",
                   scale, std::sqrt(targetMeanSquare));
     *note = buf;
   }
