@@ -5,6 +5,7 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <ostream>
+#include <sstream>
 
 #include "app/cli/cli.h"
 #include "app/cli/log_args.h"
@@ -56,6 +57,8 @@ const char* kDiagnoseHelp =
     "  --hypothesis-threshold C  threshold of the normalised hypothesis statistics (1)\n"
     "  --confirm S           a diagnosis must hold S seconds to become the verdict (0)\n"
     "  --settle S            no alarm in the first S seconds (0)\n"
+    "  --seed-fault NAME=F   make a fault out of fault-free data as the seed's Section 7.5 does:\n"
+    "                        theta_0 of NAME (J_a as J_a^-1) times F (1.2 for its 20 %)\n"
     "  --trace FILE.csv      write time, estimates, every test's statistic, threshold and S\n"
     "  --calibrate           choose every test's threshold by Monte-Carlo runs of the plant\n"
     "                        under LOG's conditions (controller, rate, length, reference) at the\n"
@@ -118,16 +121,19 @@ std::string calibrationText(const CalibrationResult& c) {
   std::string s = "Calibration: " + c.conditions + ".\n";
   char line[300];
   for (const auto& t : c.tests) {
-    if (t.chosen < 0) {
-      s += std::string("  ") + toString(t.test) + ": no threshold on the grid meets the rate\n";
-      continue;
+    std::string thresholds;
+    for (double v : t.thresholds) {
+      char buf[32];
+      std::snprintf(buf, sizeof buf, "%s%.4g", thresholds.empty() ? "" : ", ", v);
+      thresholds += buf;
     }
-    const auto& p = t.curve[static_cast<std::size_t>(t.chosen)];
+    const auto& p = t.point;
     std::snprintf(line, sizeof line,
-                  "  %-10s threshold %.4g: %.3g false alarms per hour (95 %% bound %.3g), %.0f %% "
+                  "  %-10s threshold%s %s%s: %.3g false alarms per hour (95 %% bound %.3g), %.0f %% "
                   "isolated within the horizon, median delay %s\n",
-                  toString(t.test), p.threshold, p.falseAlarmsPerHour, p.falseAlarmsPerHourUpper,
-                  100.0 * p.isolatedFraction, delayText(p.medianDelayS).c_str());
+                  toString(t.test), t.thresholds.size() > 1 ? "s" : "", thresholds.c_str(),
+                  t.met ? "" : " (the largest tried; the rate is not met)", p.falseAlarmsPerHour,
+                  p.falseAlarmsPerHourUpper, 100.0 * p.isolatedFraction, delayText(p.medianDelayS).c_str());
     s += line;
   }
   return s + "  " + c.message + ".\n";
@@ -140,6 +146,7 @@ int runDiagnose(const std::vector<std::string>& argv, std::ostream& out, std::os
   for (const auto& v : modelValuedOptions()) valued.push_back(v);
   for (const char* n : {"reference-log", "monitor", "tests", "decide", "window", "lambda", "k",
                         "alpha1", "alpha2", "hypothesis-threshold", "confirm", "settle", "trace", "predictor",
+                        "seed-fault",
                         "false-alarms-per-hour", "runs", "threads"})
     valued.push_back(n);
   auto flags = modelFlagOptions();
@@ -249,6 +256,13 @@ int runDiagnose(const std::vector<std::string>& argv, std::ostream& out, std::os
   if (!reference.ok()) {
     err << pre << reference.message << "\n";
     return kExitNumerical;
+  }
+  if (auto f = args.value("seed-fault")) {
+    const auto eq = f->find('=');
+    double factor = 0.0;
+    if (eq == std::string::npos || !(std::istringstream(f->substr(eq + 1)) >> factor))
+      return usage("--seed-fault expects NAME=FACTOR (e.g. k_T=1.2), not '" + *f + "'");
+    reference = withSeedFault(reference, options, f->substr(0, eq), factor);
   }
   std::optional<CalibrationResult> calibrated;
   if (args.flag("calibrate")) {

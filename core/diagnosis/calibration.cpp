@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <functional>
 #include <limits>
 #include <mutex>
 #include <stdexcept>
@@ -45,7 +46,7 @@ double quantile(std::vector<double> v, double q) {
   return v[i];
 }
 
-// What the calibration keeps of a run: the ratio traces (as floats) and the times.
+// What the calibration keeps of a run: the ratio traces and the times.
 struct RunTrace {
   bool ok = false;
   std::string message;
@@ -55,40 +56,66 @@ struct RunTrace {
   std::vector<TestTrace> traces;  // ratio only
 };
 
+// The reference of a run: its own, or fitted on a fault-free run of the same arm.
+std::shared_ptr<const DiagnosisReference> referenceFor(const MonteCarloRun& m,
+                                                       const DiagnosisOptions& options,
+                                                       std::string* why) {
+  if (m.reference) return m.reference;
+  const auto run = simulateClosedLoop(
+      *m.plant, {}, runOptions(m.conditions, m.noiseScale, m.referenceSeed, {}, m.durationS));
+  if (run.termination != Termination::Converged) {
+    *why = "the fault-free reference run failed: " + run.message;
+    return nullptr;
+  }
+  const auto signals = diagnosisSignals(run.data, options.predictor, why);
+  if (!signals) return nullptr;
+  ReferenceOptions ro;
+  ro.fitPlant = false;
+  auto ref = std::make_shared<DiagnosisReference>(referenceFromSignals(*m.plant, *signals, options, ro));
+  if (!ref->ok()) {
+    *why = "the reference of the simulated arm failed: " + ref->message;
+    return nullptr;
+  }
+  return ref;
+}
+
 // One simulated run through the whole pipeline.
-RunTrace runOnce(const DiagnosisReference& simReference, const PhysicalModel& plant,
-                 const LogConditions& conditions, double noiseScale, const DiagnosisOptions& options,
-                 const CalibrationOptions& c, int fault, std::uint64_t seed) {
+RunTrace runOnce(const MonteCarloRun& m, const DiagnosisOptions& options) {
   RunTrace out;
-  out.fault = fault;
-  const double duration = c.durationS > 0.0 ? c.durationS : conditions.simulation.durationS;
-  const double faultTime = c.faultTimeS > 0.0 ? c.faultTimeS : 0.5 * duration;
+  out.fault = m.fault;
+  std::string why;
+  const auto reference = referenceFor(m, options, &why);
+  if (!reference) {
+    out.message = why;
+    return out;
+  }
+  const double duration = m.durationS > 0.0 ? m.durationS : m.conditions.simulation.durationS;
   std::vector<ParameterStep> steps;
-  if (fault >= 0) {
-    const std::string& name = options.parameters[static_cast<std::size_t>(fault)];
+  if (m.fault >= 0) {
+    const std::string& name = options.parameters[static_cast<std::size_t>(m.fault)];
     const bool inverted =
         std::find(options.inverted.begin(), options.inverted.end(), name) != options.inverted.end();
-    const double v = plant.value(name);
-    steps.push_back({name, inverted ? v / (1.0 + c.faultSize) : v * (1.0 + c.faultSize), faultTime});
+    const double v = m.plant->value(name);
+    steps.push_back({name, inverted ? v / (1.0 + m.faultSize) : v * (1.0 + m.faultSize), m.faultTimeS});
   }
-  const auto run = simulateClosedLoop(plant, {}, runOptions(conditions, noiseScale, seed, steps, duration));
+  const auto run = simulateClosedLoop(*m.plant, {},
+                                      runOptions(m.conditions, m.noiseScale, m.seed, steps, duration));
   if (run.termination != Termination::Converged) {
     out.message = run.message;
     return out;
   }
-  std::string why;
-  const auto signals = diagnosisSignals(run.data, simReference.predictor, &why);
+  const auto signals = diagnosisSignals(run.data, reference->predictor, &why);
   if (!signals) {
     out.message = why;
     return out;
   }
-  DiagnosisResult r = diagnoseSignals(simReference, *signals, options);
+  DiagnosisResult r = diagnoseSignals(*reference, *signals, options);
   if (r.termination != Termination::Converged) {
     out.message = r.message;
     return out;
   }
   out.ok = true;
-  out.from = fault >= 0 ? faultTime : options.settleS;
+  out.from = m.fault >= 0 ? m.faultTimeS : options.settleS;
   out.time = std::move(r.time);
   for (auto& t : r.tests) {
     TestTrace compact;
@@ -132,6 +159,18 @@ double designThreshold(DiagnosisTest test, const DiagnosisOptions& o) {
   return 1.0;
 }
 
+DiagnosisOptions withColumnScales(const DiagnosisOptions& options, DiagnosisTest test,
+                                  const std::vector<double>& scales) {
+  DiagnosisOptions o = options;
+  std::vector<double>* v = o.scales(test);
+  if (!v) return withThresholdScale(o, test, scales.empty() ? 1.0 : scales.front());
+  if (scales.size() != o.parameters.size())
+    throw std::invalid_argument("one threshold factor per monitored parameter expected");
+  if (v->empty()) v->assign(scales.size(), 1.0);
+  for (std::size_t i = 0; i < scales.size(); ++i) (*v)[i] *= scales[i];
+  return o;
+}
+
 DiagnosisOptions withThresholdScale(const DiagnosisOptions& options, DiagnosisTest test, double scale) {
   DiagnosisOptions o = options;
   switch (test) {
@@ -152,25 +191,44 @@ CalibrationResult calibrateUnder(const DiagnosisReference& reference, const LogC
   if (!calibration.isValid(&why)) throw std::invalid_argument("calibration: " + why);
   if (!reference.ok() || !reference.plant)
     throw std::invalid_argument("calibration: the reference is not usable: " + reference.message);
-  const auto begin = std::chrono::steady_clock::now();
-  CalibrationResult result;
-  result.noiseScale = noiseScale;
-  result.calibrated = options;
-  auto finish = [&](Termination t, std::string message) {
-    result.termination = t;
-    result.message = std::move(message);
-    result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - begin).count();
-    return result;
-  };
-  const PhysicalModel& plant = *reference.plant;
-  for (const auto& name : options.parameters) {
-    if (plant.indexOf(name) < 0)
-      throw std::invalid_argument("calibration: the plant has no parameter " + name);
-    result.faults.push_back(name);
-  }
   const double duration = calibration.durationS > 0.0 ? calibration.durationS : conditions.simulation.durationS;
   const double faultTime = calibration.faultTimeS > 0.0 ? calibration.faultTimeS : 0.5 * duration;
-  if (faultTime >= duration) return finish(Termination::Failed, "the fault would step in after the run's end");
+  if (faultTime >= duration) {
+    CalibrationResult r;
+    r.message = "the fault would step in after the run's end";
+    return r;
+  }
+  // theta_0 of the simulated arm, fitted on a fault-free run as on the real log, shared by
+  // every run.
+  MonteCarloRun base;
+  base.plant = reference.plant;
+  base.conditions = conditions;
+  base.noiseScale = noiseScale;
+  base.referenceSeed = calibration.seed;
+  base.faultSize = calibration.faultSize;
+  base.faultTimeS = faultTime;
+  base.durationS = duration;
+  DiagnosisOptions same = options;
+  same.predictor = reference.predictor;
+  base.reference = referenceFor(base, same, &why);
+  if (!base.reference) {
+    CalibrationResult r;
+    r.message = why;
+    return r;
+  }
+  std::vector<MonteCarloRun> runs;
+  std::uint64_t seed = calibration.seed + 1;
+  for (int i = 0; i < calibration.healthyRuns; ++i) {
+    runs.push_back(base);
+    runs.back().seed = seed++;
+  }
+  for (std::size_t p = 0; p < options.parameters.size(); ++p)
+    for (int i = 0; i < calibration.faultyRuns; ++i) {
+      runs.push_back(base);
+      runs.back().seed = seed++;
+      runs.back().fault = static_cast<int>(p);
+    }
+  CalibrationResult result = monteCarlo(runs, same, calibration, progress);
   char text[400];
   std::snprintf(text, sizeof text,
                 "%d fault-free and %d x %zu faulty runs of %.3g s (fault of %+.0f %% at %.3g s) of the "
@@ -178,71 +236,106 @@ CalibrationResult calibrateUnder(const DiagnosisReference& reference, const LogC
                 calibration.healthyRuns, calibration.faultyRuns, options.parameters.size(), duration,
                 100.0 * calibration.faultSize, faultTime, conditions.note.c_str(), noiseScale);
   result.conditions = text;
+  result.noiseScale = noiseScale;
+  return result;
+}
 
-  // theta_0 of the simulated arm, fitted on a fault-free run as on the real log.
-  const auto referenceRun =
-      simulateClosedLoop(plant, {}, runOptions(conditions, noiseScale, calibration.seed, {}, duration));
-  const auto referenceSignals = referenceRun.termination == Termination::Converged
-                                    ? diagnosisSignals(referenceRun.data, reference.predictor, &why)
-                                    : std::nullopt;
-  if (!referenceSignals)
-    return finish(Termination::Failed, "the fault-free reference run could not be simulated: " +
-                                           (referenceRun.termination == Termination::Converged ? why : referenceRun.message));
-  ReferenceOptions ro;
-  ro.fitPlant = false;
-  DiagnosisOptions same = options;
-  same.predictor = reference.predictor;
-  const DiagnosisReference simReference = referenceFromSignals(plant, *referenceSignals, same, ro);
-  if (!simReference.ok())
-    return finish(Termination::Failed, "the reference of the simulated arm failed: " + simReference.message);
+CalibrationResult monteCarlo(const std::vector<MonteCarloRun>& plan, const DiagnosisOptions& options,
+                             const CalibrationOptions& calibration, const ProgressCallback& progress) {
+  std::string why;
+  if (!options.isValid(&why)) throw std::invalid_argument("Monte Carlo: " + why);
+  if (!calibration.isValid(&why)) throw std::invalid_argument("Monte Carlo: " + why);
+  for (const auto& m : plan)
+    if (!m.plant) throw std::invalid_argument("Monte Carlo: a run without a plant");
+  const auto begin = std::chrono::steady_clock::now();
+  CalibrationResult result;
+  result.calibrated = options;
+  auto finish = [&](Termination t, std::string message) {
+    result.termination = t;
+    result.message = std::move(message);
+    result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - begin).count();
+    return result;
+  };
+  result.faults = options.parameters;
 
-  // The runs, in parallel; progress and cancellation from this thread.
-  std::vector<int> faultOf;
-  for (int i = 0; i < calibration.healthyRuns; ++i) faultOf.push_back(-1);
-  for (std::size_t p = 0; p < options.parameters.size(); ++p)
-    for (int i = 0; i < calibration.faultyRuns; ++i) faultOf.push_back(static_cast<int>(p));
-  std::vector<RunTrace> runs(faultOf.size());
-  std::atomic<std::size_t> next{0}, done{0};
+  // Runs of one arm share its reference: fitted first, once per arm, then every run; both in
+  // parallel, with progress and cancellation from this thread.
+  std::vector<MonteCarloRun> filled = plan;
+  std::vector<std::size_t> owner(plan.size());  // the first run of each arm fits its reference
+  for (std::size_t i = 0; i < plan.size(); ++i) {
+    owner[i] = i;
+    for (std::size_t j = 0; j < i; ++j)
+      if (!plan[i].reference && plan[j].plant == plan[i].plant &&
+          plan[j].referenceSeed == plan[i].referenceSeed) {
+        owner[i] = owner[j];
+        break;
+      }
+  }
+  std::vector<std::string> failures(plan.size());
   std::atomic<bool> cancel{false};
-  auto worker = [&]() {
-    for (std::size_t i = next++; i < runs.size() && !cancel; i = next++) {
+  auto parallel = [&](std::size_t count, const std::function<void(std::size_t)>& work, double from,
+                      double to) {
+    std::atomic<std::size_t> next{0}, done{0};
+    auto body = [&](std::size_t i) {
       try {
-        runs[i] = runOnce(simReference, plant, conditions, noiseScale, options, calibration, faultOf[i],
-                          calibration.seed + 1 + i);
+        work(i);
       } catch (const std::exception& e) {
-        runs[i].message = e.what();
+        failures[i] = e.what();
       }
       ++done;
+    };
+    std::vector<std::thread> pool;
+    for (int t = 1; t < calibration.threads; ++t)
+      pool.emplace_back([&]() {
+        for (std::size_t i = next++; i < count && !cancel; i = next++) body(i);
+      });
+    for (std::size_t i = next++; i < count && !cancel; i = next++) {
+      body(i);
+      if (reportProgress(progress, from + (to - from) * static_cast<double>(done) / static_cast<double>(count),
+                         "calibrate"))
+        cancel = true;
     }
+    for (auto& t : pool) t.join();
   };
-  std::vector<std::thread> pool;
-  for (int t = 1; t < calibration.threads; ++t) pool.emplace_back(worker);
-  for (std::size_t i = next++; i < runs.size() && !cancel; i = next++) {
-    try {
-      runs[i] = runOnce(simReference, plant, conditions, noiseScale, options, calibration, faultOf[i],
-                        calibration.seed + 1 + i);
-    } catch (const std::exception& e) {
-      runs[i].message = e.what();
-    }
-    ++done;
-    if (reportProgress(progress, static_cast<double>(done) / static_cast<double>(runs.size()), "calibrate"))
-      cancel = true;
-  }
-  for (auto& t : pool) t.join();
+  parallel(plan.size(), [&](std::size_t i) {
+    if (owner[i] != i || plan[i].reference) return;
+    std::string problem;
+    filled[i].reference = referenceFor(plan[i], options, &problem);
+    if (!filled[i].reference) failures[i] = problem;
+  }, 0.0, 0.2);
+  for (std::size_t i = 0; i < plan.size(); ++i)
+    if (!failures[owner[i]].empty())
+      return finish(Termination::Failed, "a simulated arm could not be referenced: " + failures[owner[i]]);
+    else if (!filled[i].reference)
+      filled[i].reference = filled[owner[i]].reference;
+  std::vector<RunTrace> runs(plan.size());
+  if (!cancel) parallel(plan.size(), [&](std::size_t i) { runs[i] = runOnce(filled[i], options); }, 0.2, 1.0);
   if (cancel) return finish(Termination::Cancelled, "cancelled");
-  for (const auto& r : runs)
-    if (!r.ok) return finish(Termination::Failed, "a simulated run could not be diagnosed: " + r.message);
+  for (std::size_t i = 0; i < runs.size(); ++i)
+    if (!failures[i].empty()) runs[i].message = failures[i];
+  for (std::size_t i = 0; i < runs.size(); ++i)
+    if (!runs[i].ok) {
+      const MonteCarloRun& m = plan[i];
+      char what[200];
+      std::snprintf(what, sizeof what, "run %zu (%s, %s, noise %.3g, seed %llu)", i + 1,
+                    m.fault < 0 ? "fault-free"
+                                : ("fault in " + options.parameters[static_cast<std::size_t>(m.fault)] +
+                                   " at " + std::to_string(m.faultTimeS) + " s").c_str(),
+                    m.conditions.note.c_str(), m.noiseScale, static_cast<unsigned long long>(m.seed));
+      return finish(Termination::Failed, std::string(what) + " could not be diagnosed: " + runs[i].message);
+    }
 
-  result.healthyRuns = calibration.healthyRuns;
-  result.faultyRuns = calibration.faultyRuns * static_cast<int>(options.parameters.size());
-  for (const auto& r : runs)
+  for (const auto& r : runs) {
+    (r.fault < 0 ? result.healthyRuns : result.faultyRuns) += 1;
     if (r.fault < 0 && !r.time.empty())
       result.healthyHours += std::max(0.0, r.time.back() - r.from + (r.time.size() > 1 ? r.time[1] - r.time[0] : 0.0)) / 3600.0;
-
-  // One threshold of a set of tests over every run: false alarms, isolation and delays.
+  }
+  // Thresholds of a set of tests over every run: false alarms, isolation and delays; the
+  // alarms of each column on the fault-free runs go to *columnAlarms.
   const std::size_t faults = options.parameters.size();
-  auto evaluate = [&](const std::vector<std::size_t>& which, const std::vector<double>& scales,
-                      std::vector<double>* isolatedPerFault, std::vector<double>* delayPerFault) {
+  auto evaluate = [&](const std::vector<std::size_t>& which, const std::vector<std::vector<double>>& scales,
+                      std::vector<double>* isolatedPerFault, std::vector<double>* delayPerFault,
+                      std::vector<int>* columnAlarms) {
     CalibrationPoint point;
     std::vector<std::vector<double>> delays(faults);
     int isolated = 0, wrong = 0, faulty = 0;
@@ -252,6 +345,10 @@ CalibrationResult calibrateUnder(const DiagnosisReference& reference, const LogC
       const TestOutcome o = evaluateTests(traces, scales, r.time, result.faults, options.confirmS, r.from);
       if (r.fault < 0) {
         point.falseAlarms += o.detectionEvents;
+        if (columnAlarms) {
+          columnAlarms->resize(o.alarmEvents.size(), 0);
+          for (std::size_t q = 0; q < o.alarmEvents.size(); ++q) (*columnAlarms)[q] += o.alarmEvents[q];
+        }
         continue;
       }
       ++faulty;
@@ -285,43 +382,61 @@ CalibrationResult calibrateUnder(const DiagnosisReference& reference, const LogC
     return point;
   };
 
-  const std::vector<double> scales = calibration.scales.empty() ? defaultScales() : calibration.scales;
+  // The false-alarm budget: the stated rate shared by the tests of the decision, then by a
+  // test's columns.
+  std::size_t deciding = 0;
+  for (DiagnosisTest t : options.tests) deciding += options.decides(t) ? 1 : 0;
+  std::vector<double> scales = calibration.scales.empty() ? defaultScales() : calibration.scales;
+  std::sort(scales.begin(), scales.end());
   for (std::size_t k = 0; k < options.tests.size(); ++k) {
     TestCalibration tc;
     tc.test = options.tests[k];
-    for (double s : scales) {
-      CalibrationPoint p = evaluate({k}, {s}, nullptr, nullptr);
-      p.scale = s;
-      p.threshold = s * designThreshold(tc.test, options);
+    const bool hypothesis = tc.test == DiagnosisTest::Hypothesis;
+    const std::size_t columns = runs.front().traces[k].columns.size();
+    const double testBudget = calibration.targetFalseAlarmsPerHour /
+                              static_cast<double>(options.decides(tc.test) ? std::max<std::size_t>(1, deciding) : 1);
+    const double columnBudget = hypothesis ? testBudget : testBudget / static_cast<double>(columns);
+    std::vector<double> chosen(hypothesis ? 1 : columns, 0.0);
+    for (double c : scales) {
+      std::vector<int> alarms;
+      CalibrationPoint p = evaluate({k}, {{c}}, nullptr, nullptr, &alarms);
+      p.scale = c;
+      p.threshold = c * designThreshold(tc.test, options);
       tc.curve.push_back(p);
-    }
-    std::sort(tc.curve.begin(), tc.curve.end(),
-              [](const CalibrationPoint& a, const CalibrationPoint& b) { return a.scale < b.scale; });
-    for (std::size_t i = 0; i < tc.curve.size(); ++i)
-      if (tc.curve[i].falseAlarmsPerHour <= calibration.targetFalseAlarmsPerHour) {
-        tc.chosen = static_cast<int>(i);
-        break;
+      const double hours = std::max(result.healthyHours, 1e-12);
+      if (hypothesis) {
+        if (chosen[0] == 0.0 && p.falseAlarms / hours <= columnBudget) chosen[0] = c;
+      } else {
+        for (std::size_t q = 0; q < columns; ++q)
+          if (chosen[q] == 0.0 && alarms[q] / hours <= columnBudget) chosen[q] = c;
       }
-    if (tc.chosen >= 0) {
-      const double s = tc.curve[static_cast<std::size_t>(tc.chosen)].scale;
-      evaluate({k}, {s}, &tc.isolatedFraction, &tc.medianDelayS);
-      result.calibrated = withThresholdScale(result.calibrated, tc.test, s);
     }
+    tc.met = std::all_of(chosen.begin(), chosen.end(), [](double c) { return c > 0.0; });
+    for (double& c : chosen)
+      if (c == 0.0) c = scales.back();
+    tc.columnScales = chosen;
+    for (std::size_t q = 0; q < chosen.size(); ++q)
+      tc.thresholds.push_back(chosen[q] * designThreshold(tc.test, options) *
+                              (hypothesis ? 1.0 : options.thresholdScale(tc.test, q)));
+    tc.point = evaluate({k}, {chosen}, &tc.isolatedFraction, &tc.medianDelayS, nullptr);
+    tc.point.scale = *std::max_element(chosen.begin(), chosen.end());
+    tc.point.threshold = tc.thresholds.front();
+    result.calibrated = withColumnScales(result.calibrated, tc.test, chosen);
     result.tests.push_back(tc);
   }
 
   // The decision over the calibrated thresholds.
   std::vector<std::size_t> which;
-  std::vector<double> decisionScales;
+  std::vector<std::vector<double>> decisionScales;
   for (DiagnosisTest t : options.decision)
     for (std::size_t k = 0; k < options.tests.size(); ++k)
       if (options.tests[k] == t) {
         which.push_back(k);
-        const auto& tc = result.tests[k];
-        decisionScales.push_back(tc.chosen >= 0 ? tc.curve[static_cast<std::size_t>(tc.chosen)].scale : 1.0);
+        decisionScales.push_back(result.tests[k].columnScales);
       }
   result.decision = evaluate(which, decisionScales, &result.decisionIsolatedFraction,
-                             &result.decisionMedianDelayS);
+                             &result.decisionMedianDelayS, nullptr);
+  char text[400];
   std::snprintf(text, sizeof text,
                 "%.3g h of fault-free simulated time: the decision raised %d false alarms (%.3g per "
                 "hour, at most %.3g at 95 %%) and isolated %.0f %% of the faults within %.3g s",
@@ -342,8 +457,8 @@ CalibrationResult calibrate(const DiagnosisReference& reference, const IdData& l
     return r;
   }
   std::string note;
-  const double scale = matchNoiseScale(*reference.plant, *conditions, reference.predictor,
-                                       reference.plantNoiseVariance, &note);
+  const double scale = matchNoiseScale(*reference.plant, *reference.plant, *conditions,
+                                       reference.predictor, reference.noiseVariance, &note);
   CalibrationResult r = calibrateUnder(reference, *conditions, scale, options, calibration, progress);
   if (r.termination == Termination::Converged) r.conditions += "; " + note;
   return r;

@@ -12,8 +12,9 @@
 //
 // A test's threshold is scaled by c (the classical and robust 3 sigma by c, the CUSUM's h by c,
 // the hypothesis threshold 1 by c); the calibrated threshold is the smallest c on the grid
-// whose false-alarm rate on the fault-free runs does not exceed the stated rate. The rate is
-// estimated from few hours of simulated time, so its 95 % upper bound is given beside it.
+// whose false-alarm rate on the fault-free runs does not exceed the stated rate, chosen for
+// each parameter of a test on its own (TestCalibration). The rate is estimated from a few
+// hours of simulated time, so its 95 % upper bound is given beside it.
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -55,9 +56,16 @@ struct CalibrationPoint {
 
 struct TestCalibration {
   DiagnosisTest test = DiagnosisTest::Classical;
-  std::vector<CalibrationPoint> curve;  // one point per scale, increasing
-  int chosen = -1;                      // index of the calibrated threshold (-1: none meets it)
-  // Per fault (monitored parameter) at the chosen threshold: isolated fraction and median delay.
+  std::vector<CalibrationPoint> curve;  // one scale c for every column, c increasing
+  // The calibrated thresholds: the false-alarm budget of the test (the stated rate shared
+  // evenly by the tests of the decision) is shared evenly by its columns (the parameters;
+  // the hypothesis tests have one threshold), and each column gets the smallest c on the grid
+  // that keeps within its share. met: every column found one (else the largest c is kept).
+  bool met = false;
+  std::vector<double> columnScales;  // per column (one value for the hypothesis tests)
+  std::vector<double> thresholds;    // the same in the test's units: k, alpha_2, or the level
+  CalibrationPoint point;            // the test at those thresholds
+  // Per fault (monitored parameter) at those thresholds: isolated fraction and median delay.
   std::vector<double> isolatedFraction, medianDelayS;
 };
 
@@ -82,6 +90,10 @@ struct CalibrationResult {
 // hypothesis threshold) and the options with a test's threshold set to scale times it.
 double designThreshold(DiagnosisTest test, const DiagnosisOptions& options);
 DiagnosisOptions withThresholdScale(const DiagnosisOptions& options, DiagnosisTest test, double scale);
+// The options with a test's thresholds multiplied per column (parameter tests: one factor per
+// monitored parameter; hypothesis tests: one factor).
+DiagnosisOptions withColumnScales(const DiagnosisOptions& options, DiagnosisTest test,
+                                  const std::vector<double>& scales);
 
 // Runs the calibration for the reference's plant under the conditions of `log`. Data failures
 // (a log that cannot be simulated again, a simulated run the pipeline cannot fit) end as Failed
@@ -90,10 +102,32 @@ CalibrationResult calibrate(const DiagnosisReference& reference, const IdData& l
                             const DiagnosisOptions& options, const CalibrationOptions& calibration,
                             const ProgressCallback& progress = {});
 
-// The same for given conditions (the Monte-Carlo studies of the tests and the bench).
+// The same for given conditions and noise scale.
 CalibrationResult calibrateUnder(const DiagnosisReference& reference, const LogConditions& conditions,
                                  double noiseScale, const DiagnosisOptions& options,
                                  const CalibrationOptions& calibration,
                                  const ProgressCallback& progress = {});
+
+// One simulated run of a Monte-Carlo study: an arm, its conditions and noise, a seed, and the
+// fault that steps in (none: fault < 0). Without a reference, theta_0 is fitted on a fault-free
+// run of the same arm under the same conditions (seed referenceSeed), as on a real axis.
+struct MonteCarloRun {
+  std::shared_ptr<const PhysicalModel> plant;
+  LogConditions conditions;
+  double noiseScale = 1.0;
+  std::uint64_t seed = 1, referenceSeed = 0;
+  int fault = -1;         // index into DiagnosisOptions::parameters
+  double faultSize = 0.2; // the monitored quantity (theta's form) rises by this part
+  double faultTimeS = 0.0;
+  double durationS = 0.0; // 0: the conditions'
+  std::shared_ptr<const DiagnosisReference> reference;
+};
+
+// Runs every run through the whole pipeline and evaluates the tests over the threshold scales
+// of `calibration` (its run counts, fault size and times are not used: the runs say them).
+// Conditions, noise scale and counts in the result describe the runs only in general terms.
+CalibrationResult monteCarlo(const std::vector<MonteCarloRun>& runs, const DiagnosisOptions& options,
+                             const CalibrationOptions& calibration,
+                             const ProgressCallback& progress = {});
 
 }  // namespace flexarm

@@ -24,8 +24,9 @@ DecisionStructure decisionStructure(DiagnosisTest test, const std::vector<std::s
 }
 
 TestOutcome evaluateTests(const std::vector<const TestTrace*>& traces,
-                          const std::vector<double>& scales, const std::vector<double>& time,
-                          const std::vector<std::string>& faults, double confirmS, double from) {
+                          const std::vector<std::vector<double>>& scales,
+                          const std::vector<double>& time, const std::vector<std::string>& faults,
+                          double confirmS, double from) {
   if (traces.size() != scales.size())
     throw std::invalid_argument("evaluateTests: one scale per trace expected");
   TestOutcome out;
@@ -35,6 +36,9 @@ TestOutcome evaluateTests(const std::vector<const TestTrace*>& traces,
     structures.push_back(decisionStructure(t->test, faults));
     if (structures.back().columns().size() != t->columns.size())
       throw std::invalid_argument("evaluateTests: the trace does not match its decision structure");
+    const auto& sc = scales[structures.size() - 1];
+    if (sc.size() != 1 && sc.size() != t->columns.size())
+      throw std::invalid_argument("evaluateTests: one scale, or one per column, for each trace");
     columns += t->columns.size();
   }
   out.firstAlarm.assign(columns, std::nullopt);
@@ -53,7 +57,7 @@ TestOutcome evaluateTests(const std::vector<const TestTrace*>& traces,
       const TestTrace& t = *traces[j];
       fired.assign(t.columns.size(), false);
       for (std::size_t q = 0; q < t.columns.size(); ++q, ++c) {
-        const bool f = live && t.ratio[q][k] > scales[j];
+        const bool f = live && t.ratio[q][k] > scales[j][scales[j].size() == 1 ? 0 : q];
         fired[q] = f;
         if (f && !firing[c]) {
           ++out.alarmEvents[c];
@@ -143,12 +147,7 @@ DiagnosisReference completeReference(const DiagnosisReference& reference,
                                 std::string(toString(ref.predictor)) + " predictor, the log is read with the " +
                                 toString(monitored.predictor) + " one");
   if (ref.noiseVariance <= 0.0 && options.estimator.noiseVariance <= 0.0) {
-    const Eigen::VectorXd e = outputErrors(*ref.nominal, monitored);
-    const Eigen::Index quarter = std::max<Eigen::Index>(1, e.size() / 4);
-    double quietest = e.squaredNorm() / static_cast<double>(e.size());
-    for (Eigen::Index q = 0; q + quarter <= e.size(); q += quarter)
-      quietest = std::min(quietest, e.segment(q, quarter).squaredNorm() / static_cast<double>(quarter));
-    ref.noiseVariance = quietest;
+    ref.noiseVariance = quietestMeanSquare(outputErrors(*ref.nominal, monitored));
   }
   if (ref.p0.size() != n || ref.p0Single.size() != n) {
     const auto predictor = predictorModel(*ref.nominal, monitored);
@@ -255,11 +254,11 @@ DiagnosisResult diagnoseSignals(const DiagnosisReference& reference, const Diagn
 
   const double from = data.startTime + options.settleS;
   for (const auto& t : r.tests)
-    r.outcomes.push_back(evaluateTests({&t}, {1.0}, r.time, r.faults, options.confirmS, from));
+    r.outcomes.push_back(evaluateTests({&t}, {{1.0}}, r.time, r.faults, options.confirmS, from));
   std::vector<const TestTrace*> deciding;
   for (DiagnosisTest t : r.decisionTests) deciding.push_back(r.trace(t));
-  r.decision = evaluateTests(deciding, std::vector<double>(deciding.size(), 1.0), r.time, r.faults,
-                             options.confirmS, from);
+  r.decision = evaluateTests(deciding, std::vector<std::vector<double>>(deciding.size(), {1.0}),
+                             r.time, r.faults, options.confirmS, from);
   if (ending == Termination::Converged) message = r.summary();
   return finish(ending, message);
 }

@@ -50,11 +50,13 @@ struct TestOutcome {
 DecisionStructure decisionStructure(DiagnosisTest test, const std::vector<std::string>& faults);
 
 // S of each sample from the columns of the traces that fire at their threshold times `scales`
-// (one per trace; the intersection of the tests' statements when there are several), with no
-// alarm before `from` (s), and the verdict reached with confirmS (decision.h).
+// (per trace one factor per column, or a single one for every column; the intersection of the
+// tests' statements when there are several), with no alarm before `from` (s), and the verdict
+// reached with confirmS (decision.h).
 TestOutcome evaluateTests(const std::vector<const TestTrace*>& traces,
-                          const std::vector<double>& scales, const std::vector<double>& time,
-                          const std::vector<std::string>& faults, double confirmS, double from);
+                          const std::vector<std::vector<double>>& scales,
+                          const std::vector<double>& time, const std::vector<std::string>& faults,
+                          double confirmS, double from);
 
 struct DiagnosisResult {
   Termination termination = Termination::Failed;

@@ -15,9 +15,11 @@ nlohmann::json finiteOrNull(double v) { return std::isfinite(v) ? nlohmann::json
 
 nlohmann::json thresholdsJson(DiagnosisTest t, const DiagnosisOptions& o) {
   switch (t) {
-    case DiagnosisTest::Classical: return {{"k", o.classicalK}};
-    case DiagnosisTest::Robust: return {{"k", o.robustK}, {"lambda", o.robustLambda}};
-    case DiagnosisTest::Cusum: return {{"alpha1", o.cusumAlpha1}, {"alpha2", o.cusumAlpha2}};
+    case DiagnosisTest::Classical: return {{"k", o.classicalK}, {"factors", o.classicalScales}};
+    case DiagnosisTest::Robust:
+      return {{"k", o.robustK}, {"lambda", o.robustLambda}, {"factors", o.robustScales}};
+    case DiagnosisTest::Cusum:
+      return {{"alpha1", o.cusumAlpha1}, {"alpha2", o.cusumAlpha2}, {"factors", o.cusumScales}};
     case DiagnosisTest::Hypothesis:
       return {{"threshold", o.hypothesisThreshold},
               {"window", toString(o.window)},
@@ -126,7 +128,10 @@ nlohmann::json calibrationJson(const CalibrationResult& r) {
     nlohmann::json curve = nlohmann::json::array();
     for (const auto& p : t.curve) curve.push_back(pointJson(p));
     tests[toString(t.test)] = {
-        {"chosen", t.chosen >= 0 ? pointJson(t.curve[static_cast<std::size_t>(t.chosen)]) : nlohmann::json()},
+        {"met", t.met},
+        {"column_scales", t.columnScales},
+        {"thresholds", t.thresholds},
+        {"calibrated", pointJson(t.point)},
         {"per_fault", perFault(r.faults, t.isolatedFraction, t.medianDelayS)},
         {"curve", curve}};
   }

@@ -51,15 +51,18 @@ DiagnosisMonitor::DiagnosisMonitor(const DiagnosisReference& reference,
     switch (t) {
       case DiagnosisTest::Classical:
         for (std::size_t i = 0; i < n; ++i)
-          m.classical.emplace_back(params[i].nominal, sigma0[i], options.classicalK);
+          m.classical.emplace_back(params[i].nominal, sigma0[i],
+                                   options.classicalK * options.thresholdScale(t, i));
         break;
       case DiagnosisTest::Robust:
         for (std::size_t i = 0; i < n; ++i)
-          m.robust.emplace_back(params[i].nominal, sigma0[i], options.robustK, options.robustLambda);
+          m.robust.emplace_back(params[i].nominal, sigma0[i], options.robustK * options.thresholdScale(t, i),
+                                options.robustLambda);
         break;
       case DiagnosisTest::Cusum:
         for (std::size_t i = 0; i < n; ++i)
-          m.cusum.emplace_back(params[i].nominal, options.cusumAlpha1, options.cusumAlpha2);
+          m.cusum.emplace_back(params[i].nominal, options.cusumAlpha1,
+                               options.cusumAlpha2 * options.thresholdScale(t, i));
         break;
       case DiagnosisTest::Hypothesis: {
         m.nominal = std::make_unique<RecursiveEstimator>(estimator({}, {}));

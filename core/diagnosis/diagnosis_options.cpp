@@ -84,6 +84,21 @@ std::optional<HypothesisWindow> hypothesisWindowFromString(std::string_view s) {
   return std::nullopt;
 }
 
+std::vector<double>* DiagnosisOptions::scales(DiagnosisTest t) {
+  switch (t) {
+    case DiagnosisTest::Classical: return &classicalScales;
+    case DiagnosisTest::Robust: return &robustScales;
+    case DiagnosisTest::Cusum: return &cusumScales;
+    case DiagnosisTest::Hypothesis: return nullptr;
+  }
+  return nullptr;
+}
+
+double DiagnosisOptions::thresholdScale(DiagnosisTest t, std::size_t i) const {
+  const auto* v = const_cast<DiagnosisOptions*>(this)->scales(t);
+  return v && i < v->size() ? (*v)[i] : 1.0;
+}
+
 bool DiagnosisOptions::uses(DiagnosisTest t) const {
   return std::find(tests.begin(), tests.end(), t) != tests.end();
 }
@@ -118,6 +133,12 @@ bool DiagnosisOptions::isValid(std::string* why) const {
     return failWith(why, "the hypothesis tests' threshold must be > 0");
   if (window == HypothesisWindow::Sliding && !positive(windowS))
     return failWith(why, "the sliding window must be longer than 0 s");
+  for (const auto* v : {&classicalScales, &robustScales, &cusumScales}) {
+    if (!v->empty() && v->size() != parameters.size())
+      return failWith(why, "threshold factors need one value per monitored parameter");
+    for (double x : *v)
+      if (!positive(x)) return failWith(why, "threshold factors must be > 0");
+  }
   if (!(confirmS >= 0.0) || !std::isfinite(confirmS) || !(settleS >= 0.0) || !std::isfinite(settleS))
     return failWith(why, "the confirmation and settling times must be >= 0 s");
   RecursiveOptions e = estimatorOptions(*this, parameters);

@@ -69,11 +69,20 @@ struct DiagnosisOptions {
   double hypothesisThreshold = 1.0;  // the seed's natural choice after normalisation
   HypothesisWindow window = HypothesisWindow::Cumulative;
   double windowS = 5.0;        // length of the sliding window, s
+  // Per-parameter factors on the thresholds of the classical, robust and CUSUM tests, one per
+  // monitored parameter (empty: 1 for each), as the calibration chooses them: the seed's
+  // h = alpha_2 theta_0 (7.17) is in the parameter's own units, so one alpha_2 does not give
+  // every parameter the same false-alarm rate.
+  std::vector<double> classicalScales, robustScales, cusumScales;
   // A diagnosis statement must hold this long before it becomes the verdict (0: at once).
   double confirmS = 0.0;
-  // No alarm is raised before this time (the estimator's start-up transient), s.
-  double settleS = 0.0;
+  // No alarm is raised before this time: the start-up transient of the estimators and of the
+  // hypothesis sums (the seed: "in the first few seconds there is a transient behavior"), s.
+  double settleS = 2.0;
 
+  // The factor on test t's threshold for monitored parameter i (1 for the hypothesis tests).
+  double thresholdScale(DiagnosisTest t, std::size_t i) const;
+  std::vector<double>* scales(DiagnosisTest t);
   bool uses(DiagnosisTest t) const;
   bool decides(DiagnosisTest t) const;
   bool isValid(std::string* why) const;

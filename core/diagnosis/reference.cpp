@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <stdexcept>
 
 #include "core/diagnosis/simulate_like.h"
@@ -47,6 +48,15 @@ bool ReferenceOptions::isValid(std::string* why) const {
 
 Eigen::VectorXd outputErrors(const PhysicalModel& model, const DiagnosisSignals& data) {
   return data.output - simulate(*predictorModel(model, data), data.input, data.sampleTime);
+}
+
+double quietestMeanSquare(const Eigen::VectorXd& e) {
+  if (e.size() == 0) return 0.0;
+  const Eigen::Index quarter = std::max<Eigen::Index>(1, e.size() / 4);
+  double quietest = e.squaredNorm() / static_cast<double>(e.size());
+  for (Eigen::Index q = 0; q + quarter <= e.size(); q += quarter)
+    quietest = std::min(quietest, e.segment(q, quarter).squaredNorm() / static_cast<double>(quarter));
+  return quietest;
 }
 
 NominalFit fitNominalModel(const PhysicalModel& start, const DiagnosisSignals& data, bool closedLoop,
@@ -146,8 +156,6 @@ DiagnosisReference referenceFromSignals(const PhysicalModel& start, const Diagno
       plantNote = "the direct fit (the two-stage fit failed: " + plant.message + ")";
     }
   }
-  ref.plantNoiseVariance =
-      outputErrors(*ref.plant, healthy).squaredNorm() / static_cast<double>(healthy.size());
 
   // P(0) as the seed forms it (Section 6.6.2), on the fault-free data: for the estimator of
   // every monitored parameter and for each one alone.
@@ -185,6 +193,28 @@ DiagnosisReference referenceFromSignals(const PhysicalModel& start, const Diagno
   ref.message = ref.source;
   ref.seconds = seconds(begin);
   return ref;
+}
+
+DiagnosisReference withSeedFault(const DiagnosisReference& reference, const DiagnosisOptions& options,
+                                 const std::string& name, double factor) {
+  if (std::find(options.parameters.begin(), options.parameters.end(), name) == options.parameters.end())
+    throw std::invalid_argument("a seed fault needs a monitored parameter, not '" + name + "'");
+  if (!reference.nominal) throw std::invalid_argument("the reference has no theta_0");
+  if (!(factor > 0.0) || !std::isfinite(factor))
+    throw std::invalid_argument("a seed fault's factor must be a positive number");
+  const bool inverted =
+      std::find(options.inverted.begin(), options.inverted.end(), name) != options.inverted.end();
+  auto copy = reference.nominal->clone();
+  const double v = reference.nominal->value(name);
+  copy->setParameter(name, inverted ? v / factor : v * factor);
+  DiagnosisReference out = reference;
+  out.nominal = physicalCopy(*copy);
+  char buf[120];
+  std::snprintf(buf, sizeof buf, "; a fault made as the seed does (Section 7.5): theta_0 of %s%s times %.4g",
+                name.c_str(), inverted ? "^-1" : "", factor);
+  out.source += buf;
+  out.message = out.source;
+  return out;
 }
 
 DiagnosisReference referenceFromLog(const PhysicalModel& start, const IdData& healthy,
@@ -225,13 +255,9 @@ DiagnosisReference referenceFromModel(const PhysicalModel& model, const IdData& 
   }
   // The noise level: the model's output error on the quietest quarter of the monitored log (a
   // fault raises it where it acts).
-  const Eigen::VectorXd e = outputErrors(model, *signals);
-  const Eigen::Index quarter = std::max<Eigen::Index>(1, e.size() / 4);
-  double quietest = e.squaredNorm() / static_cast<double>(e.size());
-  for (Eigen::Index q = 0; q + quarter <= e.size(); q += quarter)
-    quietest = std::min(quietest, e.segment(q, quarter).squaredNorm() / static_cast<double>(quarter));
+  const double quietest = quietestMeanSquare(outputErrors(model, *signals));
   std::string noiseNote;
-  const double scale = matchNoiseScale(model, *conditions, signals->predictor, quietest, &noiseNote);
+  const double scale = matchNoiseScale(model, model, *conditions, signals->predictor, quietest, &noiseNote);
   const auto run = simulateClosedLoop(model, {}, runOptions(*conditions, scale, 20240601));
   const auto healthy = run.termination == Termination::Converged
                            ? diagnosisSignals(run.data, signals->predictor, &why)
@@ -247,7 +273,6 @@ DiagnosisReference referenceFromModel(const PhysicalModel& model, const IdData& 
   DiagnosisReference ref = referenceFromSignals(model, *healthy, options, noPlant, progress);
   if (!ref.ok()) return ref;
   ref.plant = physicalCopy(model);
-  ref.plantNoiseVariance = quietest;
   ref.source = "theta_0 from the output-error fit of a fault-free run of the given model simulated "
                "with " + conditions->note + " and " + noiseNote + ", " + healthy->description +
                "; the plant for the calibration: the given model";

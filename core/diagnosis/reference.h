@@ -43,11 +43,9 @@ struct DiagnosisReference {
   // Standard deviation of theta_0,i per monitored parameter in the estimator's form (J_a^-1),
   // from the fit's covariance (7.4); 0 where the fit held the parameter (k_T).
   std::vector<double> sigma0;
-  // lambda_0: mean squared output error of theta_0 on the fault-free data (0: not known).
+  // lambda_0: mean squared output error of theta_0 on the fault-free data (0: not known); the
+  // calibration simulates the plant at the noise level that gives the same.
   double noiseVariance = 0.0;
-  // Mean squared output error of the plant on the fault-free data: the noise level the
-  // calibration reproduces (0: not known).
-  double plantNoiseVariance = 0.0;
   // diag P(0) of the estimator of every monitored parameter and of each one alone (the bank of
   // Section 7.5.2), from the seed's pre-run (Section 6.6.2) on the fault-free data; empty: to be
   // formed on the monitored log.
@@ -97,7 +95,18 @@ DiagnosisReference referenceFromModel(const PhysicalModel& model, const IdData& 
                                       const ReferenceOptions& referenceOptions = {},
                                       const ProgressCallback& progress = {});
 
+// The seed's way of making a fault out of fault-free data (Section 7.5: "to simulate a fault the
+// initial value of the faulty parameter is changed"): theta_0 of one monitored parameter, in
+// the estimator's form (J_a^-1), multiplied by `factor` (1.2 for the seed's 20 %), so that the
+// estimates on the data settle 1/factor off it. Throws std::invalid_argument for a name that is
+// not monitored or a value the model refuses.
+DiagnosisReference withSeedFault(const DiagnosisReference& reference, const DiagnosisOptions& options,
+                                 const std::string& name, double factor);
+
 // Output error of the plant inside the signals' predictor (simulated from the input).
 Eigen::VectorXd outputErrors(const PhysicalModel& model, const DiagnosisSignals& data);
+// The mean square of e over its quietest quarter: the noise level of a log in which a fault
+// may raise the error over part of the time.
+double quietestMeanSquare(const Eigen::VectorXd& e);
 
 }  // namespace flexarm

@@ -54,13 +54,16 @@ SimulationOptions runOptions(const LogConditions& conditions, double noiseScale,
   return o;
 }
 
-double matchNoiseScale(const PhysicalModel& plant, const LogConditions& conditions,
-                       DiagnosisPredictor predictor, double targetMeanSquare, std::string* note) {
+double matchNoiseScale(const PhysicalModel& plant, const PhysicalModel& start,
+                       const LogConditions& conditions, DiagnosisPredictor predictor,
+                       double targetMeanSquare, std::string* note) {
   auto meanSquare = [&](double scale) -> double {
     const auto run = simulateClosedLoop(plant, {}, runOptions(conditions, scale, 1));
     if (run.termination != Termination::Converged) return NAN;
     auto s = diagnosisSignals(run.data, predictor, nullptr);
-    return s ? outputErrors(plant, *s).squaredNorm() / static_cast<double>(s->size()) : NAN;
+    if (!s) return NAN;
+    const NominalFit fit = fitNominalModel(start, *s, false, 60);
+    return fit.termination == Termination::Converged ? fit.loss : NAN;
   };
   const double quiet = meanSquare(0.0), loud = meanSquare(1.0);
   if (!(targetMeanSquare > 0.0) || !std::isfinite(quiet) || !std::isfinite(loud) || loud <= quiet) {
@@ -71,8 +74,8 @@ double matchNoiseScale(const PhysicalModel& plant, const LogConditions& conditio
   if (note) {
     char buf[160];
     std::snprintf(buf, sizeof buf,
-                  "torque and load noise %.3g times the simulator's defaults (output error RMS %.3g "
-                  "as on the fault-free log)",
+                  "torque and load noise %.3g times the simulator's defaults (theta_0's output "
+                  "error RMS %.3g as on the fault-free log)",
                   scale, std::sqrt(targetMeanSquare));
     *note = buf;
   }

@@ -29,11 +29,13 @@ std::optional<LogConditions> logConditions(const IdData& log, std::string* why);
 SimulationOptions runOptions(const LogConditions& conditions, double noiseScale, std::uint64_t seed,
                              const std::vector<ParameterStep>& steps = {}, double durationS = 0.0);
 
-// The noise scale at which the plant's output error (through the predictor) on a simulated run
-// matches the given mean square (that of the plant on the fault-free log): runs at scale 1 and
-// 0 (quantisation only) and the quadratic growth of the mean square in between. 1 when the
-// level cannot be matched (a sentence in *note says why).
-double matchNoiseScale(const PhysicalModel& plant, const LogConditions& conditions,
-                       DiagnosisPredictor predictor, double targetMeanSquare, std::string* note);
+// The noise scale at which a simulated run of the plant looks as noisy to the diagnosis as the
+// fault-free log did: lambda_0, the mean squared output error of the predictor fitted to the
+// run (as theta_0 is fitted to the log, starting from `start`), matches targetMeanSquare. Runs
+// at scale 1 and 0 (quantisation only) and the quadratic growth in between. 1 when the level
+// cannot be matched (a sentence in *note says why).
+double matchNoiseScale(const PhysicalModel& plant, const PhysicalModel& start,
+                       const LogConditions& conditions, DiagnosisPredictor predictor,
+                       double targetMeanSquare, std::string* note);
 
 }  // namespace flexarm
