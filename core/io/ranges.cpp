@@ -1,33 +1,9 @@
 #include "core/io/ranges.h"
 
 #include <algorithm>
-#include <charconv>
 #include <cmath>
-#include <cstdio>
 
 namespace flexarm {
-
-bool parseSecondsRange(const std::string& text, double& t0, double& t1) {
-  const auto colon = text.find(':');
-  if (colon == std::string::npos) return false;
-  auto parse = [](const std::string& s, double& v) {
-    const char* b = s.data();
-    const char* e = s.data() + s.size();
-    while (b < e && *b == ' ') ++b;
-    while (e > b && e[-1] == ' ') --e;
-    if (b < e && *b == '+') ++b;
-    auto r = std::from_chars(b, e, v);
-    return r.ec == std::errc() && r.ptr == e && std::isfinite(v);
-  };
-  return parse(text.substr(0, colon), t0) && parse(text.substr(colon + 1), t1) && t1 > t0;
-}
-
-std::string formatSecondsRange(const IdData& data, const SampleRange& r) {
-  char buf[96];
-  const std::size_t last = r.end > 0 ? r.end - 1 : 0;
-  std::snprintf(buf, sizeof buf, "%.9g:%.9g", data.timeAt(r.begin), data.timeAt(last));
-  return buf;
-}
 
 bool applyStoredRanges(IdData& data, std::string* why) {
   struct Slot {

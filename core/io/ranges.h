@@ -4,16 +4,12 @@
 #include <string>
 
 #include "core/signal/id_data.h"
+#include "core/signal/seconds_range.h"
 
 namespace flexarm {
 
 inline constexpr const char* kEstimationRangeKey = "estimation_range_s";
 inline constexpr const char* kValidationRangeKey = "validation_range_s";
-
-// Parses "A:B" (seconds, A < B); false when malformed.
-bool parseSecondsRange(const std::string& text, double& t0, double& t1);
-// "A:B" for a sample range of data, in seconds.
-std::string formatSecondsRange(const IdData& data, const SampleRange& r);
 
 // Sets data's ranges from its metadata; false with a message when a stored range is malformed.
 bool applyStoredRanges(IdData& data, std::string* why);

@@ -2,6 +2,7 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "core/ident/pem.h"
 #include "core/recursive/covariance_update.h"
 #include "core/recursive/extended_zoh.h"
 #include "core/recursive/rpem.h"
@@ -62,9 +63,20 @@ struct RecursiveEstimator::Impl {
   std::vector<Eigen::VectorXd> noInputDerivatives;
   Eigen::MatrixXd noSensitivities;
 
+  // A theta that never moves (updateParameters false, or nothing estimated: the pre-run for
+  // P(0), a fixed predictor): the model is sampled once with sampleZoh's exact matrices and
+  // their derivatives, and the predictor runs on products.
+  bool fixedTheta = false;
+  SampledModel fixed;                               // at theta, derivatives in theta's coordinates
+  std::vector<SampledModel> fixedPlus, fixedMinus;  // difference gradient: theta +- Delta/2
+  Eigen::VectorXd scratch;
+
   RecursiveStep step;
   Eigen::VectorXd psi, gain;
   std::size_t count = 0;
+  std::size_t heldRun = 0, heldTotal = 0;  // samples held at the bounds: in a row, in all
+  double heldSince = 0.0;
+  std::string firstHeld;
   bool good = true;
   std::string message;
   double lambda0 = 0.0;
@@ -125,9 +137,83 @@ struct RecursiveEstimator::Impl {
   // Carries the predictor (and its gradient) from the sample just processed to the next one
   // with the model at theta and u held. False (after stop()) when the model refuses theta or
   // a perturbed theta, or the state is no longer finite.
+  // Samples the held model once (see fixedTheta).
+  void sampleFixed() {
+    std::vector<int> indices;
+    for (const auto& q : params) indices.push_back(q.modelIndex);
+    const bool sensitivity = options.gradient == RecursiveGradient::Sensitivity;
+    std::string why;
+    if (!setTheta(theta0, &why)) throw std::invalid_argument("theta(0) is refused: " + why);
+    fixed = sampleZoh(*model, T, sensitivity ? indices : std::vector<int>{}, sensitivity);
+    for (std::size_t j = 0; j < fixed.dAd.size(); ++j) {
+      const RecursiveParameter& q = params[j];
+      const double value = q.toModel(theta0[static_cast<Eigen::Index>(j)]);
+      const double chain = q.inverted ? -value * value : 1.0;
+      fixed.dAd[j] *= chain;
+      fixed.dBd[j] *= chain;
+      fixed.dC[j] *= chain;
+      fixed.dD[j] *= chain;
+    }
+    fixedPlus.clear();
+    fixedMinus.clear();
+    if (!sensitivity)
+      for (Eigen::Index j = 0; j < p; ++j) {
+        const double step = theta0[j] != 0.0 ? options.differenceStep * std::abs(theta0[j])
+                                             : options.differenceStep;
+        for (int side : {+1, -1}) {
+          Eigen::VectorXd th = theta0;
+          th[j] += side * 0.5 * step;
+          if (!setTheta(th, &why))
+            throw std::invalid_argument("the difference gradient (6.33) needs " +
+                                        params[static_cast<std::size_t>(j)].name + " = " +
+                                        formatNumber(th[j]) + ", which the model refuses: " + why);
+          (side > 0 ? fixedPlus : fixedMinus).push_back(sampleZoh(*model, T, {}, false));
+        }
+      }
+    setTheta(theta0, &why);
+  }
+
+  // propagate() for a held theta: products with the matrices sampled once.
+  void propagateFixed(double u) {
+    for (Eigen::Index j = 0; j < p; ++j) {
+      const auto sj = static_cast<std::size_t>(j);
+      if (options.gradient == RecursiveGradient::Sensitivity) {
+        scratch.noalias() = fixed.Ad * X.col(j);
+        scratch.noalias() += fixed.dAd[sj] * x;
+        scratch += fixed.dBd[sj].col(0) * u;
+        X.col(j) = scratch;
+      } else {
+        const SampledModel& plus = fixedPlus[sj];
+        const SampledModel& minus = fixedMinus[sj];
+        xPlus[sj].noalias() = plus.Ad * x;
+        xPlus[sj] += plus.Bd.col(0) * u;
+        xMinus[sj].noalias() = minus.Ad * x;
+        xMinus[sj] += minus.Bd.col(0) * u;
+        cPlus[sj] = plus.C.row(0);
+        cMinus[sj] = minus.C.row(0);
+        dPlus[j] = plus.D(0, 0);
+        dMinus[j] = minus.D(0, 0);
+        delta[j] = theta[j] != 0.0 ? options.differenceStep * std::abs(theta[j])
+                                   : options.differenceStep;
+      }
+    }
+    scratch.noalias() = fixed.Ad * x;
+    scratch += fixed.Bd.col(0) * u;
+    x = scratch;
+  }
+
   bool propagate(double u) {
     std::string why;
     const double t = timeOf(count);
+    if (fixedTheta) {
+      propagateFixed(u);
+      if (!x.allFinite() || !X.allFinite()) {
+        stop("The predictor's state is no longer finite at t = " + formatNumber(t) +
+             " s: the nominal model is unstable.");
+        return false;
+      }
+      return true;
+    }
     if (options.gradient == RecursiveGradient::Difference) {
       for (Eigen::Index j = 0; j < p; ++j) {
         const auto sj = static_cast<std::size_t>(j);
@@ -214,6 +300,9 @@ struct RecursiveEstimator::Impl {
       xMinus[sj] = Eigen::VectorXd::Zero(n);
     }
     count = 0;
+    heldRun = heldTotal = 0;
+    heldSince = 0.0;
+    firstHeld.clear();
     good = true;
     message = "No sample processed yet.";
     lambda0 = options.noiseVariance;
@@ -272,14 +361,30 @@ struct RecursiveEstimator::Impl {
       }
       thetaNew = theta;
       if (options.updateParameters) thetaNew.noalias() += gain * eps;  // (6.15)/(6.20)
+      if (!thetaNew.allFinite()) {
+        stop("The estimate is no longer a finite number at t = " + formatNumber(t) + " s.");
+        return step;
+      }
+      step.held = false;
       const Eigen::Index bad = outOfBounds(thetaNew);
       if (bad >= 0) {
+        // Projection: the update is held back while it would leave the bounds.
         const RecursiveParameter& q = params[static_cast<std::size_t>(bad)];
-        std::string text = "The estimate of " + q.name + " left its bounds [" + formatNumber(q.lower) +
-                           ", " + formatNumber(q.upper) + "] at t = " + formatNumber(t) + " s";
-        if (std::isfinite(thetaNew[bad])) text += " (it would have become " + formatNumber(thetaNew[bad]) + ")";
-        stop(text + ".");
-        return step;
+        const std::string where = "the estimate of " + q.name + " would have left its bounds [" +
+                                  formatNumber(q.lower) + ", " + formatNumber(q.upper) + "]";
+        if (heldRun == 0) heldSince = t;
+        ++heldRun;
+        if (heldTotal++ == 0)
+          firstHeld = where + " at t = " + formatNumber(t) + " s (as " + formatNumber(thetaNew[bad]) + ")";
+        if (static_cast<double>(heldRun) * T > options.maxHeldSeconds) {
+          stop("The estimate left its bounds: from t = " + formatNumber(heldSince) + " s on, " +
+               where + " for " + std::to_string(heldRun) + " samples in a row.");
+          return step;
+        }
+        thetaNew = theta;
+        step.held = true;
+      } else {
+        heldRun = 0;
       }
       const std::string problem = covarianceProblem(Pnew, t);
       if (!problem.empty()) {
@@ -350,6 +455,8 @@ RecursiveEstimator::RecursiveEstimator(const ParametricModel& nominal, double sa
   m.dPlus = m.dMinus = m.delta = Eigen::VectorXd::Ones(m.p);
   m.psi = m.gain = Eigen::VectorXd::Zero(m.p);
   m.noSensitivities.resize(m.n, 0);
+  m.fixedTheta = !options.updateParameters || m.p == 0;
+  if (m.fixedTheta) m.sampleFixed();
   // The norm weights of the exponential's series, from the nominal model and its derivatives.
   std::string refused;
   if (!m.setTheta(m.theta0, &refused)) throw std::invalid_argument("theta(0) is refused: " + refused);
@@ -384,9 +491,15 @@ Termination RecursiveEstimator::termination() const {
   return impl_->good ? Termination::Converged : Termination::Diverged;
 }
 const std::string& RecursiveEstimator::message() const {
-  if (impl_->good && impl_->count > 0)
-    impl_->message = "Processed " + std::to_string(impl_->count) +
-                     " samples; the estimates stayed within their bounds.";
+  if (impl_->good && impl_->count > 0) {
+    impl_->message = "Processed " + std::to_string(impl_->count) + " samples; ";
+    if (impl_->heldTotal == 0)
+      impl_->message += "the estimates stayed within their bounds.";
+    else
+      impl_->message += "the update was held back at the bounds in " +
+                        std::to_string(impl_->heldTotal) + " of them (first: " +
+                        impl_->firstHeld + ").";
+  }
   return impl_->message;
 }
 void RecursiveEstimator::reset() { impl_->reset(); }

@@ -52,33 +52,76 @@ void ExtendedZoh::setScalesFor(const Eigen::MatrixXd& A, const std::vector<Eigen
   setScales(d, block);
 }
 
-void ExtendedZoh::collect(const Eigen::MatrixXd& M, Sparse& out) {
-  out.start.clear();
-  out.col.clear();
-  out.value.clear();
-  for (Eigen::Index i = 0; i < M.rows(); ++i) {
-    out.start.push_back(static_cast<int>(out.col.size()));
-    for (Eigen::Index j = 0; j < M.cols(); ++j)
-      if (M(i, j) != 0.0) {
-        out.col.push_back(static_cast<int>(j));
-        out.value.push_back(M(i, j));
-      }
+namespace {
+
+// The series for one model size. N is the number of states (Eigen::Dynamic for any), MaxCols
+// bounds the columns x, X_1..X_p (Eigen::Dynamic: no bound): with both fixed, every matrix
+// lives on the stack and the products unroll.
+template <int N, int MaxCols>
+int series(const Eigen::MatrixXd& A0, const Eigen::VectorXd& B0,
+           const std::vector<Eigen::MatrixXd>& dA0, const std::vector<Eigen::VectorXd>& dB0,
+           double h, int substeps, double u, const Eigen::MatrixXd& weight, Eigen::VectorXd& x,
+           Eigen::MatrixXd& X, double tolerance, int maxTerms) {
+  constexpr int MaxStack = (N == Eigen::Dynamic || MaxCols == Eigen::Dynamic) ? Eigen::Dynamic
+                                                                              : N * (MaxCols - 1);
+  using Square = Eigen::Matrix<double, N, N>;
+  using Wide = Eigen::Matrix<double, N, Eigen::Dynamic, N == 1 ? Eigen::RowMajor : Eigen::ColMajor, N, MaxCols>;
+  using Stack = Eigen::Matrix<double, Eigen::Dynamic, N, Eigen::ColMajor, MaxStack, N>;
+  using Column = Eigen::Matrix<double, Eigen::Dynamic, 1, Eigen::ColMajor, MaxStack, 1>;
+  const Eigen::Index n = A0.rows();
+  const auto p = static_cast<Eigen::Index>(dA0.size());
+  const Square A = A0;
+  Stack D(n * p, n);          // dA_1 .. dA_p stacked
+  Wide input(n, p + 1);       // (B, dB_1, .., dB_p) u
+  input.col(0) = B0 * u;
+  for (Eigen::Index j = 0; j < p; ++j) {
+    D.middleRows(j * n, n) = dA0[static_cast<std::size_t>(j)];
+    input.col(j + 1) = dB0[static_cast<std::size_t>(j)] * u;
   }
-  out.start.push_back(static_cast<int>(out.col.size()));
+  const Wide w = weight;
+  Wide sum(n, p + 1), term(n, p + 1), next(n, p + 1);
+  Column coupling(n * p);
+  sum.col(0) = x;
+  if (p) sum.rightCols(p) = X;
+  int terms = 0;
+  for (int s = 0; s < substeps; ++s) {
+    term = sum;
+    double previous = term.cwiseAbs().cwiseProduct(w).maxCoeff();
+    for (int k = 1; k <= maxTerms; ++k) {
+      // next = (h / k) M term: A on every column, dA_j x on X_j's, and the held input's
+      // contribution in the first term only.
+      next.noalias() = A.lazyProduct(term);
+      if (p) {
+        coupling.noalias() = D.lazyProduct(term.col(0));
+        next.rightCols(p) += Eigen::Map<const Eigen::MatrixXd>(coupling.data(), n, p);
+      }
+      if (k == 1) next += input;
+      next *= h / k;
+      sum += next;
+      ++terms;
+      const double current = next.cwiseAbs().cwiseProduct(w).maxCoeff();
+      const double total = sum.cwiseAbs().cwiseProduct(w).maxCoeff();
+      term.swap(next);
+      if (current + previous <= tolerance * total) break;
+      previous = current;
+    }
+  }
+  x = sum.col(0);
+  if (p) X = sum.rightCols(p);
+  return terms;
 }
 
-void ExtendedZoh::apply(const Sparse& A, const double* v, const Sparse* D, const double* vx,
-                        double* out, Eigen::Index n) {
-  for (Eigen::Index i = 0; i < n; ++i) {
-    double acc = 0.0;
-    for (int k = A.start[static_cast<std::size_t>(i)]; k < A.start[static_cast<std::size_t>(i) + 1]; ++k)
-      acc += A.value[static_cast<std::size_t>(k)] * v[A.col[static_cast<std::size_t>(k)]];
-    if (D)
-      for (int k = D->start[static_cast<std::size_t>(i)]; k < D->start[static_cast<std::size_t>(i) + 1]; ++k)
-        acc += D->value[static_cast<std::size_t>(k)] * vx[D->col[static_cast<std::size_t>(k)]];
-    out[i] = acc;
-  }
+template <int N>
+int seriesOfSize(const Eigen::MatrixXd& A, const Eigen::VectorXd& B,
+                 const std::vector<Eigen::MatrixXd>& dA, const std::vector<Eigen::VectorXd>& dB,
+                 double h, int substeps, double u, const Eigen::MatrixXd& weight,
+                 Eigen::VectorXd& x, Eigen::MatrixXd& X, double tolerance, int maxTerms) {
+  if (dA.size() < 16)
+    return series<N, 16>(A, B, dA, dB, h, substeps, u, weight, x, X, tolerance, maxTerms);
+  return series<N, Eigen::Dynamic>(A, B, dA, dB, h, substeps, u, weight, x, X, tolerance, maxTerms);
 }
+
+}  // namespace
 
 void ExtendedZoh::advance(const Eigen::MatrixXd& A, const Eigen::VectorXd& B,
                           const std::vector<Eigen::MatrixXd>& dA,
@@ -91,88 +134,45 @@ void ExtendedZoh::advance(const Eigen::MatrixXd& A, const Eigen::VectorXd& B,
     throw std::invalid_argument("ExtendedZoh: inconsistent sizes");
   if (stateScale_.size() != n || static_cast<std::size_t>(blockScale_.size()) < p)
     setScalesFor(A, dA, dB);
-  const Eigen::Index N = n * static_cast<Eigen::Index>(p + 1);
-  term_.resize(N);
-  next_.resize(N);
-  sum_.resize(N);
-  weight_.resize(N);
-  for (Eigen::Index i = 0; i < n; ++i) weight_[i] = 1.0 / stateScale_[i];
+  weight_.resize(n, static_cast<Eigen::Index>(p + 1));
+  weight_.col(0) = stateScale_.cwiseInverse();
   for (std::size_t j = 0; j < p; ++j)
-    for (Eigen::Index i = 0; i < n; ++i)
-      weight_[n * static_cast<Eigen::Index>(j + 1) + i] =
-          1.0 / (stateScale_[i] * blockScale_[static_cast<Eigen::Index>(j)]);
-
-  collect(A, a_);
-  da_.resize(p);
-  for (std::size_t j = 0; j < p; ++j) collect(dA[j], da_[j]);
+    weight_.col(static_cast<Eigen::Index>(j + 1)) =
+        stateScale_.cwiseInverse() / blockScale_[static_cast<Eigen::Index>(j)];
 
   // The number of sub-steps follows the weighted norm of h A: the coupling blocks dA_j are
   // nilpotent in the extended matrix and only add a polynomial factor to the series' terms.
   double nu = 0.0;
-  {
-    for (Eigen::Index i = 0; i < n; ++i) {
-      double row = 0.0;
-      for (int k = a_.start[static_cast<std::size_t>(i)]; k < a_.start[static_cast<std::size_t>(i) + 1]; ++k)
-        row += std::abs(a_.value[static_cast<std::size_t>(k)]) *
-               stateScale_[a_.col[static_cast<std::size_t>(k)]];
-      nu = std::max(nu, row / stateScale_[i]);
-    }
-    nu *= T;
+  for (Eigen::Index i = 0; i < n; ++i) {
+    double row = 0.0;
+    for (Eigen::Index k = 0; k < n; ++k) row += std::abs(A(i, k)) * stateScale_[k];
+    nu = std::max(nu, row / stateScale_[i]);
   }
+  nu *= T;
   if (!std::isfinite(nu)) {
     x.setConstant(std::numeric_limits<double>::quiet_NaN());
     return;
   }
   const int substeps = std::max(1, static_cast<int>(std::ceil(nu / kMaxStepNorm)));
   const double h = T / substeps;
-
-  // The extended state w = (x, X_1, ..., X_p).
-  double* sum = sum_.data();
-  double* term = term_.data();
-  double* next = next_.data();
-  const double* w = weight_.data();
-  std::copy(x.data(), x.data() + n, sum);
-  for (std::size_t j = 0; j < p; ++j)
-    std::copy(X.col(static_cast<Eigen::Index>(j)).data(), X.col(static_cast<Eigen::Index>(j)).data() + n,
-              sum + n * static_cast<Eigen::Index>(j + 1));
-
-  lastTerms_ = 0;
-  for (int s = 0; s < substeps; ++s) {
-    std::copy(sum, sum + N, term);
-    double previous = 0.0;
-    for (Eigen::Index i = 0; i < N; ++i) previous = std::max(previous, std::abs(term[i]) * w[i]);
-    for (int k = 1; k <= kMaxTerms; ++k) {
-      // next = (h / k) M term, with the held input's contribution h (B u, dB_j u) in the
-      // first term only.
-      apply(a_, term, nullptr, nullptr, next, n);
-      for (std::size_t j = 0; j < p; ++j) {
-        const Eigen::Index off = n * static_cast<Eigen::Index>(j + 1);
-        apply(a_, term + off, &da_[j], term, next + off, n);
-      }
-      if (k == 1 && u != 0.0) {
-        for (Eigen::Index i = 0; i < n; ++i) next[i] += B[i] * u;
-        for (std::size_t j = 0; j < p; ++j) {
-          double* out = next + n * static_cast<Eigen::Index>(j + 1);
-          for (Eigen::Index i = 0; i < n; ++i) out[i] += dB[j][i] * u;
-        }
-      }
-      const double c = h / k;
-      double current = 0.0, total = 0.0;
-      for (Eigen::Index i = 0; i < N; ++i) {
-        next[i] *= c;
-        sum[i] += next[i];
-        current = std::max(current, std::abs(next[i]) * w[i]);
-        total = std::max(total, std::abs(sum[i]) * w[i]);
-      }
-      std::swap(term, next);
-      ++lastTerms_;
-      if (current + previous <= kTolerance * total) break;
-      previous = current;
-    }
+  switch (n) {
+#define FLEXARM_SERIES_CASE(K) \
+  case K:                      \
+    lastTerms_ = seriesOfSize<K>(A, B, dA, dB, h, substeps, u, weight_, x, X, kTolerance, kMaxTerms); \
+    break;
+    FLEXARM_SERIES_CASE(1)
+    FLEXARM_SERIES_CASE(2)
+    FLEXARM_SERIES_CASE(3)
+    FLEXARM_SERIES_CASE(4)
+    FLEXARM_SERIES_CASE(5)
+    FLEXARM_SERIES_CASE(6)
+    FLEXARM_SERIES_CASE(7)
+    FLEXARM_SERIES_CASE(8)
+#undef FLEXARM_SERIES_CASE
+    default:
+      lastTerms_ = series<Eigen::Dynamic, Eigen::Dynamic>(A, B, dA, dB, h, substeps, u, weight_,
+                                                           x, X, kTolerance, kMaxTerms);
   }
-  x = sum_.head(n);
-  for (std::size_t j = 0; j < p; ++j)
-    X.col(static_cast<Eigen::Index>(j)) = sum_.segment(n * static_cast<Eigen::Index>(j + 1), n);
 }
 
 }  // namespace flexarm

@@ -9,7 +9,7 @@
 // as a constant extra state), so the step is that exponential applied to the extended state.
 // It is formed as the exponential's action on the vector (its Taylor series with scaling, to
 // double precision, as sampleZoh's matrices are), which costs matrix-vector products of the
-// sparse model matrices instead of exponentials of 2(n+1)-square matrices for every parameter.
+// model matrices instead of exponentials of 2(n+1)-square matrices for every parameter.
 #include <vector>
 
 #include <Eigen/Dense>
@@ -36,20 +36,8 @@ class ExtendedZoh {
   int lastTerms() const { return lastTerms_; }
 
  private:
-  // A sparse matrix by rows (the model matrices have a few entries per row).
-  struct Sparse {
-    std::vector<int> start, col;  // start: n + 1 offsets into col and value
-    std::vector<double> value;
-  };
-  static void collect(const Eigen::MatrixXd& M, Sparse& out);
-  // out = A v_block + D v_x for one block (D may be null), row by row.
-  static void apply(const Sparse& A, const double* v, const Sparse* D, const double* vx,
-                    double* out, Eigen::Index n);
-
   Eigen::VectorXd stateScale_, blockScale_;
-  Sparse a_;
-  std::vector<Sparse> da_;
-  Eigen::VectorXd term_, next_, sum_, weight_;
+  Eigen::MatrixXd weight_;  // of x and each X_j, one column each
   int lastTerms_ = 0;
 };
 

@@ -30,6 +30,51 @@ Eigen::MatrixXd sqrtm(const Eigen::MatrixXd& S) {
          es.eigenvectors().transpose();
 }
 
+// How far sigma can be trusted, measured on the run: the lag-1 autocorrelation of the
+// prediction errors and, per parameter, the spread of theta(t) against the mean sigma(t) over
+// the second half. Sets r.caveat when sigma understates the uncertainty.
+void assessSigma(RecursiveResult& r) {
+  const auto& t = r.trajectory;
+  const std::size_t n = t.size();
+  if (n < 40) return;
+  double c0 = 0.0, c1 = 0.0;
+  for (std::size_t k = 0; k < n; ++k) {
+    c0 += t.epsilon[k] * t.epsilon[k];
+    if (k > 0) c1 += t.epsilon[k] * t.epsilon[k - 1];
+  }
+  r.epsilonLag1 = c0 > 0.0 ? c1 / c0 : 0.0;
+  std::string wide;
+  for (std::size_t i = 0; i < r.estimates.size(); ++i) {
+    double mean = 0.0, sigma = 0.0;
+    const std::size_t from = n / 2, count = n - from;
+    for (std::size_t k = from; k < n; ++k) {
+      mean += t.theta[i][k];
+      sigma += t.sigma[i][k];
+    }
+    mean /= static_cast<double>(count);
+    double var = 0.0;
+    for (std::size_t k = from; k < n; ++k) var += (t.theta[i][k] - mean) * (t.theta[i][k] - mean);
+    RecursiveEstimate& e = r.estimates[i];
+    e.spread = std::sqrt(var / static_cast<double>(count));
+    e.meanSigma = sigma / static_cast<double>(count);
+    if (e.meanSigma > 0.0 && e.spread > e.meanSigma)
+      wide += (wide.empty() ? "" : ", ") + e.parameter.name + " " +
+              formatNumber(std::round(10.0 * e.spread / e.meanSigma) / 10.0) + " times";
+  }
+  // Beyond 2.58 / sqrt(n) the lag-1 correlation is significant at 99 %.
+  const bool coloured = std::abs(r.epsilonLag1) > 2.58 / std::sqrt(static_cast<double>(n));
+  if (!coloured && wide.empty()) return;
+  r.caveat = "sigma = sqrt(lambda_0 P_ii) (7.8) holds for white prediction errors";
+  if (coloured)
+    r.caveat += "; these are coloured (lag-1 autocorrelation " +
+                formatNumber(std::round(100.0 * r.epsilonLag1) / 100.0) + ")";
+  if (!wide.empty())
+    r.caveat += (coloured ? ", and " : "; ") + std::string("over the second half the estimates varied ") +
+                wide + " as much as sigma says";
+  r.caveat += ": read the +-3 sigma band as a lower bound of the uncertainty (a bias, e.g. from "
+              "noise fed back in closed loop or from decimation, is not in it either).";
+}
+
 }  // namespace
 
 InitialCovariance steadyStateCovariance(const ParametricModel& nominal, const Eigen::VectorXd& u,
@@ -190,6 +235,7 @@ RecursiveResult recursiveIdentification(const ParametricModel& nominal, const Ei
     r.estimates.push_back(e);
   }
   r.model = est.model();
+  assessSigma(r);
   if (!est.ok()) {
     r.termination = Termination::Diverged;
     r.message = est.message();
@@ -199,9 +245,9 @@ RecursiveResult recursiveIdentification(const ParametricModel& nominal, const Ei
                 " samples.";
   } else {
     r.termination = Termination::Converged;
+    std::string m = est.message();  // "Processed N samples; ..."
     r.message = "Processed all " + std::to_string(N) + " samples (" +
-                formatNumber(static_cast<double>(N) * T) +
-                " s); the estimates stayed within their bounds.";
+                formatNumber(static_cast<double>(N) * T) + " s)" + m.substr(m.find(';'));
   }
   r.seconds = elapsed();
   return r;

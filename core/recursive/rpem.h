@@ -81,6 +81,10 @@ struct RecursiveOptions {
   bool updateParameters = true;
   // P is taken as blown up when a diagonal element exceeds this multiple of its P(0) value.
   double covarianceLimit = 1e8;
+  // An update that would take theta outside its bounds (the model's, e.g. f_m >= 0) is held
+  // back: theta(t) = theta(t-1), the projection of Ljung and Soederstroem. When it keeps
+  // pushing outside for this long (seconds), the estimate has left its bounds: Diverged.
+  double maxHeldSeconds = 1.0;
 
   bool isValid(std::string* why) const;
 };
@@ -115,6 +119,7 @@ struct RecursiveStep {
   Eigen::VectorXd psi;        // psi(t), the gradient of yhat(t) in theta
   Eigen::VectorXd gain;       // K(t) of (6.14)/(6.19)
   double noiseVariance = 0.0; // lambda_0 used for sigma
+  bool held = false;          // the update would have left the bounds and was held back
   bool ok = true;             // false once the estimate left its bounds or P blew up
 };
 
@@ -190,6 +195,10 @@ struct RecursiveEstimate {
   RecursiveParameter parameter;
   double start = 0.0, final = 0.0, sigma = 0.0;  // theta's form
   double modelNominal = 0.0, modelStart = 0.0, modelFinal = 0.0, modelSigma = 0.0;
+  // Measured over the second half of the run: the standard deviation of theta(t) and the mean
+  // of sigma(t). White prediction errors give spread / meanSigma near 1 / sqrt 2 for the
+  // forgetting factor; a larger ratio means sigma understates the uncertainty.
+  double spread = 0.0, meanSigma = 0.0;
 };
 
 // The seed's P(0) (Section 6.6.2): the P update is run with psi at the nominal theta, and the
@@ -223,6 +232,10 @@ struct RecursiveResult {
   Eigen::MatrixXd Q;      // (6.53) from the pre-run (empty when P(0) was given)
   Eigen::MatrixXd P;      // P at the end
   double rmsEpsilon = 0.0;  // RMS of the prediction errors over the run
+  double epsilonLag1 = 0.0; // their lag-1 autocorrelation (0 for white errors)
+  // A sentence when sigma cannot be taken at its word: the prediction errors are coloured or
+  // the estimates varied more than sigma says (empty otherwise).
+  std::string caveat;
   std::shared_ptr<const ParametricModel> model;  // the model at the final estimate
 };
 

@@ -54,6 +54,7 @@ bool RecursiveOptions::isValid(std::string* why) const {
   if (!(noiseVariance >= 0.0) || !std::isfinite(noiseVariance))
     return fail("the noise variance must not be negative");
   if (!(covarianceLimit > 1.0)) return fail("the covariance limit must exceed 1");
+  if (!(maxHeldSeconds >= 0.0)) return fail("the time held at the bounds must not be negative");
   return true;
 }
 

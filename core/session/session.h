@@ -14,6 +14,7 @@
 
 #include "core/io/log_io.h"
 #include "core/signal/preprocess.h"
+#include "core/signal/seconds_range.h"
 
 namespace flexarm {
 
@@ -28,13 +29,6 @@ struct LogReference {
   std::string path;
   std::string sha256;  // of the file when the session was saved
   LogReadOptions read;
-};
-
-// A time range in seconds, start < end.
-struct SecondsRange {
-  double start = 0.0;
-  double end = 0.0;
-  bool operator==(const SecondsRange& o) const { return start == o.start && end == o.end; }
 };
 
 struct Session {

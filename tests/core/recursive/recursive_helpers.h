@@ -38,8 +38,8 @@ inline Eigen::VectorXd gaussian(Eigen::Index n, double sigma, std::mt19937& rng)
 // alpha = e^{-aT}, beta = (1 - alpha) / a: the gain theta of (6.42), one sample later.
 class FirstOrderModel : public ParametricModel {
  public:
-  FirstOrderModel(double a, double theta) {
-    params_ = {{"a", "1/s", a, 1e-6, 1e6, false}, {"theta", "1", theta, -1e6, 1e6, true}};
+  FirstOrderModel(double a, double theta, double thetaLower = -1e6) {
+    params_ = {{"a", "1/s", a, 1e-6, 1e6, false}, {"theta", "1", theta, thetaLower, 1e6, true}};
   }
   std::string structureName() const override { return "first-order"; }
   std::unique_ptr<ParametricModel> clone() const override {

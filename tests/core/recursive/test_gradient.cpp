@@ -14,17 +14,22 @@ namespace {
 
 constexpr double kTs = 0.005;
 
-// psi of a held theta (updateParameters = false) over the whole input, one column per theta.
+// psi over the whole input at the model's theta, one column per theta entry. held: theta is
+// held (updateParameters = false: the model sampled once by sampleZoh); otherwise the
+// estimator runs as it does on data, sampling the extended system every sample, on the
+// model's own noise-free output, so that the prediction errors and theta's updates vanish.
 Eigen::MatrixXd psiAtFixedTheta(const ParametricModel& model, const RecursiveOptions& base,
-                                const Eigen::VectorXd& u, Eigen::VectorXd* yhat = nullptr) {
+                                const Eigen::VectorXd& u, Eigen::VectorXd* yhat = nullptr,
+                                bool held = true) {
   RecursiveOptions o = base;
-  o.updateParameters = false;
+  o.updateParameters = !held;
   o.p0.assign(o.estimate.size(), 1.0);
   RecursiveEstimator est(model, kTs, o);
+  const Eigen::VectorXd y = held ? Eigen::VectorXd::Zero(u.size()) : simulate(model, u, kTs);
   Eigen::MatrixXd psi(u.size(), static_cast<Eigen::Index>(o.estimate.size()));
   if (yhat) yhat->resize(u.size());
   for (Eigen::Index k = 0; k < u.size(); ++k) {
-    const RecursiveStep& s = est.update(u[k], 0.0);
+    const RecursiveStep& s = est.update(u[k], y[k]);
     psi.row(k) = s.psi.transpose();
     if (yhat) (*yhat)[k] = s.yhat;
   }
@@ -51,17 +56,19 @@ TEST(RecursiveGradient, SensitivityPsiEqualsCentralDifferencesOfTheReSimulation)
   std::mt19937 rng(11);
   const Eigen::VectorXd u = testing::gaussian(1500, 0.1, rng);
   RecursiveOptions o;  // theta = (k_T, J_a^-1, f_m), the seed's
-  Eigen::VectorXd yhat;
-  const Eigen::MatrixXd psi = psiAtFixedTheta(*model, o, u, &yhat);
-  // The predictor at a held theta is the output-error simulation.
   const Eigen::VectorXd sim = simulate(*model, u, kTs);
-  EXPECT_LT((yhat - sim).lpNorm<Eigen::Infinity>(), 1e-10 * sim.lpNorm<Eigen::Infinity>());
   const std::vector<std::pair<std::string, bool>> entries = {{"k_T", false}, {"J_a", true}, {"f_m", false}};
-  for (std::size_t j = 0; j < entries.size(); ++j) {
-    const Eigen::VectorXd cd = centralDifference(*model, entries[j].first, entries[j].second, u);
-    const double err = (psi.col(static_cast<Eigen::Index>(j)) - cd).lpNorm<Eigen::Infinity>() /
-                       cd.lpNorm<Eigen::Infinity>();
-    EXPECT_LT(err, 1e-6) << entries[j].first;
+  for (bool held : {true, false}) {
+    Eigen::VectorXd yhat;
+    const Eigen::MatrixXd psi = psiAtFixedTheta(*model, o, u, &yhat, held);
+    // The predictor at the model's theta is the output-error simulation.
+    EXPECT_LT((yhat - sim).lpNorm<Eigen::Infinity>(), 1e-10 * sim.lpNorm<Eigen::Infinity>()) << held;
+    for (std::size_t j = 0; j < entries.size(); ++j) {
+      const Eigen::VectorXd cd = centralDifference(*model, entries[j].first, entries[j].second, u);
+      const double err = (psi.col(static_cast<Eigen::Index>(j)) - cd).lpNorm<Eigen::Infinity>() /
+                         cd.lpNorm<Eigen::Infinity>();
+      EXPECT_LT(err, 1e-6) << entries[j].first << (held ? " held" : " updated every sample");
+    }
   }
 }
 
@@ -98,8 +105,12 @@ TEST(RecursiveGradient, Example61TheDifferenceGradientMissesTheOutputErrorRecurs
   o.inverted.clear();
   o.gradient = RecursiveGradient::Sensitivity;
   const Eigen::VectorXd exact = psiAtFixedTheta(model, o, u).col(0);
+  EXPECT_LT((psiAtFixedTheta(model, o, u, nullptr, false).col(0) - exact).lpNorm<Eigen::Infinity>(),
+            1e-12 * exact.lpNorm<Eigen::Infinity>());
   o.gradient = RecursiveGradient::Difference;
   const Eigen::VectorXd difference = psiAtFixedTheta(model, o, u).col(0);
+  EXPECT_LT((psiAtFixedTheta(model, o, u, nullptr, false).col(0) - difference).lpNorm<Eigen::Infinity>(),
+            1e-9 * difference.lpNorm<Eigen::Infinity>());
 
   double psi = 0.0;  // (6.44): psi(t) = alpha psi(t-1) + beta u(t-1)
   for (Eigen::Index t = 1; t < u.size(); ++t) {
