@@ -13,6 +13,7 @@
 #include "core/diagnosis/diagnosis.h"
 #include "core/diagnosis/calibration.h"
 #include "core/diagnosis/diagnosis_json.h"
+#include "core/diagnosis/diagnosis_request.h"
 
 namespace flexarm::cli {
 namespace {
@@ -178,6 +179,10 @@ int runDiagnose(const std::vector<std::string>& argv, std::ostream& out, std::os
     for (const auto& n : options.parameters)
       if (n == "J_a") inverted.push_back(n);
     options.inverted = inverted;
+    // The default thresholds' factors belong to the default parameters.
+    options.classicalScales.clear();
+    options.robustScales.clear();
+    options.cusumScales.clear();
   }
   if (auto t = args.value("tests")) {
     auto tests = diagnosisTestsFromList(*t, &why);
@@ -207,13 +212,25 @@ int runDiagnose(const std::vector<std::string>& argv, std::ostream& out, std::os
         return usage("--window expects seconds or 'cumulative', not '" + *w + "'");
     }
   }
-  double lambda = options.estimator.lambda;
-  if (!args.number("lambda", lambda) || !args.number("k", options.classicalK) ||
+  double lambda = options.estimator.lambda, k = 0.0;
+  if (!args.number("lambda", lambda) || !args.number("k", k) ||
       !args.number("alpha1", options.cusumAlpha1) || !args.number("alpha2", options.cusumAlpha2) ||
       !args.number("hypothesis-threshold", options.hypothesisThreshold) ||
       !args.number("confirm", options.confirmS) || !args.number("settle", options.settleS))
     return usage(args.error());
-  CalibrationOptions calibration;
+  if (args.value("k")) {
+    options.classicalK = options.robustK = k;
+    options.classicalScales.clear();
+    options.robustScales.clear();
+  }
+  if (args.value("alpha2")) options.cusumScales.clear();
+  if (args.value("lambda")) {
+    options.estimator.lambda = lambda;
+    options.robustLambda = std::min(lambda, 0.999999);
+  }
+  DiagnosisRequest request;
+  request.calibrate = args.flag("calibrate");
+  CalibrationOptions& calibration = request.calibration;
   long runs = calibration.healthyRuns, threads = calibration.threads;
   if (!args.number("false-alarms-per-hour", calibration.targetFalseAlarmsPerHour) ||
       !args.integer("runs", runs) || !args.integer("threads", threads))
@@ -222,16 +239,20 @@ int runDiagnose(const std::vector<std::string>& argv, std::ostream& out, std::os
   calibration.faultyRuns = static_cast<int>(std::max(1L, runs / 5));
   calibration.threads = static_cast<int>(threads);
   if (!calibration.isValid(&why)) return usage(why);
-  options.estimator.lambda = lambda;
-  options.robustLambda = std::min(lambda, 0.999999);
-  options.robustK = options.classicalK;
   if (!options.isValid(&why)) return usage(why);
+  if (auto f = args.value("seed-fault")) {
+    const auto eq = f->find('=');
+    double factor = 0.0;
+    if (eq == std::string::npos || !(std::istringstream(f->substr(eq + 1)) >> factor) || !(factor > 0.0))
+      return usage("--seed-fault expects NAME=FACTOR (e.g. k_T=1.2), not '" + *f + "'");
+    request.seedFault = std::make_pair(f->substr(0, eq), factor);
+  }
 
   auto model = modelFromArgs(args, "diagnose", err);
   if (!model) return kExitUsage;
-  for (const auto& name : options.parameters)
-    if (model->indexOf(name) < 0)
-      return usage("--monitor: the " + model->structureName() + " model has no parameter '" + name + "'");
+  request.model = std::move(model);
+  request.options = options;
+  if (!request.isValid(&why)) return usage(why);
   auto readOptions = logReadOptions(args, err);
   if (!readOptions) return kExitUsage;
   auto log = loadLog(args.positional()[0], *readOptions, err);
@@ -240,8 +261,6 @@ int runDiagnose(const std::vector<std::string>& argv, std::ostream& out, std::os
     err << pre << args.positional()[0] << ": " << why << "\n";
     return kExitBadInput;
   }
-
-  DiagnosisReference reference;
   if (referenceLog) {
     auto healthy = loadLog(*referenceLog, *readOptions, err);
     if (!healthy) return kExitBadInput;
@@ -249,45 +268,26 @@ int runDiagnose(const std::vector<std::string>& argv, std::ostream& out, std::os
       err << pre << *referenceLog << ": " << why << "\n";
       return kExitBadInput;
     }
-    reference = referenceFromLog(*model, *healthy, options);
-  } else {
-    reference = referenceFromModel(*model, *log, options);
+    request.referenceLog = std::make_shared<const IdData>(std::move(*healthy));
   }
-  if (!reference.ok()) {
-    err << pre << reference.message << "\n";
+  const DiagnosisRun run = runDiagnosisRequest(request, *log);
+  if (run.termination == Termination::Failed) {
+    err << pre << run.message << "\n";
     return kExitNumerical;
   }
-  if (auto f = args.value("seed-fault")) {
-    const auto eq = f->find('=');
-    double factor = 0.0;
-    if (eq == std::string::npos || !(std::istringstream(f->substr(eq + 1)) >> factor))
-      return usage("--seed-fault expects NAME=FACTOR (e.g. k_T=1.2), not '" + *f + "'");
-    reference = withSeedFault(reference, options, f->substr(0, eq), factor);
-  }
-  std::optional<CalibrationResult> calibrated;
-  if (args.flag("calibrate")) {
-    calibrated = calibrate(reference, *log, options, calibration);
-    if (calibrated->termination != Termination::Converged) {
-      err << pre << "calibration: " << calibrated->message << "\n";
-      return kExitNumerical;
-    }
-    options = calibrated->calibrated;
-  }
-  const DiagnosisResult r = diagnose(reference, *log, options);
-  if (r.termination == Termination::Failed) {
-    err << pre << r.message << "\n";
-    return kExitNumerical;
-  }
+  const DiagnosisResult& r = run.result;
   if (auto trace = args.value("trace"); trace && !writeTrace(r, *trace, &why)) {
     err << pre << why << "\n";
     return kExitBadInput;
   }
   if (args.flag("json")) {
     auto j = diagnosisResultJson(r);
-    if (calibrated) j["calibration"] = calibrationJson(*calibrated);
+    if (run.calibration) j["calibration"] = calibrationJson(*run.calibration);
+    else j["thresholds_provenance"] = defaultThresholdsProvenance();
     out << j.dump(2) << "\n";
   } else {
-    if (calibrated) out << calibrationText(*calibrated);
+    if (run.calibration) out << calibrationText(*run.calibration);
+    else out << "Thresholds: " << defaultThresholdsProvenance() << "\n";
     out << r.summary() << "\n";
     if (r.termination != Termination::Converged) out << r.message << "\n";
     out << "Reference: " << r.referenceSource << "\n";

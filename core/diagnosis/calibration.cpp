@@ -19,7 +19,7 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 
 std::vector<double> defaultScales() {
   std::vector<double> s;
-  for (int i = 0; i < 48; ++i) s.push_back(0.5 * std::pow(16.0, i / 47.0));
+  for (int i = 0; i < 64; ++i) s.push_back(0.1 * std::pow(100.0, i / 63.0));
   return s;
 }
 
@@ -67,11 +67,9 @@ std::shared_ptr<const DiagnosisReference> referenceFor(const MonteCarloRun& m,
     *why = "the fault-free reference run failed: " + run.message;
     return nullptr;
   }
-  const auto signals = diagnosisSignals(run.data, options.predictor, why);
-  if (!signals) return nullptr;
   ReferenceOptions ro;
   ro.fitPlant = false;
-  auto ref = std::make_shared<DiagnosisReference>(referenceFromSignals(*m.plant, *signals, options, ro));
+  auto ref = std::make_shared<DiagnosisReference>(referenceFromLog(*m.plant, run.data, options, ro));
   if (!ref->ok()) {
     *why = "the reference of the simulated arm failed: " + ref->message;
     return nullptr;
@@ -436,6 +434,8 @@ CalibrationResult monteCarlo(const std::vector<MonteCarloRun>& plan, const Diagn
       }
   result.decision = evaluate(which, decisionScales, &result.decisionIsolatedFraction,
                              &result.decisionMedianDelayS, nullptr);
+  result.given = evaluate(which, std::vector<std::vector<double>>(which.size(), {1.0}),
+                          &result.givenIsolatedFraction, &result.givenMedianDelayS, nullptr);
   char text[400];
   std::snprintf(text, sizeof text,
                 "%.3g h of fault-free simulated time: the decision raised %d false alarms (%.3g per "

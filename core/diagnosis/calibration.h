@@ -34,7 +34,7 @@ struct CalibrationOptions {
   double durationS = 0.0;    // length of a run; 0: the log's
   double horizonS = 5.0;     // a fault isolated later than this after its step counts as missed
   double targetFalseAlarmsPerHour = 1.0;
-  // Threshold scales c tried for every test (empty: 48 values from 0.5 to 8, log-spaced).
+  // Threshold scales c tried for every test (empty: 64 values from 0.1 to 10, log-spaced).
   std::vector<double> scales;
   int threads = 2;
   std::uint64_t seed = 1;
@@ -84,6 +84,10 @@ struct CalibrationResult {
   DiagnosisOptions calibrated;
   CalibrationPoint decision;
   std::vector<double> decisionIsolatedFraction, decisionMedianDelayS;  // per fault
+  // The decision at the options' own thresholds (as given, before calibrating): how the
+  // thresholds in use fare on these runs.
+  CalibrationPoint given;
+  std::vector<double> givenIsolatedFraction, givenMedianDelayS;  // per fault
 };
 
 // The design value a scale multiplies (k of the classical or robust test, alpha_2, the

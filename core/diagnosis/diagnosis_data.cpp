@@ -4,22 +4,11 @@
 #include <stdexcept>
 
 #include "core/diagnosis/loop_model.h"
-#include "core/signal/preprocess.h"
+#include "core/ident/fit_data.h"
+#include "core/recursive/recursive_log.h"
 
 namespace flexarm {
 
-namespace {
-
-Eigen::VectorXd vector(const std::vector<double>& v) {
-  return Eigen::Map<const Eigen::VectorXd>(v.data(), static_cast<Eigen::Index>(v.size()));
-}
-
-Eigen::VectorXd centred(const std::vector<double>& v) {
-  Eigen::VectorXd x = vector(v);
-  return x.array() - x.mean();
-}
-
-}  // namespace
 
 std::optional<DiagnosisSignals> diagnosisSignals(const IdData& log, DiagnosisPredictor predictor,
                                                  std::string* why) {
@@ -27,38 +16,33 @@ std::optional<DiagnosisSignals> diagnosisSignals(const IdData& log, DiagnosisPre
     if (why) *why = text;
     return std::nullopt;
   };
-  const Channel* torque = log.channel(columns::kTorqueRef);
-  if (!torque) torque = log.input();
-  if (!torque) return fail("the log has no torque reference (torque_ref_nm or an input channel)");
-  const Channel* velocity = log.channel(columns::kMotorVelocity);
-  const Channel* angle = log.channel(columns::kMotorAngle);
-  if (!velocity && !angle)
-    return fail("the log has neither motor_velocity_rad_s nor motor_angle_rad");
-  if (log.samples() < 10) return fail("the log has fewer than 10 samples");
-  if (!(log.sampleTime > 0.0) || !std::isfinite(log.sampleTime))
-    return fail("the log's sample time is not a positive number");
+  if (!log.input()) return fail("the log has no input channel (the torque reference)");
+  if (!log.output()) return fail("the log has no output channel (the motor angle or velocity)");
+  // The fit's data preparation, as the recursive estimator of chapter 6 uses it: the motor
+  // velocity from the angle at the log's rate, decimation to the seed's 200 Hz behind the
+  // anti-alias filter, the means removed (the reference and the angle go through the same
+  // filter, so that the loop's input and output stay related as the loop relates them).
+  FitDataOptions f;
+  f.velocityOutput = true;
+  f.decimation = recursiveDecimation(0, log.sampleRateHz());
+  f.removeMeans = true;
+  const PreparedData prepared = prepareFitData(log, f);
+  if (!prepared.ok()) return fail(prepared.message);
   DiagnosisSignals s;
-  s.sampleTime = log.sampleTime;
-  s.startTime = log.startTime;
-  s.u = centred(torque->values);
-  std::string velocityText;
-  if (velocity) {
-    s.velocity = centred(velocity->values);
-    velocityText = "the motor velocity channel";
-  } else {
-    s.velocity = centred(differentiate(angle->values, log.sampleTime));
-    velocityText = "the motor velocity by central differences of the motor angle (Section 5.2)";
-  }
-  const Channel* reference = log.withRole(ChannelRole::Reference);
-  if (reference) s.r = centred(reference->values);
-  if (!s.u.allFinite() || !s.velocity.allFinite() || !s.r.allFinite())
-    return fail("the log holds a value that is not a finite number");
+  s.sampleTime = prepared.sampleTime;
+  s.startTime = prepared.startTime;
+  s.u = prepared.u;
+  s.velocity = prepared.y;
+  s.r = prepared.r;
+  const std::string preparation = prepared.note();
 
   // The loop needs the reference, the angle and the controller.
   std::string missing;
   std::optional<ControllerOptions> controller = controllerFromMetadata(log, &missing);
-  if (!reference) missing = "the log has no reference channel (angle_ref_rad)";
-  else if (!angle) missing = "the log has no motor angle";
+  if (!prepared.closedLoop || prepared.r.size() != prepared.u.size())
+    missing = "the log has no reference channel (angle_ref_rad)";
+  else if (prepared.angle.size() != prepared.u.size())
+    missing = "the log has no motor angle";
   const bool loop = predictor == DiagnosisPredictor::Loop ||
                     (predictor == DiagnosisPredictor::Auto && missing.empty());
   if (predictor == DiagnosisPredictor::Loop && !missing.empty())
@@ -66,16 +50,18 @@ std::optional<DiagnosisSignals> diagnosisSignals(const IdData& log, DiagnosisPre
   if (loop) {
     s.predictor = DiagnosisPredictor::Loop;
     s.controller = controller;
-    const double rest = angle->values.front();
-    s.input = LoopModel::referenceSlopes(vector(reference->values).array() - rest, log.sampleTime);
-    s.output = vector(angle->values).array() - rest;
+    const double rest = prepared.angle(0);
+    const Eigen::VectorXd reference = prepared.r.array() + prepared.referenceMean - rest;
+    s.input = LoopModel::referenceSlopes(reference, prepared.sampleTime);
+    s.output = prepared.angle.array() - rest;
     s.description = "the motor angle predicted from the position reference through the log's "
-                    "controller (the loop, free of closed-loop bias)";
+                    "controller (the loop, free of closed-loop bias; " + preparation + ")";
   } else {
     s.predictor = DiagnosisPredictor::Direct;
     s.input = s.u;
     s.output = s.velocity;
-    s.description = velocityText + " predicted from the torque reference (direct, as the seed)";
+    s.description = "the motor velocity predicted from the torque reference (direct, as the seed; " +
+                    preparation + ")";
     if (predictor == DiagnosisPredictor::Auto) s.description += " because " + missing;
   }
   if (!s.input.allFinite() || !s.output.allFinite())

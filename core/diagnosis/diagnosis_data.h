@@ -1,9 +1,10 @@
 #pragma once
-// The signals a diagnosis works on, taken from a log, and the model the recursive estimators
-// run on them (the predictor):
+// The signals a diagnosis works on, taken from a log by the fit's data preparation as the
+// recursive estimator of chapter 6 uses it (core/ident/fit_data.h: the motor velocity from the
+// angle, decimation to the seed's 200 Hz behind the anti-alias filter, means removed), and the
+// model the recursive estimators run on them (the predictor):
 //  - direct, as the seed's chapters 6 and 7: input u the torque reference, output the motor
-//    velocity (the log's velocity channel, else the motor angle differentiated by central
-//    differences, Section 5.2), means removed; the plant itself predicts it;
+//    velocity; the plant itself predicts it;
 //  - loop: input the position reference (as its slopes, a first-order hold), output the
 //    measured motor angle, both relative to the first sample (the loop starts at rest); the
 //    plant closed by the log's controller predicts it (loop_model.h).
@@ -35,8 +36,8 @@ struct DiagnosisSignals {
 };
 
 // The signals of a log for the predictor asked; nullopt with a sentence naming the problem (no
-// torque reference, no motor angle or velocity, fewer than 10 samples, a non-finite value; for
-// Loop: no reference channel, no motor angle, no controller in the metadata).
+// input or output channel, too few samples, a non-finite value; for Loop: no reference
+// channel, no motor angle, no controller in the metadata).
 std::optional<DiagnosisSignals> diagnosisSignals(const IdData& log, DiagnosisPredictor predictor,
                                                  std::string* why);
 

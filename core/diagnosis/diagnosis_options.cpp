@@ -84,6 +84,23 @@ std::optional<HypothesisWindow> hypothesisWindowFromString(std::string_view s) {
   return std::nullopt;
 }
 
+DiagnosisOptions DiagnosisOptions::seed() {
+  DiagnosisOptions o;
+  o.predictor = DiagnosisPredictor::Direct;
+  o.classicalK = o.robustK = 3.0;
+  o.robustLambda = 0.995;
+  o.cusumAlpha1 = 3.0;
+  o.cusumAlpha2 = 20.0;
+  o.hypothesisThreshold = 1.0;
+  o.window = HypothesisWindow::Cumulative;
+  o.classicalScales.clear();
+  o.robustScales.clear();
+  o.cusumScales.clear();
+  o.confirmS = 0.0;
+  o.settleS = 2.0;
+  return o;
+}
+
 std::vector<double>* DiagnosisOptions::scales(DiagnosisTest t) {
   switch (t) {
     case DiagnosisTest::Classical: return &classicalScales;

@@ -61,25 +61,36 @@ struct DiagnosisOptions {
   std::vector<DiagnosisTest> decision = {DiagnosisTest::Robust, DiagnosisTest::Cusum,
                                          DiagnosisTest::Hypothesis};
 
+  // The thresholds. The seed's design values (3 sigma, alpha_1 = 3, alpha_2 = 20, level 1 over
+  // the cumulative window; seed() gives them) scaled per parameter as bench/bench_diagnosis
+  // calibrated them on designed experiments (Section 6.6.2) of randomly drawn arms, with a
+  // margin over the largest excursion of the fault-free runs; the classical test keeps the
+  // seed's 3 sigma, whose false alarms (Figure 7.1) are what the others remove.
   double classicalK = 3.0;     // the 3 of (7.3)/(7.7)
   double robustLambda = 0.995; // the lambda of (7.12)/(7.13) (seed: that of the estimator)
   double robustK = 3.0;        // the 3 of the robust threshold 3 sigma (Figure 7.2)
   double cusumAlpha1 = 3.0;    // (7.15) (seed: 3)
   double cusumAlpha2 = 20.0;   // (7.17) (seed: 20)
-  double hypothesisThreshold = 1.0;  // the seed's natural choice after normalisation
-  HypothesisWindow window = HypothesisWindow::Cumulative;
+  double hypothesisThreshold = 1.06;  // the seed's 1, "a natural choice after normalisation"
+  HypothesisWindow window = HypothesisWindow::Sliding;  // on-line use (seed: cumulative)
   double windowS = 5.0;        // length of the sliding window, s
   // Per-parameter factors on the thresholds of the classical, robust and CUSUM tests, one per
   // monitored parameter (empty: 1 for each), as the calibration chooses them: the seed's
   // h = alpha_2 theta_0 (7.17) is in the parameter's own units, so one alpha_2 does not give
-  // every parameter the same false-alarm rate.
-  std::vector<double> classicalScales, robustScales, cusumScales;
+  // every parameter the same false-alarm rate. The defaults are for k_T, J_a (as J_a^-1), f_m.
+  std::vector<double> classicalScales;
+  std::vector<double> robustScales = {2.0, 0.6, 1.8};
+  std::vector<double> cusumScales = {0.2, 0.27, 1.25};
   // A diagnosis statement must hold this long before it becomes the verdict (0: at once).
   double confirmS = 0.0;
   // No alarm is raised before this time: the start-up transient of the estimators and of the
   // hypothesis sums (the seed: "in the first few seconds there is a transient behavior"), s.
   double settleS = 2.0;
 
+  // The seed's design: the direct predictor, 3 sigma, the robust test's lambda 0.995, alpha_1 = 3,
+  // alpha_2 = 20, the hypothesis level 1 over the cumulative window, every test in the decision
+  // but the classical one, a two-second settling time.
+  static DiagnosisOptions seed();
   // The factor on test t's threshold for monitored parameter i (1 for the hypothesis tests).
   double thresholdScale(DiagnosisTest t, std::size_t i) const;
   std::vector<double>* scales(DiagnosisTest t);

@@ -228,7 +228,19 @@ DiagnosisReference referenceFromLog(const PhysicalModel& start, const IdData& he
     ref.message = "the fault-free log cannot be used: " + why;
     return ref;
   }
-  return referenceFromSignals(start, *signals, options, referenceOptions, progress);
+  DiagnosisReference ref = referenceFromSignals(start, *signals, options, referenceOptions, progress);
+  if (ref.ok() || ref.termination == Termination::Cancelled || options.predictor != DiagnosisPredictor::Auto ||
+      signals->predictor != DiagnosisPredictor::Loop)
+    return ref;
+  // Auto: the loop could not be fitted (e.g. the model closed by the controller is unstable
+  // without the controller's sampling); the direct predictor of the seed instead.
+  const auto direct = diagnosisSignals(healthy, DiagnosisPredictor::Direct, &why);
+  if (!direct) return ref;
+  DiagnosisReference fallback = referenceFromSignals(start, *direct, options, referenceOptions, progress);
+  if (!fallback.ok()) return ref;
+  fallback.source += " (the loop predictor could not be fitted: " + ref.message + ")";
+  fallback.message = fallback.source;
+  return fallback;
 }
 
 DiagnosisReference referenceFromModel(const PhysicalModel& model, const IdData& monitored,

@@ -13,7 +13,7 @@ bool ScenarioOptions::isValid(std::string* why) const {
     return false;
   };
   if (arms < 1 || arms > 100000) return fail("at least one arm");
-  if (!(durationS > 0.0) || !(faultTimeLowS > 0.0) || !(faultTimeHighS >= faultTimeLowS) ||
+  if (!(durationS > 0.0) || !(healthyDurationS >= 0.0) || !(faultTimeLowS > 0.0) || !(faultTimeHighS >= faultTimeLowS) ||
       !(faultTimeHighS < durationS))
     return fail("the fault must step in within the run");
   if (!(truthSpread >= 0.0 && truthSpread < 0.9)) return fail("the truth spread must lie in [0, 0.9)");
@@ -60,6 +60,7 @@ std::vector<MonteCarloRun> randomScenarios(const PhysicalModel& nominal,
       r.fault = fault;
       r.seed = random.next() >> 16;
       r.faultTimeS = uniform(o.faultTimeLowS, o.faultTimeHighS);
+      if (fault < 0 && o.healthyDurationS > 0.0) r.durationS = o.healthyDurationS;
       runs.push_back(r);
     }
   }

@@ -15,14 +15,16 @@ namespace flexarm {
 
 struct ScenarioOptions {
   int arms = 20;               // each gives one fault-free run and one run per fault
-  double durationS = 20.0;     // of every run and of the reference runs
+  double durationS = 20.0;     // of the runs with a fault and of the reference runs
+  double healthyDurationS = 0.0;  // of the fault-free runs (0: durationS)
   double faultTimeLowS = 8.0, faultTimeHighS = 12.0;  // the step time, uniform
   double faultSize = 0.2;      // the monitored quantity rises by this part
   double truthSpread = 0.15;   // each parameter of the nominal arm times U(1 - s, 1 + s)
   double noiseLow = 0.5, noiseHigh = 1.5;    // scale of the simulator's torque and load noise
   std::vector<ExcitationKind> excitations = {ExcitationKind::Multisine, ExcitationKind::Prbs};
-  double amplitudeLow = 0.04, amplitudeHigh = 0.08;  // rad on the motor side
-  double rateHz = 200.0;       // log rate (the controller runs at 2 kHz)
+  // rad on the motor side, around the designed experiment of the chapter-6/7 logs (0.2 rad)
+  double amplitudeLow = 0.1, amplitudeHigh = 0.3;
+  double rateHz = 2000.0;      // log rate (the controller's; the diagnosis decimates to 200 Hz)
   std::uint64_t seed = 1;
   bool isValid(std::string* why) const;
 };

@@ -26,4 +26,9 @@ nlohmann::json modelToJson(const std::string& name, const PhysicalModel& model,
 // value outside its bounds, or a malformed effect.
 std::optional<ModelSpec> modelFromJson(const nlohmann::json& j, std::string* why);
 
+// The model named `name` in a session's "models" part (a list of modelToJson objects);
+// nullopt with a sentence when there is none by that name.
+std::optional<ModelSpec> findListModel(const nlohmann::json& models, const std::string& name,
+                                       std::string* why);
+
 }  // namespace flexarm

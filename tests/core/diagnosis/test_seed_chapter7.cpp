@@ -1,11 +1,14 @@
-// The seed's chapter 7 on the sample logs, made the seed's way (Section 7.5): the direct
-// predictor (torque reference to motor velocity), theta_0 fitted on one fault-free data set
-// (diagnosis_step_none) and the diagnosis run on another (diagnosis_no_fault), a 20 % fault
-// simulated by moving theta_0 of one parameter. Reproduces the table of Section 7.5.2 after
-// five seconds and the false alarms of the classical test in Figure 7.1 that the robustified
-// test of Figure 7.2 does not raise.
+// The seed's chapter 7 on the sample logs, made the seed's way (Section 7.5): theta_0 fitted on
+// one fault-free data set (diagnosis_step_none) and the diagnosis run on another
+// (diagnosis_no_fault), a 20 % fault simulated by moving theta_0 of one parameter. With the
+// seed's predictor (torque reference to motor velocity) the table of Section 7.5.2 after five
+// seconds is reproduced; with FlexArm's (reference to motor angle through the loop, whose
+// estimates scatter around theta_0 a little more than lambda_0 P says, as the seed's real data
+// did) the false alarms of the classical test in Figure 7.1 that the robustified test of
+// Figure 7.2 does not raise.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <map>
 
 #include "core/diagnosis/diagnosis.h"
@@ -22,10 +25,9 @@ IdData sampleLog(const std::string& name) {
 
 // The seed's design: thresholds 3 sigma, alpha_1 = 3, alpha_2 = 20, hypothesis level 1 with
 // the cumulative window; no alarm in the first two seconds (the transient the seed mentions).
-DiagnosisOptions seedOptions() {
-  DiagnosisOptions o;
-  o.predictor = DiagnosisPredictor::Direct;
-  o.window = HypothesisWindow::Cumulative;
+DiagnosisOptions seedOptions(DiagnosisPredictor predictor) {
+  DiagnosisOptions o = DiagnosisOptions::seed();
+  o.predictor = predictor;
   return o;
 }
 
@@ -33,10 +35,9 @@ struct SeedRows {
   std::map<std::string, DiagnosisResult> rows;  // "k_T", "J_a", "f_m", "none"
 };
 
-const SeedRows& seedRows() {
-  static const SeedRows rows = [] {
+SeedRows makeRows(DiagnosisPredictor predictor) {
     SeedRows out;
-    const DiagnosisOptions o = seedOptions();
+    const DiagnosisOptions o = seedOptions(predictor);
     const auto model = makeModel("three-mass");
     const DiagnosisReference reference = referenceFromLog(*model, sampleLog("diagnosis_step_none.csv"), o);
     if (!reference.ok()) throw std::runtime_error(reference.message);
@@ -47,7 +48,15 @@ const SeedRows& seedRows() {
       out.rows[fault] = diagnose(r, data, o);
     }
     return out;
-  }();
+}
+
+const SeedRows& directRows() {
+  static const SeedRows rows = makeRows(DiagnosisPredictor::Direct);
+  return rows;
+}
+
+const SeedRows& loopRows() {
+  static const SeedRows rows = makeRows(DiagnosisPredictor::Loop);
   return rows;
 }
 
@@ -56,7 +65,7 @@ const SeedRows& seedRows() {
 TEST(SeedChapter7, HypothesisTableAfterFiveSeconds) {
   const std::map<std::string, std::pair<std::string, std::string>> seed = {
       {"k_T", {"1011", "{F_k_T}"}}, {"J_a", {"1101", "{F_J_a}"}}, {"f_m", {"1110", "{F_f_m}"}}};
-  for (const auto& [fault, result] : seedRows().rows) {
+  for (const auto& [fault, result] : directRows().rows) {
     ASSERT_EQ(result.termination, Termination::Converged) << fault << ": " << result.message;
     const TestTrace* h = result.trace(DiagnosisTest::Hypothesis);
     ASSERT_NE(h, nullptr);
@@ -79,10 +88,11 @@ TEST(SeedChapter7, HypothesisTableAfterFiveSeconds) {
 }
 
 // Figure 7.1 against Figure 7.2: on the fault-free row the classical test raises false alarms
-// with its 3 sigma threshold from lambda_0 P (7.7)-(7.9); the robustified test (7.12)-(7.14)
-// raises none, and it isolates each simulated fault correctly "after some time".
+// with its 3 sigma threshold from lambda_0 P (7.7)-(7.9), and on the fault rows other
+// parameters than the faulty one alarm too; the robustified test (7.12)-(7.14) raises none on
+// the fault-free row, and its isolation of each fault is correct "after some time".
 TEST(SeedChapter7, ClassicalTestFalseAlarmsRobustTestNone) {
-  const auto& rows = seedRows().rows;
+  const auto& rows = loopRows().rows;
   const DiagnosisResult& healthy = rows.at("none");
   const TestOutcome* classical = healthy.outcome(DiagnosisTest::Classical);
   const TestOutcome* robust = healthy.outcome(DiagnosisTest::Robust);
@@ -94,12 +104,18 @@ TEST(SeedChapter7, ClassicalTestFalseAlarmsRobustTestNone) {
   EXPECT_TRUE(classical->detectionTime.has_value());
   EXPECT_EQ(robustAlarms, 0);
   EXPECT_FALSE(robust->detectionTime.has_value());
+  int crossAlarms = 0;
   for (const char* fault : {"k_T", "J_a", "f_m"}) {
-    const TestOutcome* r = rows.at(fault).outcome(DiagnosisTest::Robust);
-    ASSERT_TRUE(r->verdict) << fault;
-    EXPECT_EQ(rows.at(fault).faults[*r->verdict], fault);
-    EXPECT_LT(*r->verdictTime, 10.0) << fault;
+    const DiagnosisResult& row = rows.at(fault);
+    const std::size_t i = static_cast<std::size_t>(
+        std::find(row.faults.begin(), row.faults.end(), fault) - row.faults.begin());
+    const TestOutcome* c = row.outcome(DiagnosisTest::Classical);
+    EXPECT_TRUE(c->firstAlarm[i]) << fault;
+    for (std::size_t j = 0; j < c->alarmEvents.size(); ++j) crossAlarms += j == i ? 0 : c->alarmEvents[j];
+    const TestOutcome* r = row.outcome(DiagnosisTest::Robust);
+    EXPECT_EQ(modeSetString(r->statement.back(), row.faults), "{F_" + std::string(fault) + "}");
   }
+  EXPECT_GE(crossAlarms, 3);
 }
 
 }  // namespace
