@@ -22,6 +22,7 @@
 #include <QSpinBox>
 #include <QUndoStack>
 #include <QStatusBar>
+#include <QToolBar>
 #include <QtConcurrent>
 #include <fstream>
 #include <sstream>
@@ -38,8 +39,10 @@
 #include "widgets/log_panel.h"
 #include "widgets/lqg_panel.h"
 #include "widgets/model_panel.h"
+#include "widgets/playhead.h"
 #include "widgets/preprocess_panel.h"
 #include "widgets/residuals_panel.h"
+#include "widgets/transport_bar.h"
 #include "widgets/workspace.h"
 
 namespace flexarm {
@@ -103,7 +106,7 @@ bool askTableMapping(QWidget* parent, const QString& path, LogReadOptions& o) {
 }  // namespace
 
 MainWindow::MainWindow(QWidget* parent)
-    : QMainWindow(parent), workspace_(new Workspace(this)),
+    : QMainWindow(parent), workspace_(new Workspace(this)), playhead_(new Playhead(this)),
       logPanel_(new LogPanel(workspace_, this)) {
   setObjectName("mainWindow");
   setWindowTitle("FlexArm");
@@ -130,6 +133,26 @@ MainWindow::MainWindow(QWidget* parent)
                       "Ctrl+Shift+L", preprocessDock_);
   discoveryDock_ = addPanel(discoveryPanel_ = new DiscoveryPanel(workspace_, this), tr("Discovery"), "discoveryDock", "Ctrl+Shift+D", preprocessDock_);
   preprocessDock_->raise();
+  // The playhead spans the log as read (preprocessing keeps its times); every panel that
+  // shows time follows it.
+  connect(workspace_, &Workspace::logChanged, this, [this] {
+    const IdData* d = workspace_->raw();
+    if (d && d->samples() > 0)
+      playhead_->setSpan(d->startTime, d->timeAt(d->samples() - 1), d->sampleTime);
+    else
+      playhead_->clearSpan();
+  });
+  logPanel_->setPlayhead(playhead_);
+  armPanel_->setPlayhead(playhead_);
+  comparePanel_->setPlayhead(playhead_);
+  modelPanel_->setPlayhead(playhead_);
+  discoveryPanel_->setPlayhead(playhead_);
+  transportBar_ = new TransportBar(playhead_, this);
+  auto* transport = new QToolBar(tr("Playhead"), this);
+  transport->setObjectName("transportToolBar");
+  transport->setMovable(false);
+  transport->addWidget(transportBar_);
+  addToolBar(Qt::BottomToolBarArea, transport);
   session_ = new SessionController(this, workspace_);  // File menu: sessions and reports
   resize(1280, 860);
 
@@ -352,6 +375,15 @@ void MainWindow::closeEvent(QCloseEvent* e) {
   settings.setValue("window/geometry", saveGeometry());
   settings.setValue("window/state", saveState());
   QMainWindow::closeEvent(e);
+}
+
+void MainWindow::keyPressEvent(QKeyEvent* e) {
+  // Keys reach the window only when no focused widget used them.
+  if (TransportBar::handleKey(playhead_, e)) {
+    e->accept();
+    return;
+  }
+  QMainWindow::keyPressEvent(e);
 }
 
 void MainWindow::dragEnterEvent(QDragEnterEvent* e) {

@@ -1,7 +1,9 @@
 #pragma once
 // The main window: the Log panel in the centre, dockable Preprocess and Arm panels, menus
 // with shortcuts, recent files, drag-and-drop to open, settings kept between runs and
-// status bar messages. Logs are read off the GUI thread.
+// status bar messages. Logs are read off the GUI thread. It owns the one playhead (the
+// current time every panel follows) and its transport bar at the bottom; keys no focused
+// widget takes (Space, arrows) drive the playhead.
 #include <QFutureWatcher>
 #include <QMainWindow>
 #include <QStringList>
@@ -22,7 +24,9 @@ class DiscoveryPanel;
 class LogPanel;
 class LqgPanel;
 class ModelPanel;
+class Playhead;
 class PreprocessPanel;
+class TransportBar;
 class ResidualsPanel;
 class SessionController;
 class Workspace;
@@ -52,6 +56,8 @@ class MainWindow : public QMainWindow {
   SessionController* sessionController() const { return session_; }
   DiscoveryPanel* discoveryPanel() const { return discoveryPanel_; }
   QStringList recentFiles() const;
+  Playhead* playhead() const { return playhead_; }
+  TransportBar* transportBar() const { return transportBar_; }
 
  signals:
   void logOpened(const QString& path);
@@ -61,6 +67,7 @@ class MainWindow : public QMainWindow {
   void closeEvent(QCloseEvent* e) override;
   void dragEnterEvent(QDragEnterEvent* e) override;
   void dropEvent(QDropEvent* e) override;
+  void keyPressEvent(QKeyEvent* e) override;
 
  private:
   void createMenus();
@@ -76,7 +83,9 @@ class MainWindow : public QMainWindow {
   void showError(const QString& title, const QString& message);
 
   Workspace* workspace_;
+  Playhead* playhead_;
   LogPanel* logPanel_;
+  TransportBar* transportBar_ = nullptr;
   PreprocessPanel* preprocessPanel_ = nullptr;
   ArmPanel* armPanel_ = nullptr;
   ModelPanel* modelPanel_ = nullptr;

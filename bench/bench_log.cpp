@@ -1,74 +1,106 @@
-// Reading and decimating a 10-minute, 2 kHz, four-column log: FlexArm against NumPy/SciPy on
-// the same file in one run, reported as time ratios.
-#include <chrono>
-#include <cmath>
-#include <cstdio>
-#include <cstdlib>
+// Reading a 2 kHz robot log: FlexArm's reader against pandas.read_csv (CSV) and
+// scipy.io.loadmat (.mat) on the same files, at 1x, 4x and 16x data (16x is the seed's
+// ten-minute log, 92 MB of CSV). Agreement: sample count and every column's sum of squares.
 #include <filesystem>
-#include <string>
 
+#include "bench_common.h"
+#include "bench_data.h"
 #include "core/io/log_io.h"
-#include "core/signal/preprocess.h"
 
 using namespace flexarm;
+using namespace flexarm::bench;
 
 namespace {
-double seconds(std::chrono::steady_clock::time_point a, std::chrono::steady_clock::time_point b) {
-  return std::chrono::duration<double>(b - a).count();
+
+// Sum of squares of every channel, in the order torque, angle, reference.
+std::vector<double> columnSums(const IdData& d) {
+  std::vector<double> s;
+  for (const char* name : {columns::kTorqueRef, columns::kMotorAngle, columns::kAngleRef}) {
+    const Channel* c = d.channel(name);
+    double sum = 0.0;
+    if (c)
+      for (double v : c->values) sum += v * v;
+    s.push_back(c ? sum : NAN);
+  }
+  return s;
 }
+
+// Agreement of FlexArm's read with the peer's: same sample count, column sums equal.
+void compare(Row& row, const IdData& mine, const Json& peer) {
+  const auto sums = columnSums(mine);
+  const auto theirs = peer.value("sums", std::vector<double>{});
+  double worst = 0.0;
+  bool same = theirs.size() == sums.size() && peer.value("samples", 0L) == static_cast<long>(mine.samples());
+  for (std::size_t i = 0; same && i < sums.size(); ++i) worst = std::max(worst, relDiff(sums[i], theirs[i]));
+  row.agree = same && worst < 1e-9;
+  std::ostringstream s;
+  s.precision(2);
+  s << "values: " << mine.samples() << " samples, sums of squares differ by " << worst;
+  row.agreement = same ? s.str() : "values: different sample counts or columns";
+}
+
 }  // namespace
 
 int main() {
-  const std::size_t n = 2000 * 600;
-  IdData d;
-  d.sampleTime = 0.0005;
-  std::vector<double> angle(n), torque(n), ref(n);
-  for (std::size_t i = 0; i < n; ++i) {
-    const double t = i * d.sampleTime;
-    ref[i] = 0.05 * std::sin(2 * M_PI * (0.5 + 0.02 * t) * t);
-    angle[i] = ref[i] + 1e-4 * std::sin(2 * M_PI * 17 * t);
-    torque[i] = 0.1 * std::cos(2 * M_PI * 3.1 * t) + 0.01 * std::sin(2 * M_PI * 211 * t);
+  TempDir dir("flexarm-bench-log");
+  std::vector<std::string> csv;
+  for (int scale : {1, 4, 16}) {
+    csv.push_back(dir.file("log" + std::to_string(scale) + "x.csv"));
+    if (!writeFlexArmCsv(syntheticLog(kLogUnit * scale), csv.back())) return 1;
   }
-  d.setChannel({columns::kMotorAngle, "", ChannelRole::Output, angle});
-  d.setChannel({columns::kTorqueRef, "", ChannelRole::Input, torque});
-  d.setChannel({columns::kAngleRef, "", ChannelRole::Reference, ref});
-  const std::string path = (std::filesystem::temp_directory_path() / "flexarm_bench_10min.csv").string();
-  if (!writeFlexArmCsv(d, path)) return 1;
-  std::printf("log: %s, %zu samples x 3 channels, %.1f MB\n", path.c_str(), n,
-              std::filesystem::file_size(path) / 1e6);
+  const std::string mat = dir.file("log16x.mat");
+  // The peer reads every CSV with pandas, writes the largest as .mat and reads it back.
+  std::string args = std::to_string(repeats(5)) + " " + mat;
+  for (const auto& f : csv) args += " " + f;
+  std::string why;
+  const auto peer = runPeer(python("peer_log.py", args), &why);
 
-  const int reps = 3;
-  double readBest = 1e9, decBest = 1e9;
-  std::size_t outSamples = 0;
-  for (int r = 0; r < reps; ++r) {
-    auto t0 = std::chrono::steady_clock::now();
-    LogReadResult res = readLog(path);
-    auto t1 = std::chrono::steady_clock::now();
-    if (!res.ok) return 1;
-    DecimateOptions o;
-    o.factor = 10;
-    IdData y = decimate(res.data, o);
-    auto t2 = std::chrono::steady_clock::now();
-    readBest = std::min(readBest, seconds(t0, t1));
-    decBest = std::min(decBest, seconds(t1, t2));
-    outSamples = y.samples();
+  for (std::size_t i = 0; i < csv.size(); ++i) {
+    const int scale = 1 << (2 * i);
+    LogReadResult res;
+    Row row;
+    row.group = "log";
+    row.task = "read CSV log";
+    row.scale = scale;
+    row.flexarmSeconds = medianSeconds(repeats(scale == 16 ? 3 : 5), [&] { res = readLog(csv[i]); });
+    if (!res.ok) {
+      std::cerr << "bench_log: " << res.error.toString() << "\n";
+      return 1;
+    }
+    const double bytes = static_cast<double>(std::filesystem::file_size(csv[i]));
+    row.size = megabytes(bytes) + ", " + std::to_string(res.data.samples() / 1000) + "k x 4";
+    row.extra["bytes"] = bytes;
+    row.extra["flexarm_mb_s"] = bytes / 1e6 / row.flexarmSeconds;
+    row.peer = "pandas.read_csv";
+    const Json p = peerResult(peer, "csv" + std::to_string(i));
+    if (!p.is_null()) {
+      row.peerSeconds = p["seconds"].get<double>();
+      compare(row, res.data, p);
+    } else {
+      row.extra["note"] = why;
+    }
+    emit(row);
   }
-  std::printf("FlexArm: read %.3f s, decimate x10 (FIR, 3 channels) %.3f s -> %zu samples\n",
-              readBest, decBest, outSamples);
 
-  const std::string cmd = std::string("/usr/bin/python3 ") + FLEXARM_BENCH_DIR + "/peer_log.py " + path + " 10";
-  double peerRead = 0, peerDec = 0;
-  long peerSamples = 0;
-  if (FILE* p = popen(cmd.c_str(), "r")) {
-    if (std::fscanf(p, "%lf %lf %ld", &peerRead, &peerDec, &peerSamples) != 3) peerRead = 0;
-    pclose(p);
-  }
-  if (peerRead <= 0) {
-    std::printf("peer (NumPy/SciPy) did not run: install python3-scipy\n");
+  Row row;
+  row.group = "log";
+  row.task = "read .mat log";
+  row.peer = "scipy.io.loadmat";
+  const Json p = peerResult(peer, "mat");
+  if (p.is_null() || !std::filesystem::exists(mat)) {
+    std::cerr << "bench_log: the peer wrote no .mat file (" << why << ")\n";
     return 1;
   }
-  std::printf("NumPy/SciPy: read %.3f s, decimate %.3f s -> %ld samples\n", peerRead, peerDec, peerSamples);
-  std::printf("ratio (peer / FlexArm): read %.1fx, decimate %.1fx\n", peerRead / readBest, peerDec / decBest);
-  if (!std::getenv("FLEXARM_BENCH_KEEP")) std::filesystem::remove(path);
+  LogReadResult res;
+  row.flexarmSeconds = medianSeconds(repeats(3), [&] { res = readLog(mat); });
+  if (!res.ok) {
+    std::cerr << "bench_log: " << res.error.toString() << "\n";
+    return 1;
+  }
+  row.size = megabytes(static_cast<double>(std::filesystem::file_size(mat))) + ", " +
+             std::to_string(res.data.samples() / 1000) + "k x 4";
+  row.peerSeconds = p["seconds"].get<double>();
+  compare(row, res.data, p);
+  emit(row);
   return 0;
 }

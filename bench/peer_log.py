@@ -1,18 +1,34 @@
-"""Peer for bench_log: reads the same FlexArm CSV log with NumPy and decimates every channel
-by the same factor with SciPy (FIR, zero phase). Prints one line: read_s decimate_s samples."""
+"""Peer of bench_log: reads the same FlexArm CSV logs with pandas.read_csv, writes the last
+as a MATLAB .mat file (scipy.io.savemat) and reads it back with scipy.io.loadmat.
+
+Usage: peer_log.py REPEATS MAT_PATH CSV...
+Prints one JSON line per file: name (csv0, csv1, ..., mat), seconds (median), samples and
+the sums of squares of torque_ref_nm, motor_angle_rad, angle_ref_rad."""
 import sys
-import time
 
 import numpy as np
-from scipy import signal
+import pandas as pd
+import scipy.io
 
-path, factor = sys.argv[1], int(sys.argv[2])
-t0 = time.perf_counter()
-# np.loadtxt cannot skip the named header after comments, so hand it the lines after it.
-with open(path, "r", encoding="ascii") as f:
-    lines = [ln for ln in f if not ln.startswith("#")]
-data = np.loadtxt(lines[1:], delimiter=",")
-t1 = time.perf_counter()
-out = [signal.decimate(data[:, c], factor, ftype="fir", zero_phase=True) for c in range(1, data.shape[1])]
-t2 = time.perf_counter()
-print(f"{t1 - t0:.6f} {t2 - t1:.6f} {len(out[0])}")
+from peer_common import emit, median_seconds
+
+COLUMNS = ("torque_ref_nm", "motor_angle_rad", "angle_ref_rad")
+
+
+def main():
+    repeats, mat_path, files = int(sys.argv[1]), sys.argv[2], sys.argv[3:]
+    frame = None
+    for i, path in enumerate(files):
+        # comment="#" skips the metadata lines; the header follows them.
+        sec, frame = median_seconds(repeats if i < 2 else min(repeats, 3),
+                                    lambda: pd.read_csv(path, comment="#"))
+        emit(f"csv{i}", sec, samples=len(frame),
+             sums=[float((frame[c] ** 2).sum()) for c in COLUMNS])
+    scipy.io.savemat(mat_path, {c: frame[c].to_numpy() for c in ("time_s",) + COLUMNS},
+                     oned_as="column")
+    sec, mat = median_seconds(min(repeats, 3), lambda: scipy.io.loadmat(mat_path))
+    emit("mat", sec, samples=int(mat["time_s"].size),
+         sums=[float(np.sum(mat[c] ** 2)) for c in COLUMNS])
+
+
+main()

@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
 # Installs every Debian package FlexArm needs to build, run and test.
+# With --bench: the peers of the benchmarks instead (scripts/bench.sh; not needed by CI).
 # Idempotent: packages already present are skipped, so a second run is quick.
 set -euo pipefail
 
@@ -12,6 +13,11 @@ PACKAGES=(
   xvfb xauth libgl1-mesa-dri
   poppler-utils python3-scipy
 )
+
+if [ "${1:-}" = "--bench" ]; then
+  PACKAGES=(python3-numpy python3-scipy python3-pandas python3-matplotlib
+            octave octave-control octave-signal)
+fi
 
 missing=()
 for p in "${PACKAGES[@]}"; do

@@ -1,21 +1,19 @@
 #pragma once
-// Arm dock: the 3D arm (VTK) that the user rotates and zooms with the mouse, and a time
-// slider with Play that moves axis one along the loaded log's motor angle (through the gear
-// ratio, magnified so that small motions can be seen).
+// Arm dock: the 3D arm (VTK) that the user rotates and zooms with the mouse. It follows the
+// window's playhead: axis one turns by the loaded log's motor angle through the gear ratio,
+// magnified so that small motions can be seen.
 #include <QWidget>
 #include <memory>
 
 #include "widgets/workspace.h"
 
 class QLabel;
-class QSlider;
 class QSpinBox;
-class QTimer;
-class QToolButton;
 
 namespace flexarm {
 
 class ArmScene;
+class Playhead;
 class VtkView;
 
 class ArmPanel : public QWidget {
@@ -26,8 +24,11 @@ class ArmPanel : public QWidget {
 
   VtkView* view() const { return view_; }
   ArmScene* scene() const { return scene_.get(); }
-  // Shows the arm at sample index i of the current data.
-  void showSample(int i);
+  // Follows the window's playhead.
+  void setPlayhead(Playhead* playhead);
+  // Shows the arm at time t (seconds of the log).
+  void showTime(double t);
+  QString labelText() const;
 
  private:
   void onDataChanged();
@@ -35,11 +36,9 @@ class ArmPanel : public QWidget {
   Workspace* workspace_;
   std::unique_ptr<ArmScene> scene_;
   VtkView* view_;
-  QSlider* time_;
-  QToolButton* play_;
   QSpinBox* magnify_;
   QLabel* label_;
-  QTimer* timer_;
+  Playhead* playhead_ = nullptr;
   double gearRatio_ = 1.0 / 118.0;
 };
 

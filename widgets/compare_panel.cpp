@@ -11,6 +11,7 @@
 #include <qcustomplot.h>
 
 #include "widgets/ident_data.h"
+#include "widgets/plots/playhead_cursor.h"
 
 namespace flexarm {
 namespace {
@@ -22,7 +23,8 @@ constexpr std::size_t kMaxPoints = 6000;
 
 ComparePanel::ComparePanel(Workspace* workspace, QWidget* parent)
     : QWidget(parent), workspace_(workspace), models_(new QListWidget(this)),
-      range_(new QComboBox(this)), plot_(new QCustomPlot(this)), fit_(new QLabel(this)) {
+      range_(new QComboBox(this)), plot_(new QCustomPlot(this)), fit_(new QLabel(this)),
+      cursor_(new PlayheadCursor(plot_, this)) {
   setObjectName("comparePanel");
   models_->setObjectName("compareModelList");
   models_->setMaximumWidth(220);
@@ -64,6 +66,8 @@ void ComparePanel::refillList() {
   fillModelChecklist(models_, workspace_->models());
   refresh();
 }
+
+void ComparePanel::setPlayhead(Playhead* playhead) { cursor_->setPlayhead(playhead); }
 
 void ComparePanel::setModelShown(int index, bool shown) {
   if (index >= 0 && index < models_->count())

@@ -15,6 +15,9 @@ class QListWidget;
 
 namespace flexarm {
 
+class Playhead;
+class PlayheadCursor;
+
 class ComparePanel : public QWidget {
   Q_OBJECT
  public:
@@ -26,6 +29,9 @@ class ComparePanel : public QWidget {
   std::vector<double> fits() const { return fits_; }
   QString fitText() const;
   QCustomPlot* plot() const { return plot_; }
+  // Shows the window's playhead in the plot; a click there moves it.
+  void setPlayhead(Playhead* playhead);
+  PlayheadCursor* playheadCursor() const { return cursor_; }
 
  public slots:
   void refresh();
@@ -38,6 +44,7 @@ class ComparePanel : public QWidget {
   QComboBox* range_;
   QCustomPlot* plot_;
   QLabel* fit_;
+  PlayheadCursor* cursor_;
   std::vector<double> fits_;
 };
 

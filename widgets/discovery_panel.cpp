@@ -15,6 +15,7 @@
 #include <qcustomplot.h>
 
 #include "core/signal/preprocess.h"
+#include "widgets/plots/playhead_cursor.h"
 
 namespace flexarm {
 
@@ -79,7 +80,9 @@ DiscoveryPanel::DiscoveryPanel(Workspace* workspace, QWidget* parent)
       table_(new QTableWidget(0, 7, this)),
       residualTime_(new QCustomPlot(this)),
       residualSpectrum_(new QCustomPlot(this)),
-      overlay_(new QCustomPlot(this)) {
+      overlay_(new QCustomPlot(this)),
+      residualCursor_(new PlayheadCursor(residualTime_, this)),
+      overlayCursor_(new PlayheadCursor(overlay_, this)) {
   find_->setObjectName("findMissingEffect");
   add_->setObjectName("addToModel");
   find_->setToolTip(tr("Fit the base model, map where it disagrees with the log, fit each "
@@ -215,6 +218,13 @@ void DiscoveryPanel::clearPlots() {
     p->clearItems();
     p->replot();
   }
+  residualCursor_->attach();
+  overlayCursor_->attach();
+}
+
+void DiscoveryPanel::setPlayhead(Playhead* playhead) {
+  residualCursor_->setPlayhead(playhead);
+  overlayCursor_->setPlayhead(playhead);
 }
 
 QString DiscoveryPanel::verdictText() const { return verdict_->text(); }

@@ -23,6 +23,9 @@ class QTableWidget;
 
 namespace flexarm {
 
+class Playhead;
+class PlayheadCursor;
+
 class DiscoveryPanel : public QWidget {
   Q_OBJECT
  public:
@@ -43,6 +46,8 @@ class DiscoveryPanel : public QWidget {
   QCustomPlot* residualTimePlot() const { return residualTime_; }
   QCustomPlot* residualSpectrumPlot() const { return residualSpectrum_; }
   QCustomPlot* overlayPlot() const { return overlay_; }
+  // Shows the window's playhead in the plots over time; a click there moves it.
+  void setPlayhead(Playhead* playhead);
   DiscoveryOptions& options() { return options_; }
   // What the shown result was asked (base, data ranges, options); null before the first
   // result.
@@ -93,6 +98,8 @@ class DiscoveryPanel : public QWidget {
   QCustomPlot* residualTime_;
   QCustomPlot* residualSpectrum_;
   QCustomPlot* overlay_;
+  PlayheadCursor* residualCursor_;
+  PlayheadCursor* overlayCursor_;
   QFutureWatcher<Outcome> watcher_;
   std::shared_ptr<std::atomic<bool>> cancelFlag_;
   std::shared_ptr<DiscoveryResult> result_;

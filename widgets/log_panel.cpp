@@ -10,11 +10,15 @@
 #include <cmath>
 #include <qcustomplot.h>
 
+#include "widgets/playhead.h"
+#include "widgets/plots/playhead_cursor.h"
+
 namespace flexarm {
 namespace {
 
 const QColor kEstimationColor(30, 110, 220);
 const QColor kValidationColor(235, 130, 20);
+const QColor kLoopColor(90, 160, 90);
 const QColor kTraceColors[] = {QColor(31, 119, 180), QColor(214, 39, 40), QColor(44, 160, 44),
                                QColor(148, 103, 189), QColor(140, 86, 75), QColor(227, 119, 194),
                                QColor(127, 127, 127), QColor(188, 189, 34)};
@@ -30,7 +34,8 @@ QString label(const Channel& c) {
 
 LogPanel::LogPanel(Workspace* workspace, QWidget* parent)
     : QWidget(parent), workspace_(workspace), plot_(new QCustomPlot(this)),
-      readout_(new QLabel(this)), rangeTable_(new QTableWidget(2, 4, this)) {
+      readout_(new QLabel(this)), rangeTable_(new QTableWidget(2, 4, this)),
+      playheadCursor_(new PlayheadCursor(plot_, this)) {
   setObjectName("logPanel");
   auto* tools = new QHBoxLayout;
   auto makeButton = [&](const QString& text, const QString& tip, const QString& shortcut) {
@@ -49,6 +54,9 @@ LogPanel::LogPanel(Workspace* workspace, QWidget* parent)
       makeButton(tr("Select estimation range"), tr("Drag in the plot to select"), "E");
   validationButton_ =
       makeButton(tr("Select validation range"), tr("Drag in the plot to select"), "V");
+  loopButton_ = makeButton(tr("Select loop"), tr("Drag in the plot to select what the playhead "
+                                                 "loops over"), "L");
+  loopButton_->setObjectName("loopSelectButton");
   navigateButton_->setObjectName("navigateButton");
   estimationButton_->setObjectName("estimationButton");
   validationButton_->setObjectName("validationButton");
@@ -96,6 +104,7 @@ LogPanel::LogPanel(Workspace* workspace, QWidget* parent)
   connect(navigateButton_, &QToolButton::toggled, this, [this](bool on) { if (on) setMode(Mode::Navigate); });
   connect(estimationButton_, &QToolButton::toggled, this, [this](bool on) { if (on) setMode(Mode::SelectEstimation); });
   connect(validationButton_, &QToolButton::toggled, this, [this](bool on) { if (on) setMode(Mode::SelectValidation); });
+  connect(loopButton_, &QToolButton::toggled, this, [this](bool on) { if (on) setMode(Mode::SelectLoop); });
   connect(clear, &QToolButton::clicked, this, [this] {
     workspace_->clearRange(RangeKind::Estimation);
     workspace_->clearRange(RangeKind::Validation);
@@ -107,14 +116,25 @@ LogPanel::LogPanel(Workspace* workspace, QWidget* parent)
   connect(plot_, &QCustomPlot::mouseDoubleClick, this, &LogPanel::onMouseDoubleClick);
   connect(workspace_, &Workspace::currentChanged, this, &LogPanel::rebuild);
   connect(workspace_, &Workspace::rangesChanged, this, &LogPanel::updateRanges);
+  playheadCursor_->setFollow(true);
   rebuild();
+}
+
+void LogPanel::setPlayhead(Playhead* playhead) {
+  if (playhead_) disconnect(playhead_, nullptr, this, nullptr);
+  playhead_ = playhead;
+  playheadCursor_->setPlayhead(playhead);
+  if (playhead_)
+    connect(playhead_, &Playhead::selectionChanged, this, &LogPanel::updateLoopSelection);
+  updateLoopSelection();
 }
 
 void LogPanel::setMode(Mode m) {
   mode_ = m;
   QToolButton* b = m == Mode::Navigate           ? navigateButton_
                    : m == Mode::SelectEstimation ? estimationButton_
-                                                 : validationButton_;
+                   : m == Mode::SelectValidation ? validationButton_
+                                                 : loopButton_;
   if (!b->isChecked()) b->setChecked(true);
   plot_->setInteraction(QCP::iRangeDrag, m == Mode::Navigate);
   plot_->setCursor(m == Mode::Navigate ? Qt::OpenHandCursor : Qt::IBeamCursor);
@@ -143,6 +163,7 @@ void LogPanel::rebuild() {
   cursors_.clear();
   estimationRects_.clear();
   validationRects_.clear();
+  loopRects_.clear();
   const IdData* data = workspace_->current();
   if (!plot_->layer("ranges")) {
     plot_->addLayer("ranges", plot_->layer("main"), QCustomPlot::limBelow);
@@ -154,6 +175,7 @@ void LogPanel::rebuild() {
   if (!data || data->channels.empty()) {
     plot_->replot();
     updateRanges();
+    playheadCursor_->attach();
     return;
   }
   auto* margins = new QCPMarginGroup(plot_);
@@ -204,7 +226,8 @@ void LogPanel::rebuild() {
     cursors_.push_back(cursor);
 
     for (auto [list, color] : {std::pair{&estimationRects_, kEstimationColor},
-                               std::pair{&validationRects_, kValidationColor}}) {
+                               std::pair{&validationRects_, kValidationColor},
+                               std::pair{&loopRects_, kLoopColor}}) {
       auto* r = new QCPItemRect(plot_);
       r->setLayer("ranges");
       r->setClipAxisRect(rect);
@@ -224,6 +247,8 @@ void LogPanel::rebuild() {
   }
   showAll();
   updateRanges();
+  updateLoopSelection();
+  playheadCursor_->attach();
   readout_->setText(tr("%1 channels, %2 samples at %3 Hz, %4 s")
                         .arg(data->channels.size())
                         .arg(n)
@@ -298,6 +323,12 @@ void LogPanel::updateRanges() {
   plot_->replot(QCustomPlot::rpQueuedReplot);
 }
 
+void LogPanel::updateLoopSelection() {
+  const auto s = playhead_ ? playhead_->selection() : std::nullopt;
+  for (auto* item : loopRects_) placeRect(item, s ? s->first : 0, s ? s->second : 0, s.has_value());
+  if (auto* layer = plot_->layer("ranges")) layer->replot();
+}
+
 void LogPanel::onMousePress(QMouseEvent* e) {
   if (mode_ == Mode::Navigate || rects_.empty() || e->button() != Qt::LeftButton) return;
   selecting_ = true;
@@ -322,7 +353,9 @@ void LogPanel::onMouseMove(QMouseEvent* e) {
     readout_->setText(text);
   }
   if (selecting_) {
-    auto* list = mode_ == Mode::SelectEstimation ? &estimationRects_ : &validationRects_;
+    auto* list = mode_ == Mode::SelectEstimation   ? &estimationRects_
+                 : mode_ == Mode::SelectValidation ? &validationRects_
+                                                   : &loopRects_;
     for (auto* item : *list) placeRect(item, selectStart_, t, true);
     plot_->layer("ranges")->replot();
   }
@@ -333,15 +366,21 @@ void LogPanel::onMouseRelease(QMouseEvent* e) {
   if (!selecting_) return;
   selecting_ = false;
   const IdData* data = workspace_->current();
-  const RangeKind kind = mode_ == Mode::SelectEstimation ? RangeKind::Estimation : RangeKind::Validation;
   double t0 = selectStart_, t1 = timeAtPixel(e->position().x());
   if (t1 < t0) std::swap(t0, t1);
   t0 = std::max(t0, data->startTime);
   t1 = std::min(t1, data->timeAt(data->samples() - 1));
   if (t1 - t0 < 2.0 * data->sampleTime) {  // a click, not a drag: keep the old range
     updateRanges();
+    updateLoopSelection();
     return;
   }
+  if (mode_ == Mode::SelectLoop) {
+    if (playhead_) playhead_->setSelection(t0, t1);
+    updateLoopSelection();
+    return;
+  }
+  const RangeKind kind = mode_ == Mode::SelectEstimation ? RangeKind::Estimation : RangeKind::Validation;
   // Snap to samples so the listed times are sample times.
   const SampleRange s = data->rangeForTimes(t0, t1);
   workspace_->setRange(kind, {data->timeAt(s.begin), data->timeAt(s.end - 1)});

@@ -2,7 +2,9 @@
 // Log panel: every channel of the current data against time in stacked plots sharing the
 // time axis. Wheel zooms time, drag pans; a crosshair follows the mouse with a readout of
 // time and values; in range mode a drag selects the estimation or validation range, shown
-// as shaded regions and listed with their sample counts.
+// as shaded regions and listed with their sample counts; in loop mode a drag selects the
+// playhead's loop selection. The window's playhead is a red line across every channel; a
+// click in a plot moves it, and while playing the time axis pages to keep it in view.
 #include <QWidget>
 #include <memory>
 #include <vector>
@@ -24,13 +26,19 @@ class QWheelEvent;
 
 namespace flexarm {
 
+class Playhead;
+class PlayheadCursor;
+
 class LogPanel : public QWidget {
   Q_OBJECT
  public:
-  enum class Mode { Navigate, SelectEstimation, SelectValidation };
+  enum class Mode { Navigate, SelectEstimation, SelectValidation, SelectLoop };
 
   explicit LogPanel(Workspace* workspace, QWidget* parent = nullptr);
 
+  // Follows the window's playhead and moves it on a click.
+  void setPlayhead(Playhead* playhead);
+  PlayheadCursor* playheadCursor() const { return playheadCursor_; }
   void setMode(Mode m);
   Mode mode() const { return mode_; }
   QCustomPlot* plot() const { return plot_; }
@@ -55,6 +63,7 @@ class LogPanel : public QWidget {
   void refreshChannel(std::size_t c);
   double timeAtPixel(double x) const;
   void placeRect(QCPItemRect* item, double t0, double t1, bool visible);
+  void updateLoopSelection();
 
   Workspace* workspace_;
   QCustomPlot* plot_;
@@ -63,10 +72,13 @@ class LogPanel : public QWidget {
   QToolButton* navigateButton_;
   QToolButton* estimationButton_;
   QToolButton* validationButton_;
+  QToolButton* loopButton_;
+  Playhead* playhead_ = nullptr;
+  PlayheadCursor* playheadCursor_;
   QCPLayer* overlay_ = nullptr;
   std::vector<QCPAxisRect*> rects_;
   std::vector<QCPItemStraightLine*> cursors_;
-  std::vector<QCPItemRect*> estimationRects_, validationRects_;
+  std::vector<QCPItemRect*> estimationRects_, validationRects_, loopRects_;
   std::vector<std::unique_ptr<EnvelopePyramid>> envelopes_;
   Mode mode_ = Mode::Navigate;
   bool selecting_ = false;

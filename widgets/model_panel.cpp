@@ -20,6 +20,7 @@
 #include "core/signal/preprocess.h"
 #include "widgets/ident_data.h"
 #include "widgets/plots/bode_plot.h"
+#include "widgets/plots/playhead_cursor.h"
 #include "widgets/plots/pole_zero_plot.h"
 
 namespace flexarm {
@@ -39,7 +40,8 @@ ModelPanel::ModelPanel(Workspace* workspace, QWidget* parent)
       effects_(new QTableWidget(0, 4, this)), bode_(new BodePlot(this)),
       poleZero_(new PoleZeroPlot(this)), frequencies_(new QLabel(this)),
       description_(new QLabel(this)), simulate_(new QPushButton(tr("Simulate against log"), this)),
-      compare_(new QCustomPlot(this)), fit_(new QLabel(this)) {
+      compare_(new QCustomPlot(this)), fit_(new QLabel(this)),
+      cursor_(new PlayheadCursor(compare_, this)) {
   setObjectName("modelPanel");
   list_->setObjectName("modelList");
   structure_->setObjectName("structureCombo");
@@ -344,6 +346,8 @@ void ModelPanel::onEffectEdited(int row, int column) {
   }
   setEffect(kind, on, first);
 }
+
+void ModelPanel::setPlayhead(Playhead* playhead) { cursor_->setPlayhead(playhead); }
 
 void ModelPanel::simulateAgainstLog() {
   const IdData* data = workspace_->current();

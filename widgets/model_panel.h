@@ -19,6 +19,8 @@ class QTableWidget;
 namespace flexarm {
 
 class BodePlot;
+class Playhead;
+class PlayheadCursor;
 class PoleZeroPlot;
 
 class ModelPanel : public QWidget {
@@ -39,6 +41,8 @@ class ModelPanel : public QWidget {
   QString frequencyText() const;
   BodePlot* bode() const { return bode_; }
   PoleZeroPlot* poleZero() const { return poleZero_; }
+  // Shows the window's playhead in the simulation plot; a click there moves it.
+  void setPlayhead(Playhead* playhead);
 
  signals:
   void simulationFinished(double fitPercent);
@@ -67,6 +71,7 @@ class ModelPanel : public QWidget {
   QPushButton* simulate_;
   QCustomPlot* compare_;
   QLabel* fit_;
+  PlayheadCursor* cursor_;
   QFutureWatcher<SimOutcome> simulation_;
   int current_ = -1;
   bool filling_ = false;

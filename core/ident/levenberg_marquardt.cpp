@@ -152,8 +152,17 @@ LeastSquaresSolution levenbergMarquardt(const LeastSquaresProblem& problem,
       s.message = "cancelled by the user";
       break;
     }
-    const Eigen::MatrixXd R = r.psi.transpose() * r.psi;  // N times (4.21)
-    const Eigen::VectorXd g = r.psi.transpose() * r.eps;  // -N times (4.19)
+    // N times (4.21) and -N times (4.19). Few parameters: one dot product per entry, which
+    // for tall, narrow psi beats the blocked matrix product.
+    Eigen::MatrixXd R;
+    Eigen::VectorXd g;
+    if (r.psi.cols() <= 16) {
+      R.noalias() = r.psi.transpose().lazyProduct(r.psi);
+      g.noalias() = r.psi.transpose().lazyProduct(r.eps);
+    } else {
+      R.noalias() = r.psi.transpose() * r.psi;
+      g.noalias() = r.psi.transpose() * r.eps;
+    }
     const double dmax = std::max(1e-300, R.diagonal().maxCoeff());
     const Eigen::VectorXd scale = R.diagonal().cwiseMax(1e-12 * dmax);
     bool accepted = false;

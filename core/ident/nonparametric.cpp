@@ -114,6 +114,13 @@ NonparametricEstimate etfe(const Eigen::VectorXd& u, const Eigen::VectorXd& y, d
   if (omega.empty())
     for (int k = 1; k <= nb; ++k) omega.push_back(k * dw);
   const double width = std::max(1, options.smoothingWidth);
+  // The Hann weights at whole-bin offsets, for frequencies on the DFT grid (the default).
+  const int half = static_cast<int>(std::ceil(width));
+  std::vector<double> gridWeight(2 * half + 1);
+  for (int j = -half; j <= half; ++j) {
+    const double x = j / width;
+    gridWeight[j + half] = std::abs(x) >= 1.0 ? 0.0 : 0.5 * (1.0 + std::cos(M_PI * x));
+  }
   for (double w : omega) {
     const double kc = w / dw;  // fractional bin
     std::complex<double> num = 0.0;
@@ -126,12 +133,17 @@ NonparametricEstimate etfe(const Eigen::VectorXd& u, const Eigen::VectorXd& y, d
       // Hann window over frequency (4.25), half-width `width` bins, weighted by |U|^2.
       const int lo = std::max(0, static_cast<int>(std::floor(kc - width)));
       const int hi = std::min(nb, static_cast<int>(std::ceil(kc + width)));
+      const bool onGrid = std::abs(kc - std::round(kc)) < 1e-9;
+      const int kr = static_cast<int>(std::lround(kc));
       for (int k = lo; k <= hi; ++k) {
         const double x = (k - kc) / width;
         if (std::abs(x) >= 1.0) continue;
-        const double a = 0.5 * (1.0 + std::cos(M_PI * x));
-        num += a * Y[k] * std::conj(U[k]);
-        den += a * std::norm(U[k]);
+        const double a = onGrid && std::abs(k - kr) <= half ? gridWeight[k - kr + half]
+                                                            : 0.5 * (1.0 + std::cos(M_PI * x));
+        // Y conj(U) written out: std::complex's product checks for infinities on every call.
+        const double ur = U[k].real(), ui = U[k].imag(), yr = Y[k].real(), yi = Y[k].imag();
+        num += std::complex<double>(a * (yr * ur + yi * ui), a * (yi * ur - yr * ui));
+        den += a * (ur * ur + ui * ui);
       }
     }
     r.response.omega.push_back(w);

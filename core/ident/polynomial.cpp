@@ -6,23 +6,80 @@
 
 namespace flexarm {
 
-Eigen::VectorXd filter(const Poly& num, const Poly& den, const Eigen::VectorXd& x) {
+namespace {
+
+// y_j[t] -= sum_{k=1}^{na-1} den[k] y_j[t-k] in place for the S series y_0..y_{S-1}, the
+// lag-one term last so that each sample waits for its predecessor through one multiply-subtract
+// only, and the series interleaved so that their recursions overlap; Order > 0 unrolls the
+// lags. Each series gets exactly the operations it would get alone.
+template <int Order, int S>
+void recurse(const double* den, int na, double* const* y, Eigen::Index n) {
+  const int m = Order > 0 ? Order + 1 : na;
+  for (Eigen::Index t = 1; t < std::min<Eigen::Index>(m - 1, n); ++t)
+    for (int j = 0; j < S; ++j)
+      for (int k = static_cast<int>(t); k >= 1; --k) y[j][t] -= den[k] * y[j][t - k];
+  for (Eigen::Index t = m - 1; t < n; ++t) {
+    double s[S];
+    for (int j = 0; j < S; ++j) s[j] = y[j][t];
+    for (int k = m - 1; k >= 2; --k)
+      for (int j = 0; j < S; ++j) s[j] -= den[k] * y[j][t - k];
+    for (int j = 0; j < S; ++j) y[j][t] = s[j] - den[1] * y[j][t - 1];
+  }
+}
+
+// num(q)/den(q) applied to the S signals x[j] into y[j] (sized by the caller).
+template <int S>
+void filterMany(const Poly& num, const Poly& den, const Eigen::VectorXd* const* x,
+                Eigen::VectorXd* const* y) {
   if (den.empty() || den[0] == 0.0)
     throw std::invalid_argument("filter: the denominator's leading coefficient is zero");
-  const Eigen::Index n = x.size();
-  Eigen::VectorXd y(n);
-  const int nb = static_cast<int>(num.size());
-  const int na = static_cast<int>(den.size());
+  const Eigen::Index n = x[0]->size();
+  // Monic form: the leading coefficient divides both polynomials.
   const double inv0 = 1.0 / den[0];
-  for (Eigen::Index t = 0; t < n; ++t) {
-    double s = 0.0;
-    const int kb = static_cast<int>(std::min<Eigen::Index>(nb - 1, t));
-    for (int k = 0; k <= kb; ++k) s += num[k] * x[t - k];
-    const int ka = static_cast<int>(std::min<Eigen::Index>(na - 1, t));
-    for (int k = 1; k <= ka; ++k) s -= den[k] * y[t - k];
-    y[t] = s * inv0;
+  int na = static_cast<int>(den.size());
+  while (na > 1 && den[na - 1] == 0.0) --na;
+  // Moving average part (vectorized over t), then the autoregressive recursion.
+  double* out[S];
+  for (int j = 0; j < S; ++j) {
+    Eigen::VectorXd& yj = *y[j];
+    yj.setZero(n);
+    for (std::size_t k = 0; k < num.size() && static_cast<Eigen::Index>(k) < n; ++k) {
+      const double c = num[k] * inv0;
+      if (c == 0.0) continue;
+      const Eigen::Index len = n - static_cast<Eigen::Index>(k);
+      yj.tail(len) += c * x[j]->head(len);
+    }
+    out[j] = yj.data();
   }
+  if (na == 1) return;
+  std::vector<double> dn(den.begin(), den.begin() + na);
+  for (double& v : dn) v *= inv0;
+  switch (na - 1) {
+    case 1: recurse<1, S>(dn.data(), na, out, n); break;
+    case 2: recurse<2, S>(dn.data(), na, out, n); break;
+    case 3: recurse<3, S>(dn.data(), na, out, n); break;
+    case 4: recurse<4, S>(dn.data(), na, out, n); break;
+    default: recurse<0, S>(dn.data(), na, out, n); break;
+  }
+}
+
+}  // namespace
+
+Eigen::VectorXd filter(const Poly& num, const Poly& den, const Eigen::VectorXd& x) {
+  Eigen::VectorXd y;
+  const Eigen::VectorXd* in[1] = {&x};
+  Eigen::VectorXd* out[1] = {&y};
+  filterMany<1>(num, den, in, out);
   return y;
+}
+
+void filter(const Poly& num, const Poly& den, const Eigen::VectorXd& x1,
+            const Eigen::VectorXd& x2, Eigen::VectorXd& y1, Eigen::VectorXd& y2) {
+  if (x1.size() != x2.size())
+    throw std::invalid_argument("filter: the two signals differ in length");
+  const Eigen::VectorXd* in[2] = {&x1, &x2};
+  Eigen::VectorXd* out[2] = {&y1, &y2};
+  filterMany<2>(num, den, in, out);
 }
 
 Eigen::VectorXd delayed(const Eigen::VectorXd& x, int k) {

@@ -28,13 +28,6 @@ class MainWindowTest : public QObject {
  private:
   MainWindow* window_ = nullptr;
 
-  // A mouse move delivered straight to the widget, so no other window can take it.
-  static void moveMouse(QWidget* w, QPoint p) {
-    QMouseEvent move(QEvent::MouseMove, QPointF(p), w->mapToGlobal(QPointF(p)), Qt::NoButton,
-                     Qt::NoButton, Qt::NoModifier);
-    QApplication::sendEvent(w, &move);
-  }
-
   // Drags in the log plot from time t0 to t1 in the first channel's plot.
   void drag(double t0, double t1) {
     QCustomPlot* plot = window_->logPanel()->plot();
@@ -42,7 +35,7 @@ class MainWindowTest : public QObject {
     const QPoint a(static_cast<int>(std::lround(window_->logPanel()->pixelForTime(t0))), y);
     const QPoint b(static_cast<int>(std::lround(window_->logPanel()->pixelForTime(t1))), y);
     QTest::mousePress(plot, Qt::LeftButton, Qt::NoModifier, a);
-    for (int i = 1; i <= 10; ++i) moveMouse(plot, a + (b - a) * i / 10);
+    for (int i = 1; i <= 10; ++i) test::moveMouse(plot, a + (b - a) * i / 10);
     QTest::mouseRelease(plot, Qt::LeftButton, Qt::NoModifier, b);
   }
 
@@ -129,7 +122,7 @@ class MainWindowTest : public QObject {
     QCustomPlot* plot = window_->logPanel()->plot();
     const int y = static_cast<int>(window_->logPanel()->channelRect(1)->center().y());
     const int x = static_cast<int>(std::lround(window_->logPanel()->pixelForTime(5.0)));
-    moveMouse(plot, QPoint(x, y));
+    test::moveMouse(plot, QPoint(x, y));
     const QString text = window_->logPanel()->readoutText();
     QVERIFY2(text.startsWith("t = "), qPrintable(text));
     const double t = text.mid(4, text.indexOf(" s") - 4).toDouble();

@@ -1,7 +1,9 @@
 #pragma once
 // Helpers shared by the widget tests: the VTK surface format, screenshots, pixel checks.
+#include <QApplication>
 #include <QDir>
 #include <QImage>
+#include <QMouseEvent>
 #include <QString>
 #include <QWidget>
 
@@ -15,6 +17,14 @@ inline QString saveShot(const QImage& image, const QString& name) {
   const QString path = QString(FLEXARM_SCREENSHOT_DIR) + "/" + name + ".png";
   image.save(path);
   return path;
+}
+
+// A mouse move delivered straight to the widget (with the buttons held), so no other window
+// can take it.
+inline void moveMouse(QWidget* w, QPoint p, Qt::MouseButtons held = Qt::NoButton) {
+  QMouseEvent move(QEvent::MouseMove, QPointF(p), w->mapToGlobal(QPointF(p)), Qt::NoButton, held,
+                   Qt::NoModifier);
+  QApplication::sendEvent(w, &move);
 }
 
 // Fraction of pixels that look like the arm's orange paint (RGB 237,115,26 before lighting).

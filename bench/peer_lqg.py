@@ -1,16 +1,18 @@
-"""Peer of bench_lqg.cpp: one LQG slider move in SciPy.
+"""Peer of bench_lqg: one LQG slider move in SciPy.
 
 Redesign with scipy.linalg.solve_continuous_are (LQR of the four-state arm, Kalman filter of
 the model with the arm-load state x5), frequency responses of F_y G and G_0 on the grid
 that FlexArm used, |S| and |T|, and the closed-loop disturbance steps (Figure 8.3) by a
-zero-order-hold discretization, as FlexArm does. Prints "seconds <median>".
-Usage: bench_lqg.py GRID_FILE REPETITIONS
+zero-order-hold discretization, as FlexArm does. Prints one JSON line: name "lqg", seconds
+(median), max_s and peak_arm of case (ii) (R2 = 1e-8), regulator_rhp_poles.
+Usage: peer_lqg.py GRID_FILE REPETITIONS
 """
 import sys
-import time
 
 import numpy as np
 from scipy.linalg import expm, solve_continuous_are
+
+from peer_common import CLOCK, emit
 
 Jm, Ja, fm, fa, k, d = 0.0043, 0.0762, 0.02, 0.005, 43.0, 0.05
 A = np.array([[0, 1, 0, 0],
@@ -71,13 +73,12 @@ def main():
     times = []
     for i in range(reps):
         r2 = 10.0 ** (-8.0 + 2.0 * (i % 20) / 19.0)
-        t0 = time.perf_counter()
+        t0 = CLOCK()
         slider_move(r2, s)
-        times.append(time.perf_counter() - t0)
+        times.append(CLOCK() - t0)
     ms, _, peak, poles, _ = slider_move(1e-8, s)
-    print("case (ii): max|S| %.5f, peak arm deviation %.6f, regulator RHP poles %d"
-          % (ms, peak, int((poles[1].real > 1e-9 * np.abs(poles[1]).max()).sum())))
-    print("seconds %.9f" % float(np.median(times)))
+    emit("lqg", float(np.median(times)), max_s=float(ms), peak_arm=float(peak),
+         regulator_rhp_poles=int((poles[1].real > 1e-9 * np.abs(poles[1]).max()).sum()))
 
 
 main()
