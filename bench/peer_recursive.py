@@ -6,18 +6,15 @@ model (3.21) built at the current estimate every sample and sampled with scipy.l
 
 Usage: peer_recursive.py DIR   (DIR holds data.csv and setup.json written by bench_recursive)
 Prints one JSON line per algorithm: name, seconds (the recursion only, interpreter start-up
-and reading excluded), samples, theta (final estimate: k_T, J_a^-1, f_m)."""
+and reading excluded; peer_common's clock), samples, theta (final estimate: k_T, J_a^-1,
+f_m)."""
 import json
-import os
 import sys
-import time
 
 import numpy as np
 from scipy.linalg import expm
 
-
-# FLEXARM_BENCH_CLOCK=cpu: the process's CPU time, as the bench program measures it.
-CLOCK = time.process_time if os.environ.get("FLEXARM_BENCH_CLOCK") == "cpu" else time.perf_counter
+from peer_common import emit, median_seconds
 
 
 def three_mass(p):
@@ -107,13 +104,10 @@ def main():
     setup = json.load(open(folder + "/setup.json"))
     u, y = data[:, 0], data[:, 1]
     for run in setup["runs"]:
-        t0 = CLOCK()
-        theta = rpem(u, y, setup["ts"], setup["nominal"], setup["theta0"], run["p0"],
-                     run["algorithm"], setup["lambda"], setup["r1"], setup["r2"])
-        sec = CLOCK() - t0
-        print(json.dumps({"name": run["algorithm"], "seconds": sec, "samples": len(u),
-                          "theta": [float(v) for v in theta]}), flush=True)
-
+        seconds, theta = median_seconds(1, lambda: rpem(
+            u, y, setup["ts"], setup["nominal"], setup["theta0"], run["p0"], run["algorithm"],
+            setup["lambda"], setup["r1"], setup["r2"]))
+        emit(run["algorithm"], seconds, samples=len(u), theta=[float(v) for v in theta])
 
 if __name__ == "__main__":
     main()

@@ -101,6 +101,7 @@ std::unique_ptr<PhysicalModel> modelFromFile(const std::string& path, std::strin
   }
   // A session's or `flexarm model`'s model: {"structure", "parameters": [{name, value}, ...]}.
   if (j.contains("structure")) {
+    if (!j.contains("name")) j["name"] = path;  // `flexarm model --json` names none
     auto spec = modelFromJson(j, why);
     if (!spec) return nullptr;
     return std::unique_ptr<PhysicalModel>(

@@ -168,55 +168,44 @@ InitialCovariance steadyStateCovariance(const ParametricModel& nominal, const Ei
   return r;
 }
 
-RecursiveResult recursiveIdentification(const ParametricModel& nominal, const Eigen::VectorXd& u,
-                                        const Eigen::VectorXd& y, double T,
-                                        const RecursiveOptions& options,
-                                        const ProgressCallback& progress, double startTime) {
-  const auto clock0 = std::chrono::steady_clock::now();
-  auto elapsed = [&]() {
-    return std::chrono::duration<double>(std::chrono::steady_clock::now() - clock0).count();
-  };
+RecursiveStart startRecursive(const ParametricModel& nominal, const Eigen::VectorXd& u,
+                              const Eigen::VectorXd& y, double T, const RecursiveOptions& options,
+                              double startTime) {
   if (u.size() != y.size())
     throw std::invalid_argument("recursive identification: input and output must have the same "
                                 "number of samples");
   std::string why;
   if (!options.isValid(&why)) throw std::invalid_argument("recursive identification: " + why);
-  RecursiveResult r;
-  r.sampleTime = T;
+  RecursiveStart start;
+  start.failed.sampleTime = T;
   if (const std::string bad = nonFinite(u, y, T, startTime); !bad.empty()) {
-    r.message = bad;
-    r.seconds = elapsed();
-    return r;
+    start.failed.message = bad;
+    return start;
   }
   RecursiveOptions o = options;
   if (o.p0.empty() && !o.estimate.empty()) {
     const InitialCovariance ic = steadyStateCovariance(nominal, u, y, T, options);
     if (ic.termination != Termination::Converged) {
-      r.message = ic.message;
-      r.seconds = elapsed();
-      return r;
+      start.failed.message = ic.message;
+      return start;
     }
     o.p0.assign(ic.p0.data(), ic.p0.data() + ic.p0.size());
-    r.Q = ic.Q;
+    start.Q = ic.Q;
   }
-  RecursiveEstimator est(nominal, T, o, startTime);
+  start.estimator.emplace(nominal, T, o, startTime);
+  return start;
+}
+
+RecursiveResult finishRecursive(const RecursiveEstimator& est, RecursiveTrajectory trajectory,
+                                std::size_t totalSamples, bool cancelled, const Eigen::MatrixXd& Q) {
+  RecursiveResult r;
+  r.sampleTime = est.sampleTime();
+  r.Q = Q;
+  r.trajectory = std::move(trajectory);
   const auto& params = est.parameters();
-  const Eigen::Index N = u.size();
-  r.trajectory.reserve(static_cast<std::size_t>(N), params.size());
-  const Eigen::Index chunk = std::max<Eigen::Index>(1, N / 100);
-  bool cancelled = false;
-  double sumSquares = 0.0;
-  for (Eigen::Index k = 0; k < N; ++k) {
-    if (k % chunk == 0 && reportProgress(progress, static_cast<double>(k) / N, "recursive")) {
-      cancelled = true;
-      break;
-    }
-    const RecursiveStep& s = est.update(u[k], y[k]);
-    if (!s.ok) break;
-    r.trajectory.append(s);
-    sumSquares += s.epsilon * s.epsilon;
-  }
   r.samples = r.trajectory.size();
+  double sumSquares = 0.0;
+  for (double e : r.trajectory.epsilon) sumSquares += e * e;
   r.rmsEpsilon = r.samples ? std::sqrt(sumSquares / static_cast<double>(r.samples)) : 0.0;
   r.p0 = est.initialCovariance().diagonal();
   r.P = est.covariance();
@@ -239,17 +228,49 @@ RecursiveResult recursiveIdentification(const ParametricModel& nominal, const Ei
   if (!est.ok()) {
     r.termination = Termination::Diverged;
     r.message = est.message();
-  } else if (cancelled) {
+  } else if (cancelled || r.samples < totalSamples) {
     r.termination = Termination::Cancelled;
-    r.message = "Cancelled after " + std::to_string(r.samples) + " of " + std::to_string(N) +
+    r.message = "Stopped after " + std::to_string(r.samples) + " of " + std::to_string(totalSamples) +
                 " samples.";
   } else {
     r.termination = Termination::Converged;
     std::string m = est.message();  // "Processed N samples; ..."
-    r.message = "Processed all " + std::to_string(N) + " samples (" +
-                formatNumber(static_cast<double>(N) * T) + " s)" + m.substr(m.find(';'));
+    r.message = "Processed all " + std::to_string(totalSamples) + " samples (" +
+                formatNumber(static_cast<double>(totalSamples) * r.sampleTime) + " s)" +
+                m.substr(m.find(';'));
   }
-  r.seconds = elapsed();
+  return r;
+}
+
+RecursiveResult recursiveIdentification(const ParametricModel& nominal, const Eigen::VectorXd& u,
+                                        const Eigen::VectorXd& y, double T,
+                                        const RecursiveOptions& options,
+                                        const ProgressCallback& progress, double startTime) {
+  const auto clock0 = std::chrono::steady_clock::now();
+  RecursiveStart start = startRecursive(nominal, u, y, T, options, startTime);
+  if (!start.estimator) {
+    start.failed.seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - clock0).count();
+    return start.failed;
+  }
+  RecursiveEstimator& est = *start.estimator;
+  const Eigen::Index N = u.size();
+  RecursiveTrajectory trajectory;
+  trajectory.reserve(static_cast<std::size_t>(N), est.parameters().size());
+  const Eigen::Index chunk = std::max<Eigen::Index>(1, N / 100);
+  bool cancelled = false;
+  for (Eigen::Index k = 0; k < N; ++k) {
+    if (k % chunk == 0 && reportProgress(progress, static_cast<double>(k) / N, "recursive")) {
+      cancelled = true;
+      break;
+    }
+    const RecursiveStep& s = est.update(u[k], y[k]);
+    if (!s.ok) break;
+    trajectory.append(s);
+  }
+  RecursiveResult r = finishRecursive(est, std::move(trajectory), static_cast<std::size_t>(N),
+                                      cancelled, start.Q);
+  r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - clock0).count();
   return r;
 }
 

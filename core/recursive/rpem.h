@@ -239,6 +239,25 @@ struct RecursiveResult {
   std::shared_ptr<const ParametricModel> model;  // the model at the final estimate
 };
 
+// The two halves of recursiveIdentification, for a caller that feeds the samples itself (a
+// panel that animates the run as the log plays): startRecursive checks the data and chooses
+// P(0) as recursiveIdentification does and hands over the estimator at sample 0 (or a Failed
+// result with a sentence); finishRecursive summarises the run as recursiveIdentification
+// returns it. Misuse throws std::invalid_argument, as there.
+struct RecursiveStart {
+  RecursiveResult failed;  // termination Failed with a sentence when it could not start
+  std::optional<RecursiveEstimator> estimator;
+  Eigen::MatrixXd Q;  // (6.53) from the pre-run (empty when P(0) was given)
+};
+RecursiveStart startRecursive(const ParametricModel& nominal, const Eigen::VectorXd& u,
+                              const Eigen::VectorXd& y, double sampleTime,
+                              const RecursiveOptions& options, double startTime = 0.0);
+// trajectory: the steps the estimator returned (ok ones); totalSamples: how many the data had;
+// cancelled: the caller stopped early. seconds is left for the caller.
+RecursiveResult finishRecursive(const RecursiveEstimator& estimator, RecursiveTrajectory trajectory,
+                                std::size_t totalSamples, bool cancelled,
+                                const Eigen::MatrixXd& Q = {});
+
 // Runs the estimator over a whole log: P(0) from options.p0, else steadyStateCovariance on the
 // same data; then every sample. Progress is reported as the fraction of samples done.
 RecursiveResult recursiveIdentification(const ParametricModel& nominal, const Eigen::VectorXd& u,

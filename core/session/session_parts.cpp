@@ -16,6 +16,7 @@
 #include "core/session/fit_request.h"
 #include "core/session/lqg_part.h"
 #include "core/session/model_json.h"
+#include "core/session/recursive_part.h"
 #include "core/session/session_part.h"
 #include "core/signal/preprocess.h"
 
@@ -195,6 +196,7 @@ const std::vector<std::shared_ptr<const SessionPart>>& sessionParts() {
       makeFitsPart(),
       makeDiscoveryPart(),
       makeLqgPart(),
+      makeRecursivePart(),
       makeDiagnosisPart(),
       std::make_shared<ViewPart>(),
   };

@@ -9,6 +9,9 @@
 #include <string>
 
 #include "cli_test_support.h"
+#include "core/session/recursive_part.h"
+#include "core/session/session.h"
+#include "core/session/sha256.h"
 
 using namespace flexarm::test;
 using nlohmann::json;
@@ -126,4 +129,45 @@ TEST(CliRecursive, TheDifferenceGradientDivergesWithExitFour) {
   EXPECT_NE(j["message"].get<std::string>().find("t = "), std::string::npos) << j["message"];
   EXPECT_LT(j["samples"].get<int>(), 4800);
   EXPECT_FALSE(readAll(csv).empty());
+}
+
+// A session holding a recursive run (what the Recursive panel saves) replays headless: the
+// report has the run's section with the final values in the model's names.
+TEST(CliRecursive, FlexarmRunReplaysASessionsRecursiveRun) {
+  const auto dir = scratchDir();
+  const std::string path = (dir / "recursive_session.json").string();
+  flexarm::Session s;
+  flexarm::LogReference l;
+  l.name = "diagnosis";
+  l.path = kLog;
+  std::string why;
+  l.sha256 = flexarm::sha256OfFile(kLog, &why).value_or("");
+  s.logs.push_back(l);
+  flexarm::RecursiveRequest q;
+  q.label = "seed";
+  q.options.startScale = 1.2;
+  s.parts["recursive"] = {{"runs", json::array({{{"request", flexarm::recursiveRequestToJson(q)}}})}};
+  ASSERT_TRUE(flexarm::saveSession(s, path, &why)) << why;
+  const auto r = runFlexarm({"run", path, "--json"});
+  ASSERT_EQ(r.code, 0) << r.err;
+  const json j = json::parse(r.out);
+  bool found = false;
+  for (const auto& sec : j["sections"])
+    if (sec["title"] == "Recursive identification: seed") {
+      found = true;
+      EXPECT_EQ(sec["values"]["termination"], "converged");
+      EXPECT_NEAR(sec["values"]["final"]["J_a"].get<double>(), 1.72, 0.05);
+    }
+  EXPECT_TRUE(found) << r.out;
+#if FLEXARM_GUI_BUILD
+  const std::string pdf = (dir / "recursive.pdf").string();
+  const auto p = runFlexarm({"run", path, "--report", pdf});
+  ASSERT_EQ(p.code, 0) << p.err;
+  const std::string txt = pdf + ".txt";
+  ASSERT_EQ(std::system(("pdftotext -layout '" + pdf + "' '" + txt + "'").c_str()), 0);
+  const std::string text = readAll(txt);
+  EXPECT_NE(text.find("Recursive identification: seed"), std::string::npos);
+  EXPECT_NE(text.find("Estimates at the end"), std::string::npos);
+  EXPECT_NE(text.find("J_a^-1 (theta)"), std::string::npos);
+#endif
 }
