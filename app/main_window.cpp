@@ -35,6 +35,7 @@
 #include "widgets/bode_panel.h"
 #include "widgets/compare_panel.h"
 #include "widgets/fit_panel.h"
+#include "widgets/diagnosis_panel.h"
 #include "widgets/discovery_panel.h"
 #include "widgets/log_panel.h"
 #include "widgets/lqg_panel.h"
@@ -132,6 +133,8 @@ MainWindow::MainWindow(QWidget* parent)
   lqgDock_ = addPanel(lqgPanel_ = new LqgPanel(workspace_, this), tr("LQG"), "lqgDock",
                       "Ctrl+Shift+L", preprocessDock_);
   discoveryDock_ = addPanel(discoveryPanel_ = new DiscoveryPanel(workspace_, this), tr("Discovery"), "discoveryDock", "Ctrl+Shift+D", preprocessDock_);
+  diagnosisDock_ = addPanel(diagnosisPanel_ = new DiagnosisPanel(workspace_, this), tr("Diagnosis"),
+                            "diagnosisDock", "Ctrl+Shift+G", preprocessDock_);
   preprocessDock_->raise();
   // The playhead spans the log as read (preprocessing keeps its times); every panel that
   // shows time follows it.
@@ -147,6 +150,7 @@ MainWindow::MainWindow(QWidget* parent)
   comparePanel_->setPlayhead(playhead_);
   modelPanel_->setPlayhead(playhead_);
   discoveryPanel_->setPlayhead(playhead_);
+  diagnosisPanel_->setPlayhead(playhead_);
   transportBar_ = new TransportBar(playhead_, this);
   auto* transport = new QToolBar(tr("Playhead"), this);
   transport->setObjectName("transportToolBar");

@@ -28,6 +28,7 @@ class Playhead;
 class PreprocessPanel;
 class TransportBar;
 class ResidualsPanel;
+class DiagnosisPanel;
 class SessionController;
 class Workspace;
 
@@ -55,6 +56,7 @@ class MainWindow : public QMainWindow {
   LqgPanel* lqgPanel() const { return lqgPanel_; }
   SessionController* sessionController() const { return session_; }
   DiscoveryPanel* discoveryPanel() const { return discoveryPanel_; }
+  DiagnosisPanel* diagnosisPanel() const { return diagnosisPanel_; }
   QStringList recentFiles() const;
   Playhead* playhead() const { return playhead_; }
   TransportBar* transportBar() const { return transportBar_; }
@@ -105,6 +107,8 @@ class MainWindow : public QMainWindow {
   QDockWidget* lqgDock_ = nullptr;
   SessionController* session_ = nullptr;
   QDockWidget* discoveryDock_ = nullptr;
+  DiagnosisPanel* diagnosisPanel_ = nullptr;
+  QDockWidget* diagnosisDock_ = nullptr;
   QMenu* recentMenu_ = nullptr;
   QMenu* viewMenu_ = nullptr;
   QFutureWatcher<LogReadResult> reader_;

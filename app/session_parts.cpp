@@ -4,10 +4,14 @@
 #include <QVariant>
 
 #include "app/main_window.h"
+#include "core/diagnosis/diagnosis_json.h"
+#include "core/session/diagnosis_part.h"
 #include "core/session/discovery_part.h"
 #include "core/session/fit_request.h"
 #include "core/session/lqg_part.h"
 #include "core/session/model_json.h"
+#include "app/session_controller.h"
+#include "widgets/diagnosis_panel.h"
 #include "widgets/discovery_panel.h"
 #include "widgets/lqg_panel.h"
 #include "widgets/model_panel.h"
@@ -154,6 +158,45 @@ void resetLqg(MainWindow& w) {
   if (w.lqgPanel()) w.lqgPanel()->setDesign(LqgOptions::seedCaseI(), 0.0, w.lqgPanel()->tableSourceText());
 }
 
+// The Diagnosis panel's request (its reference log joins the session's logs under this name)
+// and the summary of its result; restoring takes the request over without running it.
+constexpr const char* kDiagnosisReference = "diagnosis_reference";
+
+json captureDiagnosis(const MainWindow& w) {
+  const DiagnosisPanel* panel = w.diagnosisPanel();
+  if (!panel) return nullptr;
+  const auto request = panel->sessionRequest(kDiagnosisReference);
+  if (!request) return nullptr;
+  json section = {{"request", diagnosisRequestToJson(*request)}};
+  if (const DiagnosisRun* run = panel->lastRun(); run && run->ok())
+    section["result"] = diagnosisResultJson(run->result);
+  return section;
+}
+
+std::vector<LogReference> diagnosisLogs(const MainWindow& w) {
+  const DiagnosisPanel* panel = w.diagnosisPanel();
+  if (!panel || panel->referenceLogPath().isEmpty() || !panel->sessionRequest(kDiagnosisReference))
+    return {};
+  LogReference l;
+  l.name = kDiagnosisReference;
+  l.path = panel->referenceLogPath().toStdString();
+  return {l};
+}
+
+void restoreDiagnosis(const json& section, MainWindow& w) {
+  std::string why;
+  const auto request = diagnosisRequestFromJson(section["request"], &why);
+  if (!request || !w.diagnosisPanel()) return;
+  const QString path = request->referenceLog.empty() || !w.sessionController()
+                           ? QString()
+                           : w.sessionController()->sessionLogPath(request->referenceLog);
+  w.diagnosisPanel()->setRequest(*request, path);
+}
+
+void resetDiagnosis(MainWindow& w) {
+  if (w.diagnosisPanel()) w.diagnosisPanel()->clearResult();
+}
+
 json captureView(const MainWindow& w) {
   return {{"window_state", w.saveState().toBase64().toStdString()},
           {"selected_model", w.modelPanel() ? w.modelPanel()->currentIndex() : -1}};
@@ -175,6 +218,7 @@ const std::vector<WindowSessionPart>& windowSessionParts() {
       {"fits", &captureFits, &restoreFits},
       {"discovery", &captureDiscovery, &restoreDiscovery, &resetDiscovery},
       {"lqg", &captureLqg, &restoreLqg, &resetLqg},
+      {"diagnosis", &captureDiagnosis, &restoreDiagnosis, &resetDiagnosis, &diagnosisLogs},
       {"view", &captureView, &restoreView},
   };
   return kParts;

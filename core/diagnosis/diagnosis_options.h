@@ -71,7 +71,7 @@ struct DiagnosisOptions {
   double robustK = 3.0;        // the 3 of the robust threshold 3 sigma (Figure 7.2)
   double cusumAlpha1 = 3.0;    // (7.15) (seed: 3)
   double cusumAlpha2 = 20.0;   // (7.17) (seed: 20)
-  double hypothesisThreshold = 1.06;  // the seed's 1, "a natural choice after normalisation"
+  double hypothesisThreshold = 1.12;  // the seed's 1, "a natural choice after normalisation"
   HypothesisWindow window = HypothesisWindow::Sliding;  // on-line use (seed: cumulative)
   double windowS = 5.0;        // length of the sliding window, s
   // Per-parameter factors on the thresholds of the classical, robust and CUSUM tests, one per
@@ -79,7 +79,7 @@ struct DiagnosisOptions {
   // h = alpha_2 theta_0 (7.17) is in the parameter's own units, so one alpha_2 does not give
   // every parameter the same false-alarm rate. The defaults are for k_T, J_a (as J_a^-1), f_m.
   std::vector<double> classicalScales;
-  std::vector<double> robustScales = {2.0, 0.6, 1.8};
+  std::vector<double> robustScales = {2.0, 1.0, 1.8};
   std::vector<double> cusumScales = {0.2, 0.27, 1.25};
   // A diagnosis statement must hold this long before it becomes the verdict (0: at once).
   double confirmS = 0.0;

@@ -107,9 +107,11 @@ TEST(CliRun, PdfTextHasTitlesParametersChecksumAndTheJsonFitPercent) {
   const std::string hidden = truth["effects"][0]["name"];
   const nlohmann::json* discovery = nullptr;
   const nlohmann::json* lqg = nullptr;
+  const nlohmann::json* diagnosis = nullptr;
   for (const auto& s : j["sections"]) {
     if (s["title"] == "Discovery: the missing effect") discovery = &s["values"];
     if (s["title"] == "LQG design (chapter 8)") lqg = &s["values"];
+    if (s["title"] == "Diagnosis (chapter 7)") diagnosis = &s["values"];
   }
   ASSERT_NE(discovery, nullptr);
   ASSERT_NE(lqg, nullptr);
@@ -138,6 +140,19 @@ TEST(CliRun, PdfTextHasTitlesParametersChecksumAndTheJsonFitPercent) {
   for (const char* title : {"Design options", "Nyquist curve of F_y G near -1",
                             "Sensitivity |S| (8.36) and complementary sensitivity |T|"})
     EXPECT_NE(text.find(title), std::string::npos) << title;
+  // The diagnosis of the log whose torque constant steps up at 12 s names it shortly after,
+  // and the report states the thresholds with the false-alarm rate they were chosen for.
+  ASSERT_NE(diagnosis, nullptr);
+  const nlohmann::json step = nlohmann::json::parse(
+      readAll(std::string(FLEXARM_SAMPLE_DIR) + "/diagnosis_step_k_T.truth.json"))["parameter_steps"][0];
+  EXPECT_EQ((*diagnosis)["verdict"], step["name"]);
+  const double delay = (*diagnosis)["alarm_time_s"].get<double>() - step["time_s"].get<double>();
+  EXPECT_GT(delay, 0.0);
+  EXPECT_LT(delay, 2.0);
+  for (const char* words : {"Diagnosis (chapter 7)", "Verdict: k_T changed", "Thresholds",
+                            "false alarms per hour", "Decision structure (Section 7.5.2)",
+                            "CUSUM (7.1), (7.15)-(7.17) against its threshold", "Alarm timeline"})
+    EXPECT_NE(text.find(words), std::string::npos) << words;
 }
 
 TEST(CliRun, HtmlIsSelfContained) {
