@@ -99,7 +99,7 @@ class DiagnosisMonitor {
   // noiseVariance) set; throws std::invalid_argument otherwise or for invalid options. Of the
   // signals only the predictor, its controller, the sample time and the start time are used:
   // update() is then fed their input and output sample by sample.
-  DiagnosisMonitor(const DiagnosisReference& reference, const DiagnosisSignals& signals,
+  DiagnosisMonitor(const DiagnosisReference& reference, const DiagnosisSignals& data,
                    const DiagnosisOptions& options);
   ~DiagnosisMonitor();
   DiagnosisMonitor(const DiagnosisMonitor&) = delete;

@@ -44,7 +44,7 @@ std::optional<DiagnosisSignals> diagnosisSignals(const IdData& log, DiagnosisPre
 // The model that predicts the signals' output from their input for the plant: the plant (its
 // motor-velocity form) or the plant in the loop.
 std::unique_ptr<ParametricModel> predictorModel(const PhysicalModel& plant,
-                                                const DiagnosisSignals& signals);
+                                                const DiagnosisSignals& data);
 // The plant inside a predictor model (the inverse of predictorModel).
 std::unique_ptr<PhysicalModel> plantOf(const ParametricModel& predictor);
 

@@ -62,7 +62,7 @@ struct DiagnosisOptions {
                                          DiagnosisTest::Hypothesis};
 
   // The thresholds. The seed's design values (3 sigma, alpha_1 = 3, alpha_2 = 20, level 1 over
-  // the cumulative window; seed() gives them) scaled per parameter as bench/bench_diagnosis
+  // the cumulative window; seed() gives them) scaled per parameter as bench/montecarlo_diagnosis
   // calibrated them on designed experiments (Section 6.6.2) of randomly drawn arms, with a
   // margin over the largest excursion of the fault-free runs; the classical test keeps the
   // seed's 3 sigma, whose false alarms (Figure 7.1) are what the others remove.

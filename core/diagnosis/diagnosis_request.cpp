@@ -78,7 +78,7 @@ DiagnosisRun runDiagnosisRequest(const DiagnosisRequest& request, const IdData& 
 
 std::string defaultThresholdsProvenance() {
   return "the seed's design values (3 sigma, alpha_1 = 3, alpha_2 = 20, level 1) scaled per "
-         "parameter as calibrated by bench/bench_diagnosis (see DiagnosisOptions)";
+         "parameter as calibrated by bench/montecarlo_diagnosis (see DiagnosisOptions)";
 }
 
 }  // namespace flexarm

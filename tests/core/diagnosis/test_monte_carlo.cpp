@@ -2,7 +2,7 @@
 // parameter of Table 5.7 p6 within +-15 %), noise levels (0.5-1.5 times the simulator's) and
 // designed excitations (multisine or PRBS, 0.1-0.3 rad), each arm diagnosed against theta_0
 // fitted on a fault-free run of its own, at FlexArm's default thresholds. A reduced count of
-// the Monte-Carlo study bench/bench_diagnosis runs in full (its output is quoted in the
+// the Monte-Carlo study bench/montecarlo_diagnosis runs in full (its output is quoted in the
 // report): 20 % faults isolated correctly within 5 s, median delay <= 2 s, no alarm on the
 // fault-free runs; 10 % faults isolated later, with their delays.
 #include <gtest/gtest.h>

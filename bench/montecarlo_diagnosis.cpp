@@ -5,7 +5,7 @@
 // the fault-free runs against the detection delay as the threshold scale c varies (the
 // delay/false-alarm curve), the calibrated threshold for the stated rate, and the isolation
 // of every fault within the horizon.
-//   bench_diagnosis [key=value ...]
+//   montecarlo_diagnosis [key=value ...]   (build: cmake --build build --target montecarlo_diagnosis)
 //     arms=60 threads=2 size=0.2 duration=20 healthy=0 (s of the fault-free runs, 0: duration)
 //     rate=1 (false alarms per hour) seed=1
 //     alpha1=3 window=cumulative|SECONDS predictor=auto|loop|direct noise=0.5:1.5 spread=0.15
@@ -38,9 +38,13 @@ void pair(const std::string& text, double& a, double& b) {
 
 void printPoint(const char* name, const CalibrationPoint& p, const std::vector<std::string>& faults,
                 const std::vector<double>& iso, const std::vector<double>& delay) {
-  std::printf("  %-10s c=%5.2f threshold %-8.4g FA %3d = %7.3g/h (95%% <= %7.3g/h)  isolated %5.1f %%, wrong %4.1f %%, "
+  // A test's point has its threshold; the decision's combines the tests' own.
+  char threshold[64] = "";
+  if (faults.empty() || std::string(name).rfind("decision", 0) != 0)
+    std::snprintf(threshold, sizeof threshold, "c=%5.2f threshold %-8.4g ", p.scale, p.threshold);
+  std::printf("  %-10s %sFA %3d = %7.3g/h (95%% <= %7.3g/h)  isolated %5.1f %%, wrong %4.1f %%, "
               "median delay %s s, 95th %s s |",
-              name, p.scale, p.threshold, p.falseAlarms, p.falseAlarmsPerHour, p.falseAlarmsPerHourUpper,
+              name, threshold, p.falseAlarms, p.falseAlarmsPerHour, p.falseAlarmsPerHourUpper,
               100.0 * p.isolatedFraction, 100.0 * p.wrongFraction, delayText(p.medianDelayS).c_str(),
               delayText(p.p95DelayS).c_str());
   for (std::size_t i = 0; i < faults.size() && i < iso.size(); ++i)
@@ -56,7 +60,7 @@ int main(int argc, char** argv) {
     const std::string a = argv[i];
     const auto eq = a.find('=');
     if (eq == std::string::npos) {
-      std::fprintf(stderr, "bench_diagnosis: arguments are key=value, not '%s'\n", a.c_str());
+      std::fprintf(stderr, "montecarlo_diagnosis: arguments are key=value, not '%s'\n", a.c_str());
       return 2;
     }
     kv[a.substr(0, eq)] = a.substr(eq + 1);
@@ -86,9 +90,13 @@ int main(int argc, char** argv) {
   options.cusumAlpha1 = number("alpha1", options.cusumAlpha1);
   options.confirmS = number("confirm", options.confirmS);
   options.settleS = number("settle", options.settleS);
-  if (kv.count("window") && kv["window"] != "cumulative") {
-    options.window = HypothesisWindow::Sliding;
-    options.windowS = number("window", 5.0);
+  if (kv.count("window")) {
+    if (kv["window"] == "cumulative") {
+      options.window = HypothesisWindow::Cumulative;
+    } else {
+      options.window = HypothesisWindow::Sliding;
+      options.windowS = number("window", options.windowS);
+    }
   }
   if (kv.count("predictor")) options.predictor = *diagnosisPredictorFromString(kv["predictor"]);
   CalibrationOptions co;
@@ -100,7 +108,7 @@ int main(int argc, char** argv) {
   for (auto k : so.excitations) kinds += std::string(kinds.empty() ? "" : " or ") + toString(k);
   const auto nominal = makeModel("three-mass");
   const auto runs = randomScenarios(*nominal, options.parameters, so);
-  std::printf("bench_diagnosis: %d arms (three-mass Table 5.7 p6, every parameter times U(%.2f, %.2f)), "
+  std::printf("montecarlo_diagnosis: %d arms (three-mass Table 5.7 p6, every parameter times U(%.2f, %.2f)), "
               "noise x U(%.2f, %.2f), %s of U(%.3f, %.3f) rad, %.0f s runs at %.0f Hz, "
               "%+.0f %% faults stepping in at U(%.0f, %.0f) s; predictor %s, CUSUM alpha_1 %.3g, hypothesis "
               "window %s, settle %.3g s, confirm %.3g s; %zu runs on %d threads\n",
