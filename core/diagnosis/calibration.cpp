@@ -23,21 +23,6 @@ std::vector<double> defaultScales() {
   return s;
 }
 
-// The 95 % upper confidence bound of a Poisson mean after n events.
-double poissonUpper(int n) {
-  auto cdf = [n](double mu) {
-    double term = std::exp(-mu), sum = term;
-    for (int k = 1; k <= n; ++k) sum += (term *= mu / k);
-    return sum;
-  };
-  double lo = 0.0, hi = 10.0 + 5.0 * n;
-  for (int i = 0; i < 100; ++i) {
-    const double mid = 0.5 * (lo + hi);
-    (cdf(mid) > 0.05 ? lo : hi) = mid;
-  }
-  return 0.5 * (lo + hi);
-}
-
 // Median with missed runs as +infinity; 95th percentile likewise.
 double quantile(std::vector<double> v, double q) {
   if (v.empty()) return NAN;
@@ -155,6 +140,25 @@ double designThreshold(DiagnosisTest test, const DiagnosisOptions& o) {
     case DiagnosisTest::Hypothesis: return o.hypothesisThreshold;
   }
   return 1.0;
+}
+
+double poissonUpper95(int events) {
+  if (events < 0) throw std::invalid_argument("poissonUpper95: a negative count of events");
+  // P(N <= n; mu) summed term by term in logarithms: exp(-mu) alone underflows once mu passes
+  // about 745, which a threshold far too low reaches in a few simulated hours.
+  auto cdf = [events](double mu) {
+    if (mu <= 0.0) return 1.0;
+    double sum = 0.0;
+    for (int k = 0; k <= events; ++k)
+      sum += std::exp(k * std::log(mu) - mu - std::lgamma(k + 1.0));
+    return sum;
+  };
+  double lo = 0.0, hi = 10.0 + 2.0 * events;
+  for (int i = 0; i < 60; ++i) {
+    const double mid = 0.5 * (lo + hi);
+    (cdf(mid) > 0.05 ? lo : hi) = mid;
+  }
+  return 0.5 * (lo + hi);
 }
 
 DiagnosisOptions withColumnScales(const DiagnosisOptions& options, DiagnosisTest test,
@@ -361,7 +365,7 @@ CalibrationResult monteCarlo(const std::vector<MonteCarloRun>& plan, const Diagn
     }
     point.falseAlarmsPerHour = result.healthyHours > 0.0 ? point.falseAlarms / result.healthyHours : 0.0;
     point.falseAlarmsPerHourUpper =
-        result.healthyHours > 0.0 ? poissonUpper(point.falseAlarms) / result.healthyHours : kInf;
+        result.healthyHours > 0.0 ? poissonUpper95(point.falseAlarms) / result.healthyHours : kInf;
     std::vector<double> all;
     for (const auto& d : delays) all.insert(all.end(), d.begin(), d.end());
     point.isolatedFraction = faulty ? static_cast<double>(isolated) / faulty : 0.0;

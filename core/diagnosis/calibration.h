@@ -90,6 +90,10 @@ struct CalibrationResult {
   std::vector<double> givenIsolatedFraction, givenMedianDelayS;  // per fault
 };
 
+// The 95 % upper confidence bound of a Poisson mean after `events` events (the bound beside
+// every false-alarm rate); throws std::invalid_argument for a negative count.
+double poissonUpper95(int events);
+
 // The design value a scale multiplies (k of the classical or robust test, alpha_2, the
 // hypothesis threshold) and the options with a test's threshold set to scale times it.
 double designThreshold(DiagnosisTest test, const DiagnosisOptions& options);
