@@ -10,6 +10,7 @@
 #include <QPointer>
 #include <QProgressBar>
 #include <QPushButton>
+#include <QScrollArea>
 #include <QSettings>
 #include <QSplitter>
 #include <QTableWidget>
@@ -19,6 +20,7 @@
 #include <cmath>
 #include <qcustomplot.h>
 
+#include "core/diagnosis/diagnosis_json.h"
 #include "core/io/log_io.h"
 #include "widgets/playhead.h"
 #include "widgets/plots/playhead_cursor.h"
@@ -33,7 +35,8 @@ void setupPlot(QCustomPlot* p, const QString& y) {
   p->legend->setVisible(true);
   p->legend->setFont(QFont(p->font().family(), 7));
   p->setInteractions(QCP::iRangeDrag | QCP::iRangeZoom);
-  p->setMinimumHeight(110);
+  p->legend->setBrush(QColor(255, 255, 255, 190));  // the curves stay visible beneath it
+  p->setMinimumHeight(90);
 }
 
 }  // namespace
@@ -89,24 +92,31 @@ DiagnosisPanel::DiagnosisPanel(Workspace* workspace, QWidget* parent)
   table_->setEditTriggers(QAbstractItemView::NoEditTriggers);
   table_->setSelectionMode(QAbstractItemView::NoSelection);
   table_->setMaximumHeight(170);
+  table_->setMinimumHeight(140);
   table_->setObjectName("decisionTable");
 
   setupPlot(estimates_, "");
   estimates_->legend->setVisible(false);
-  estimates_->setMinimumHeight(220);
+  estimates_->setMinimumHeight(170);
   setupPlot(cusum_, tr("g / h"));
   setupPlot(hypothesis_, tr("T"));
   setupPlot(timeline_, "");
   timeline_->legend->setVisible(false);
   timeline_->yAxis->setRange(-0.3, 5.0);
+  timeline_->setMinimumHeight(120);  // five rows whose labels must not overlap
 
+  // Short rows, so that the dock's usual width (a third of a 1366-pixel window) shows them
+  // whole, "Diagnose" included.
+  reference_->setMinimumContentsLength(12);
+  reference_->setSizeAdjustPolicy(QComboBox::AdjustToMinimumContentsLengthWithIcon);
   auto* top = new QHBoxLayout;
   top->addWidget(new QLabel(tr("Model:"), this));
   top->addWidget(reference_, 1);
   top->addWidget(chooseLog_);
-  top->addWidget(referenceName_, 1);
+  auto* testsRow = new QHBoxLayout;
+  for (QCheckBox* c : tests_) testsRow->addWidget(c);
+  testsRow->addStretch(1);
   auto* options = new QHBoxLayout;
-  for (QCheckBox* c : tests_) options->addWidget(c);
   options->addWidget(new QLabel(tr("Hypothesis window:"), this));
   options->addWidget(window_);
   options->addWidget(calibrate_);
@@ -124,24 +134,50 @@ DiagnosisPanel::DiagnosisPanel(Workspace* workspace, QWidget* parent)
   middle->addWidget(hypothesis_);
   plots->addWidget(middle);
   plots->addWidget(timeline_);
+  // The decision table beside the statement S and the thresholds' provenance; the long
+  // provenance scrolls rather than growing the panel.
+  auto* bottom = new QWidget;
+  auto* bottomLayout = new QHBoxLayout(bottom);
+  bottomLayout->setContentsMargins(0, 0, 0, 0);
+  bottomLayout->addWidget(table_, 3);
+  auto* words = new QWidget;
+  auto* wordsLayout = new QVBoxLayout(words);
+  wordsLayout->setContentsMargins(2, 2, 2, 2);
+  wordsLayout->addWidget(statement_);
+  wordsLayout->addWidget(thresholds_);
+  wordsLayout->addStretch(1);
+  auto* wordsScroll = new QScrollArea;
+  wordsScroll->setWidget(words);
+  wordsScroll->setWidgetResizable(true);
+  wordsScroll->setFrameShape(QFrame::NoFrame);
+  wordsScroll->setMaximumHeight(170);
+  bottomLayout->addWidget(wordsScroll, 2);
+  plots->addWidget(bottom);
   plots->setStretchFactor(0, 3);
   plots->setStretchFactor(1, 2);
   plots->setStretchFactor(2, 1);
-  auto* bottom = new QHBoxLayout;
-  bottom->addWidget(table_, 3);
-  auto* words = new QVBoxLayout;
-  words->addWidget(statement_);
-  words->addWidget(thresholds_);
-  words->addStretch(1);
-  bottom->addLayout(words, 2);
+  plots->setStretchFactor(3, 0);
+  plots->setChildrenCollapsible(false);
 
-  auto* layout = new QVBoxLayout(this);
+  // Everything scrolls inside the dock: at 1366x768 the window keeps its size.
+  auto* content = new QWidget;
+  auto* layout = new QVBoxLayout(content);
+  layout->setContentsMargins(4, 4, 4, 4);
   layout->addLayout(top);
+  layout->addWidget(referenceName_);
+  layout->addLayout(testsRow);
   layout->addLayout(options);
   layout->addLayout(status);
   layout->addWidget(verdict_);
   layout->addWidget(plots, 1);
-  layout->addLayout(bottom);
+  auto* scroll = new QScrollArea(this);
+  scroll->setWidget(content);
+  scroll->setWidgetResizable(true);
+  scroll->setFrameShape(QFrame::NoFrame);
+  scroll->setMinimumSize(240, 200);
+  auto* outer = new QVBoxLayout(this);
+  outer->setContentsMargins(0, 0, 0, 0);
+  outer->addWidget(scroll);
 
   connect(run_, &QPushButton::clicked, this, &DiagnosisPanel::diagnose);
   connect(cancel_, &QPushButton::clicked, this, &DiagnosisPanel::cancel);
@@ -297,7 +333,7 @@ void DiagnosisPanel::cancel() {
 void DiagnosisPanel::clearResult() {
   if (isBusy()) cancel();
   ++runId_;
-  run__.reset();
+  shownRun_.reset();
   for (QCustomPlot* p : {estimates_, cusum_, hypothesis_, timeline_}) {
     p->clearGraphs();
     p->clearItems();
@@ -327,11 +363,11 @@ void DiagnosisPanel::onFinished() {
     verdict_->setStyleSheet("color: rgb(200,40,40)");
     return;
   }
-  run__ = out.run;
-  if (run__->calibration) {
-    storedCalibration_ = calibrationJson(*run__->calibration);
+  shownRun_ = out.run;
+  if (shownRun_->calibration) {
+    storedCalibration_ = calibrationJson(*shownRun_->calibration);
     if (request_) {
-      request_->options = run__->result.options;
+      request_->options = shownRun_->result.options;
       request_->calibration = storedCalibration_;
     }
   } else if (request_) {
@@ -339,7 +375,7 @@ void DiagnosisPanel::onFinished() {
   }
   buildPlots();
   showAt(playhead_ && playhead_->hasSpan() ? playhead_->time()
-                                           : (run__->result.time.empty() ? 0.0 : run__->result.time.back()));
+                                           : (shownRun_->result.time.empty() ? 0.0 : shownRun_->result.time.back()));
 }
 
 std::optional<DiagnosisSessionRequest> DiagnosisPanel::sessionRequest(const std::string& referenceLogName) const {

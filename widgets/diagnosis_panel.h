@@ -58,7 +58,7 @@ class DiagnosisPanel : public QWidget {
   QString statementText() const;
 
   bool isBusy() const { return watcher_.isRunning(); }
-  const DiagnosisRun* lastRun() const { return run__ ? run__.get() : nullptr; }
+  const DiagnosisRun* lastRun() const { return shownRun_ ? shownRun_.get() : nullptr; }
   // What the shown result was asked, as a session stores it (null before the first run).
   std::optional<DiagnosisSessionRequest> sessionRequest(const std::string& referenceLogName) const;
   // Takes over a session's request (reference, options, the calibration's summary) without
@@ -123,7 +123,7 @@ class DiagnosisPanel : public QWidget {
   std::shared_ptr<std::atomic<bool>> cancelFlag_;
   std::shared_ptr<std::atomic<double>> progressValue_;
   int runId_ = 0;
-  std::shared_ptr<DiagnosisRun> run__;
+  std::shared_ptr<DiagnosisRun> shownRun_;
   std::optional<DiagnosisSessionRequest> request_;
   std::vector<Shown> shown_;
   std::size_t shownSample_ = static_cast<std::size_t>(-1);

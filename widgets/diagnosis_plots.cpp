@@ -39,7 +39,7 @@ QString seconds(double t) { return QString::number(t, 'f', 2) + " s"; }
 }  // namespace
 
 void DiagnosisPanel::buildPlots() {
-  const DiagnosisResult& r = run__->result;
+  const DiagnosisResult& r = shownRun_->result;
   shown_.clear();
   shownSample_ = static_cast<std::size_t>(-1);
   for (QCustomPlot* p : {estimates_, cusum_, hypothesis_, timeline_}) {
@@ -53,7 +53,10 @@ void DiagnosisPanel::buildPlots() {
   // One axis rect per parameter: the estimate and its smoothed value as % of theta_0, with the
   // robust test's band.
   QCPLayoutGrid* grid = estimates_->plotLayout();
-  while (grid->elementCount() > 1) grid->removeAt(grid->elementCount() - 1);
+  // removeAt empties a cell without removing it (elementCount stays): walk the cells once,
+  // then drop the empty rows.
+  for (int k = grid->elementCount() - 1; k > 0; --k)
+    if (grid->elementAt(k)) grid->removeAt(k);
   grid->simplify();
   const TestTrace* robust = r.trace(DiagnosisTest::Robust);
   for (std::size_t i = 0; i < r.parameters.size(); ++i) {
@@ -81,10 +84,13 @@ void DiagnosisPanel::buildPlots() {
     }
     for (double v : percent(r.estimates.theta[i])) span = std::max(span, 1.1 * std::abs(v));
     rect->axis(QCPAxis::atLeft)->setRange(-std::min(span, 60.0), std::min(span, 60.0));
+    rect->axis(QCPAxis::atLeft)->ticker()->setTickCount(3);  // three short rects: few labels
     level(estimates_, rect, 0.0, kColors[4]);
   }
 
-  auto simple = [&](QCustomPlot* p, const TestTrace* t, bool ratio, double line, const QString& yLabel) {
+  // cap: the axis stops at cap times the level, so that the approach to it stays readable.
+  auto simple = [&](QCustomPlot* p, const TestTrace* t, bool ratio, double line, double cap,
+                    const QString& yLabel) {
     if (!t) return;
     QCPAxisRect* rect = p->axisRect();
     rect->axis(QCPAxis::atBottom)->setRange(t0, t1);
@@ -95,13 +101,13 @@ void DiagnosisPanel::buildPlots() {
         if (std::isfinite(y[k])) top = std::max(top, 1.1 * y[k]);
       keep(curve(p, rect, QString::fromStdString(t->columns[q]), kColors[q % 5]), y);
     }
-    rect->axis(QCPAxis::atLeft)->setRange(ratio ? 0.0 : std::max(0.0, 2.0 - top), std::min(top, 10.0 * line));
+    rect->axis(QCPAxis::atLeft)->setRange(ratio ? 0.0 : std::max(0.0, 2.0 - top), std::min(top, cap * line));
     rect->axis(QCPAxis::atLeft)->setLabel(yLabel);
     level(p, rect, line, kAlarm);
   };
-  simple(cusum_, r.trace(DiagnosisTest::Cusum), true, 1.0, tr("CUSUM g / h"));
-  simple(hypothesis_, r.trace(DiagnosisTest::Hypothesis), false, r.options.hypothesisThreshold,
-         tr("hypothesis T (%1)").arg(QString::fromStdString(r.windowText())));
+  simple(cusum_, r.trace(DiagnosisTest::Cusum), true, 1.0, 10.0, tr("CUSUM g / h"));
+  simple(hypothesis_, r.trace(DiagnosisTest::Hypothesis), false, r.options.hypothesisThreshold, 3.0,
+         tr("hypothesis T"));
 
   // Alarm timeline: a row per test and one for the decision, raised while NF is rejected.
   QCPAxisRect* rect = timeline_->axisRect();
@@ -141,8 +147,8 @@ void DiagnosisPanel::buildPlots() {
     }
     th << QString("%1: %2").arg(toString(t.test)).arg(values.join(", "));
   }
-  const QString from = run__->calibration
-                           ? tr("calibrated: %1").arg(QString::fromStdString(run__->calibration->message))
+  const QString from = shownRun_->calibration
+                           ? tr("calibrated: %1").arg(QString::fromStdString(shownRun_->calibration->message))
                            : storedCalibration_.is_object()
                                  ? tr("calibrated: %1").arg(QString::fromStdString(storedCalibration_.value("message", std::string())))
                                  : QString::fromStdString(defaultThresholdsProvenance());
@@ -152,8 +158,8 @@ void DiagnosisPanel::buildPlots() {
 }
 
 void DiagnosisPanel::showAt(double t) {
-  if (!run__ || run__->result.time.empty()) return;
-  const DiagnosisResult& r = run__->result;
+  if (!shownRun_ || shownRun_->result.time.empty()) return;
+  const DiagnosisResult& r = shownRun_->result;
   const std::size_t k = t < r.time.front() ? 0 : r.sampleAt(t);
   if (k == shownSample_) return;
   shownSample_ = k;
