@@ -42,6 +42,7 @@
 #include "widgets/model_panel.h"
 #include "widgets/playhead.h"
 #include "widgets/preprocess_panel.h"
+#include "widgets/recursive_panel.h"
 #include "widgets/residuals_panel.h"
 #include "widgets/transport_bar.h"
 #include "widgets/workspace.h"
@@ -135,6 +136,8 @@ MainWindow::MainWindow(QWidget* parent)
   discoveryDock_ = addPanel(discoveryPanel_ = new DiscoveryPanel(workspace_, this), tr("Discovery"), "discoveryDock", "Ctrl+Shift+D", preprocessDock_);
   diagnosisDock_ = addPanel(diagnosisPanel_ = new DiagnosisPanel(workspace_, this), tr("Diagnosis"),
                             "diagnosisDock", "Ctrl+Shift+G", preprocessDock_);
+  recursiveDock_ = addPanel(recursivePanel_ = new RecursivePanel(workspace_, this), tr("Recursive"),
+                            "recursiveDock", "Ctrl+Shift+I", preprocessDock_);
   preprocessDock_->raise();
   // The playhead spans the log as read (preprocessing keeps its times); every panel that
   // shows time follows it.
@@ -151,6 +154,7 @@ MainWindow::MainWindow(QWidget* parent)
   modelPanel_->setPlayhead(playhead_);
   discoveryPanel_->setPlayhead(playhead_);
   diagnosisPanel_->setPlayhead(playhead_);
+  recursivePanel_->setPlayhead(playhead_);
   transportBar_ = new TransportBar(playhead_, this);
   auto* transport = new QToolBar(tr("Playhead"), this);
   transport->setObjectName("transportToolBar");

@@ -26,6 +26,7 @@ class LqgPanel;
 class ModelPanel;
 class Playhead;
 class PreprocessPanel;
+class RecursivePanel;
 class TransportBar;
 class ResidualsPanel;
 class DiagnosisPanel;
@@ -57,6 +58,8 @@ class MainWindow : public QMainWindow {
   SessionController* sessionController() const { return session_; }
   DiscoveryPanel* discoveryPanel() const { return discoveryPanel_; }
   DiagnosisPanel* diagnosisPanel() const { return diagnosisPanel_; }
+  RecursivePanel* recursivePanel() const { return recursivePanel_; }
+  QDockWidget* recursiveDock() const { return recursiveDock_; }
   QStringList recentFiles() const;
   Playhead* playhead() const { return playhead_; }
   TransportBar* transportBar() const { return transportBar_; }
@@ -109,6 +112,8 @@ class MainWindow : public QMainWindow {
   QDockWidget* discoveryDock_ = nullptr;
   DiagnosisPanel* diagnosisPanel_ = nullptr;
   QDockWidget* diagnosisDock_ = nullptr;
+  RecursivePanel* recursivePanel_ = nullptr;
+  QDockWidget* recursiveDock_ = nullptr;
   QMenu* recentMenu_ = nullptr;
   QMenu* viewMenu_ = nullptr;
   QFutureWatcher<LogReadResult> reader_;
