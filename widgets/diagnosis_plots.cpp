@@ -84,7 +84,9 @@ void DiagnosisPanel::buildPlots() {
     }
     for (double v : percent(r.estimates.theta[i])) span = std::max(span, 1.1 * std::abs(v));
     rect->axis(QCPAxis::atLeft)->setRange(-std::min(span, 60.0), std::min(span, 60.0));
-    rect->axis(QCPAxis::atLeft)->ticker()->setTickCount(3);  // three short rects: few labels
+    // Three short rects: labels at -span, 0, span only, or they overlap.
+    rect->axis(QCPAxis::atLeft)->ticker()->setTickStepStrategy(QCPAxisTicker::tssMeetTickCount);
+    rect->axis(QCPAxis::atLeft)->ticker()->setTickCount(2);
     level(estimates_, rect, 0.0, kColors[4]);
   }
 
