@@ -77,8 +77,12 @@ DiagnosisRun runDiagnosisRequest(const DiagnosisRequest& request, const IdData& 
 }
 
 std::string defaultThresholdsProvenance() {
+  // The figures are those of bench/results/diagnosis.txt (60 arms, 240 runs).
   return "the seed's design values (3 sigma, alpha_1 = 3, alpha_2 = 20, level 1) scaled per "
-         "parameter as calibrated by bench/montecarlo_diagnosis (see DiagnosisOptions)";
+         "parameter as calibrated by bench/montecarlo_diagnosis (see DiagnosisOptions); in its "
+         "study of 240 simulated runs the decision at these thresholds raised no false alarm in "
+         "0.3 h of fault-free runs (at most 10 false alarms per hour at 95 %) and isolated 99 % "
+         "of 20 % faults within 5 s, median delay 0.85 s";
 }
 
 }  // namespace flexarm

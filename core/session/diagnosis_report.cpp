@@ -45,6 +45,8 @@ ReportSection diagnosisReportSection(const DiagnosisRun& run, const json& calibr
   s.paragraphs.push_back(r.summary());
   s.paragraphs.push_back("Reference: " + r.referenceSource + ".");
   s.values = diagnosisResultJson(r);
+  // The time the run took is no result: a replayed report must equal the saved one.
+  s.values.erase("seconds");
 
   // Thresholds and the false-alarm rate they were chosen for.
   ReportTable th{"Thresholds", {"Test", "Parameter", "Threshold", "False alarms per hour"}, {}};
@@ -69,6 +71,7 @@ ReportSection diagnosisReportSection(const DiagnosisRun& run, const json& calibr
     s.paragraphs.push_back("Thresholds calibrated on the simulator: " + calibration.value("conditions", std::string()) +
                            ". " + calibration.value("message", std::string()) + ".");
     s.values["calibration"] = calibration;
+    if (calibration.is_object()) s.values["calibration"].erase("seconds");
   } else {
     s.paragraphs.push_back("Thresholds: " + defaultThresholdsProvenance() + ".");
     s.values["thresholds_provenance"] = defaultThresholdsProvenance();
