@@ -78,5 +78,6 @@ int runLqg(const std::vector<std::string>& args, std::ostream& out, std::ostream
 int runRun(const std::vector<std::string>& args, std::ostream& out, std::ostream& err);
 int runDiscover(const std::vector<std::string>& args, std::ostream& out, std::ostream& err);
 int runRecursive(const std::vector<std::string>& args, std::ostream& out, std::ostream& err);
+int runDiagnose(const std::vector<std::string>& args, std::ostream& out, std::ostream& err);
 
 }  // namespace flexarm::cli

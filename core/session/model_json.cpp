@@ -95,4 +95,15 @@ std::optional<ModelSpec> modelFromJson(const json& j, std::string* why) {
   return spec;
 }
 
+std::optional<ModelSpec> findListModel(const nlohmann::json& models, const std::string& name,
+                                       std::string* why) {
+  if (models.is_array())
+    for (const auto& m : models) {
+      auto spec = modelFromJson(m, why);
+      if (spec && spec->name == name) return spec;
+    }
+  if (why) *why = "the model list has no model named '" + name + "'";
+  return std::nullopt;
+}
+
 }  // namespace flexarm

@@ -30,4 +30,9 @@ inline constexpr std::size_t kMaxEffects = 16;
 // parameters, or a malformed effect.
 std::optional<ModelSpec> modelFromJson(const nlohmann::json& j, std::string* why);
 
+// The model named `name` in a session's "models" part (a list of modelToJson objects);
+// nullopt with a sentence when there is none by that name.
+std::optional<ModelSpec> findListModel(const nlohmann::json& models, const std::string& name,
+                                       std::string* why);
+
 }  // namespace flexarm

@@ -33,6 +33,10 @@ struct ReplayContext {
   const std::vector<std::pair<std::string, const IdData*>>* rawLogs = nullptr;
 };
 
+// The log a part names (empty: the session's first) among the context's logs as read (raw) or
+// as preprocessed; nullptr with a sentence when there is none.
+const IdData* findLog(const ReplayContext& context, const std::string& name, bool raw, std::string* why);
+
 class SessionPart {
  public:
   virtual ~SessionPart() = default;

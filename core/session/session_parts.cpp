@@ -7,6 +7,8 @@
 #include <set>
 
 #include "core/models/analysis.h"
+#include "core/models/nonlinear_plant.h"
+#include "core/session/diagnosis_part.h"
 #include "core/session/discovery_part.h"
 #include "core/session/fit_request.h"
 #include "core/session/lqg_part.h"
@@ -187,9 +189,23 @@ const std::vector<std::shared_ptr<const SessionPart>>& sessionParts() {
       makeDiscoveryPart(),
       makeLqgPart(),
       makeRecursivePart(),
+      makeDiagnosisPart(),
       std::make_shared<ViewPart>(),
   };
   return kParts;
+}
+
+const IdData* findLog(const ReplayContext& context, const std::string& name, bool raw, std::string* why) {
+  const auto* logs = raw ? context.rawLogs : &context.logs;
+  if (!logs || logs->empty()) {
+    if (why) *why = raw ? "the logs as read are not available" : "the session has no log";
+    return nullptr;
+  }
+  const IdData* d = nullptr;
+  for (const auto& [logName, data] : *logs)
+    if (name.empty() ? d == nullptr : logName == name) d = data;
+  if (!d && why) *why = "the session has no log named '" + name + "'";
+  return d;
 }
 
 const SessionPart* findSessionPart(const std::string& key) {
