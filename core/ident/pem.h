@@ -95,6 +95,11 @@ struct PemOptions {
   // When set, the loss is formed with this predictor instead of the ZOH simulation of the
   // model from u (output error only).
   OutputErrorPredictor predictor;
+  // Several experiments: u and y hold them one after another and these are their sample
+  // counts (they sum to the samples of u); empty: one experiment. The loss (4.6) is summed
+  // over the experiments, each predicted from zero state at its own first sample (no
+  // transient across a seam), and the covariance comes from the stacked gradient.
+  std::vector<Eigen::Index> experimentLengths;
   bool isValid(std::string* why) const;
 };
 
