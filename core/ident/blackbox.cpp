@@ -488,6 +488,9 @@ PolyEstimate refinePolynomial(const Eigen::VectorXd& u, const Eigen::VectorXd& y
   const std::vector<Segment> segments = segmentsOf(options.experimentLengths, n);
   PolynomialModel work = initial;
   std::vector<ErrorCache> caches(segments.size());
+  // Several experiments: each one's errors weighted by sqrt(lambda / lambda_k) once a first fit
+  // has estimated its noise variance (empty: unweighted), as pem does.
+  std::vector<double> weights;
   LeastSquaresProblem problem;
   problem.evaluate = [&](const Eigen::VectorXd& th, Eigen::VectorXd& eps, Eigen::MatrixXd* psi) {
     work.setParameterVector(th);
@@ -503,8 +506,9 @@ PolyEstimate refinePolynomial(const Eigen::VectorXd& u, const Eigen::VectorXd& y
       Eigen::VectorXd e;
       Eigen::MatrixXd ps;
       errorsAndPsi(work, u.segment(g.from, g.n), y.segment(g.from, g.n), e, psi ? &ps : nullptr, true, &caches[k]);
-      eps.segment(g.from, g.n) = e;
-      if (psi) psi->middleRows(g.from, g.n) = ps;
+      const double w = weights.empty() ? 1.0 : weights[k];
+      eps.segment(g.from, g.n) = w * e;
+      if (psi) psi->middleRows(g.from, g.n) = w * ps;
     }
     return true;
   };
@@ -516,11 +520,30 @@ PolyEstimate refinePolynomial(const Eigen::VectorXd& u, const Eigen::VectorXd& y
   LeastSquaresSolution sol = levenbergMarquardt(problem, initial.parameterVector(),
                                                 options.maxIterations, options.relativeTolerance,
                                                 options.initialDamping, progress);
+  const Eigen::Index skip = criterionStart(initial.orders);
+  if (segments.size() > 1 && sol.summary.termination != Termination::Failed &&
+      sol.summary.termination != Termination::Cancelled) {
+    // Each experiment's noise variance from the first fit, then the weighted fit from there.
+    Eigen::Index all = 0;
+    for (const auto& g : segments) all += g.n - std::min<Eigen::Index>(skip, g.n);
+    const double pooled = sol.eps.squaredNorm() / static_cast<double>(std::max<Eigen::Index>(1, all));
+    for (const auto& g : segments) {
+      const Eigen::Index k = g.n - std::min<Eigen::Index>(skip, g.n);
+      const double own = sol.eps.segment(g.from, g.n).squaredNorm() / static_cast<double>(std::max<Eigen::Index>(1, k));
+      weights.push_back(own > 0.0 && pooled > 0.0 ? std::sqrt(pooled / own) : 1.0);
+    }
+    for (auto& c : caches) c.theta.resize(0);
+    LeastSquaresSolution weighted = levenbergMarquardt(problem, sol.phi, options.maxIterations,
+                                                       options.relativeTolerance, options.initialDamping);
+    if (weighted.summary.termination != Termination::Failed) {
+      weighted.summary.iterations += sol.summary.iterations;
+      sol = std::move(weighted);
+    }
+  }
   s = sol.summary;
   if (s.termination == Termination::Failed) return r;
   r.model.setParameterVector(sol.phi);
   // The rows in the criterion: each experiment's from criterionStart on.
-  const Eigen::Index skip = criterionStart(initial.orders);
   Eigen::Index used = 0;
   for (const auto& g : segments) used += g.n - std::min<Eigen::Index>(skip, g.n);
   Eigen::MatrixXd psiUsed(used, sol.psi.cols());

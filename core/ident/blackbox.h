@@ -76,7 +76,11 @@ struct PolyEstimateOptions {
   // over the experiments, each filtered from zero initial conditions at its own first sample
   // with its first max(na, nb + nk - 1, nc, nd, nf) errors left out (ARX: no regressor
   // reaches into another experiment); the covariance comes from the stacked gradient. The
-  // start values are computed from the experiments joined (a start only).
+  // start values are computed from the experiments joined (a start only). Iterative
+  // structures are then refined with each experiment's errors weighted by
+  // sqrt(lambda / lambda_k), lambda_k its noise variance from the first fit and lambda the
+  // pooled one (the likelihood's loss for experiments of different noise levels); ARX keeps
+  // plain least squares.
   std::vector<Eigen::Index> experimentLengths;
   bool isValid(std::string* why) const;
 };

@@ -411,6 +411,11 @@ PemResult pem(const ParametricModel& model0, const Eigen::VectorXd& u, const Eig
       if (!(tr.logParam[j] && th <= 0.0)) phi[j] = tr.toPhi(j, th);
     }
   };
+  // Several experiments: each one's errors weighted by sqrt(lambda / lambda_k), lambda_k its
+  // own noise variance and lambda the pooled one, once a first fit has estimated them (empty:
+  // unweighted). The loss is then the likelihood's for experiments of different noise levels.
+  std::vector<double> weights;
+  std::vector<Eigen::Index> partRows;  // error rows of each experiment in the last evaluation
   problem.evaluate = [&](const Eigen::VectorXd& phi, Eigen::VectorXd& eps, Eigen::MatrixXd* psi) {
     Eigen::VectorXd K;
     setPhi(phi, K);
@@ -435,10 +440,14 @@ PemResult pem(const ParametricModel& model0, const Eigen::VectorXd& u, const Eig
         ev.eps.resize(rows);
         if (psi) ev.psi.resize(rows, parts.front().psi.cols());
         Eigen::Index at = 0;
-        for (const auto& part : parts) {
-          ev.eps.segment(at, part.eps.size()) = part.eps;
-          if (psi) ev.psi.middleRows(at, part.eps.size()) = part.psi;
+        partRows.clear();
+        for (std::size_t k = 0; k < parts.size(); ++k) {
+          const auto& part = parts[k];
+          const double w = weights.empty() ? 1.0 : weights[k];
+          ev.eps.segment(at, part.eps.size()) = w * part.eps;
+          if (psi) ev.psi.middleRows(at, part.eps.size()) = w * part.psi;
           at += part.eps.size();
+          partRows.push_back(part.eps.size());
         }
       }
     } catch (const std::invalid_argument&) {
@@ -560,6 +569,28 @@ PemResult pem(const ParametricModel& model0, const Eigen::VectorXd& u, const Eig
   // Fixed parameters of the best start, then the estimate.
   for (std::size_t i = 0; i < params0.size(); ++i)
     if (!params0[i].free) work->setParameter(params0[i].name, starts[result.bestStart][i]);
+  if (lengths.size() > 1 && !cancelled) {
+    // Each experiment's noise variance from the first fit's errors, then the weighted fit
+    // from there (the covariance below is then that of the weighted loss).
+    Eigen::VectorXd eps;
+    if (problem.evaluate(best.sol.phi, eps, nullptr) && partRows.size() == lengths.size()) {
+      const double pooled = eps.squaredNorm() / static_cast<double>(eps.size());
+      Eigen::Index at = 0;
+      for (Eigen::Index rows : partRows) {
+        const double own = eps.segment(at, rows).squaredNorm() / static_cast<double>(std::max<Eigen::Index>(1, rows));
+        weights.push_back(own > 0.0 && pooled > 0.0 ? std::sqrt(pooled / own) : 1.0);
+        at += rows;
+      }
+      LeastSquaresSolution sol = levenbergMarquardt(problem, best.sol.phi, options.maxIterations,
+                                                    options.relativeTolerance, options.initialDamping);
+      totalIterations += sol.summary.iterations;
+      if (sol.summary.termination != Termination::Failed) {
+        best.sol = std::move(sol);
+      } else {
+        weights.clear();  // keep the unweighted estimate
+      }
+    }
+  }
   Eigen::VectorXd K;
   setPhi(best.sol.phi, K);
   result.model = work->clone();
