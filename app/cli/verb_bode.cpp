@@ -48,8 +48,8 @@ int runBode(const std::vector<std::string>& argv, std::ostream& out, std::ostrea
     return kExitUsage;
   }
   double level = 0.99, wmin = 0.0, wmax = 0.0;
-  long points = 500;
-  if (!args.number("level", level) || !args.integer("points", points) ||
+  int points = 500;
+  if (!args.number("level", level) || !args.integer("points", points, 2, 1000000) ||
       !args.number("wmin", wmin) || !args.number("wmax", wmax)) {
     err << "flexarm bode: " << args.error() << "\n";
     return kExitUsage;

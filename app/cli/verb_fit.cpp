@@ -316,9 +316,11 @@ int runFitPipeline(ArgParser& args, const std::string& verb, FitResult& result, 
                   "models only\n";
     return kExitUsage;
   }
-  long decimation = 1, maxIter = 100, starts = 0, seed = 1;
-  if (!args.integer("decimate", decimation) || !args.integer("max-iterations", maxIter) ||
-      !args.integer("starts", starts) || !args.integer("seed", seed)) {
+  int decimation = 1, maxIter = 100, starts = 0;
+  long seed = 1;
+  if (!args.integer("decimate", decimation, 1, 1000000) ||
+      !args.integer("max-iterations", maxIter, 0, 100000) ||
+      !args.integer("starts", starts, 0, 1000) || !args.integer("seed", seed)) {
     err << pre << args.error() << "\n";
     return kExitUsage;
   }
@@ -397,6 +399,10 @@ int runFitPipeline(ArgParser& args, const std::string& verb, FitResult& result, 
   }
   result = fitModel(o);
   if (result.ok()) return kExitOk;
+  if (result.badRequest) {
+    err << pre << result.message << "\n";
+    return kExitUsage;
+  }
   if (result.badData) {
     err << "flexarm: " << args.positional()[0] << ": " << result.message << "\n";
     return kExitBadInput;

@@ -94,16 +94,21 @@ ReferenceProjection projectOnReference(const Eigen::VectorXd& u, const Eigen::Ve
     throw std::invalid_argument("projectOnReference: input and reference differ in length");
   if (!(T > 0.0)) throw std::invalid_argument("projectOnReference: the sample time must be positive");
   ReferenceProjection out;
-  out.pastTaps = static_cast<int>(std::lround(options.pastS / T));
-  out.futureTaps = static_cast<int>(std::lround(options.futureS / T));
   const Eigen::Index n = u.size();
-  const int lo = -out.futureTaps, hi = out.pastTaps;  // lags k: u(t) ~ r(t - k)
-  const int m = hi - lo + 1;
-  if (n < 4 * m) {
-    out.message = "too few samples (" + std::to_string(n) + ") for an FIR of " +
-                  std::to_string(m) + " taps of the reference";
+  // The FIR length is checked against the data in floating point first: a tiny sample time
+  // would overflow an int (e.g. "-1806140927 taps").
+  const double pastTaps = std::round(options.pastS / T), futureTaps = std::round(options.futureS / T);
+  if (!(pastTaps + futureTaps + 1.0 <= static_cast<double>(n) / 4.0)) {
+    char buf[64];
+    std::snprintf(buf, sizeof buf, "%.0f", pastTaps + futureTaps + 1.0);
+    out.message = "too few samples (" + std::to_string(n) + ") for an FIR of " + buf +
+                  " taps of the reference";
     return out;
   }
+  out.pastTaps = static_cast<int>(pastTaps);
+  out.futureTaps = static_cast<int>(futureTaps);
+  const int lo = -out.futureTaps, hi = out.pastTaps;  // lags k: u(t) ~ r(t - k)
+  const int m = hi - lo + 1;
   if (!u.allFinite() || !r.allFinite()) {
     out.message = "the input or the reference contains NaN or infinite values";
     return out;

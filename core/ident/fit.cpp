@@ -368,7 +368,15 @@ FitResult fitModel(const FitOptions& options, const ProgressCallback& progress) 
       case FitModelKind::Physical:
         if (!fit_detail::fitPhysical(options, r, progress)) return finish(r.termination, r.message);
         break;
-      case FitModelKind::BlackBox: fitBlackBox(options, r, progress); break;
+      case FitModelKind::BlackBox: {
+        std::string tooMuch;
+        long long samples = 0;  // of every estimation experiment
+        for (const auto& e : r.estimation) samples += static_cast<long long>(e.data.estimation.size());
+        r.badRequest = !options.model.orders.fitsData(options.model.structure, samples, &tooMuch);
+        if (r.badRequest) return finish(Termination::Failed, tooMuch);
+        fitBlackBox(options, r, progress);
+        break;
+      }
       case FitModelKind::Spa:
       case FitModelKind::Etfe: fitNonparametric(options, r); break;
     }

@@ -134,6 +134,9 @@ struct FitResult {
   // The data cannot carry the fit asked for (no usable channel or range, a closed-loop method
   // the log cannot run), as opposed to an estimator that failed on them.
   bool badData = false;
+  // The options ask for more than the data can carry (polynomial orders beyond the samples
+  // or the work FlexArm allows): a request to change, not an estimator that failed.
+  bool badRequest = false;
 
   FitModelSpec model;
   PreparedData data;  // the (first) estimation experiment as prepared

@@ -7,7 +7,7 @@
 #include <cstdio>
 #include <stdexcept>
 
-#include <fftw3.h>
+#include "core/common/fft.h"
 
 namespace flexarm {
 
@@ -37,15 +37,7 @@ using Clock = std::chrono::steady_clock;
 
 // DFT X(k) = sum_t x(t) e^{-i 2 pi k t / N}, k = 0..N/2 (scaling cancels in the ratios).
 std::vector<std::complex<double>> rfft(const Eigen::VectorXd& x) {
-  const int n = static_cast<int>(x.size());
-  std::vector<double> in(x.data(), x.data() + n);
-  std::vector<fftw_complex> out(n / 2 + 1);
-  fftw_plan plan = fftw_plan_dft_r2c_1d(n, in.data(), out.data(), FFTW_ESTIMATE);
-  fftw_execute(plan);
-  fftw_destroy_plan(plan);
-  std::vector<std::complex<double>> r(n / 2 + 1);
-  for (int k = 0; k <= n / 2; ++k) r[k] = {out[k][0], out[k][1]};
-  return r;
+  return realDft(x.data(), static_cast<int>(x.size()));
 }
 
 bool checkSignals(const Eigen::VectorXd& u, const Eigen::VectorXd& y, double ts,

@@ -399,9 +399,12 @@ PemResult pem(const ParametricModel& model0, const Eigen::VectorXd& u, const Eig
   }
 
   std::unique_ptr<ParametricModel> work = model0.clone();
+  // The bounds are applied again after the transform: exp(log(b)) or (b / s) * s may round
+  // one ulp past a bound b (e.g. exp(log(1e4)) > 1e4), which setParameter would refuse.
   auto setPhi = [&](const Eigen::VectorXd& phi, Eigen::VectorXd& K) {
     for (int j = 0; j < pf; ++j)
-      work->setParameter(params0[tr.free[j]].name, tr.toTheta(j, phi[j]));
+      work->setParameter(params0[tr.free[j]].name,
+                         std::clamp(tr.toTheta(j, phi[j]), tr.lower[j], tr.upper[j]));
     K = innovations ? Eigen::VectorXd(phi.tail(tr.nK)) : Eigen::VectorXd();
   };
   LeastSquaresProblem problem;

@@ -82,6 +82,10 @@ class FitsPart : public SessionPart {
       if (why) *why = "requests must be a list of fits";
       return false;
     }
+    if (section["requests"].size() > kMaxPartItems) {
+      if (why) *why = "more than " + std::to_string(kMaxPartItems) + " fits";
+      return false;
+    }
     for (const auto& r : section["requests"]) {
       auto request = fitRequestFromJson(r, why);
       if (!request) return false;

@@ -6,6 +6,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "core/io/input_file.h"
 #include "core/session/session_part.h"
 
 namespace flexarm {
@@ -200,6 +201,63 @@ bool preprocessFromJson(const json& j, Session& s, FieldReader& f) {
   return true;
 }
 
+// Limits checked on the text before a document is built: a 40 MB file of one list of a
+// million items, or brackets nested a million deep (whose document is destroyed
+// recursively, overflowing the stack), is refused at the cost of one pass.
+constexpr std::size_t kMaxJsonDepth = 64;
+constexpr std::size_t kMaxJsonItems = 100000;  // in one list or object
+
+class ShapeCheck : public nlohmann::json_sax<json> {
+ public:
+  std::string problem;
+  bool null() override { return item(); }
+  bool boolean(bool) override { return item(); }
+  bool number_integer(number_integer_t) override { return item(); }
+  bool number_unsigned(number_unsigned_t) override { return item(); }
+  bool number_float(number_float_t, const string_t&) override { return item(); }
+  bool string(string_t&) override { return item(); }
+  bool binary(binary_t&) override { return item(); }
+  bool start_object(std::size_t) override { return open(); }
+  bool key(string_t&) override { return true; }
+  bool end_object() override { return close(); }
+  bool start_array(std::size_t) override { return open(); }
+  bool end_array() override { return close(); }
+  bool parse_error(std::size_t, const std::string&, const nlohmann::detail::exception&) override {
+    return false;  // the document parse that follows names the place
+  }
+
+ private:
+  bool item() {
+    if (!counts_.empty() && ++counts_.back() > kMaxJsonItems) {
+      problem = "a list or object holds more than " + std::to_string(kMaxJsonItems) + " items";
+      return false;
+    }
+    return true;
+  }
+  bool open() {
+    if (!item()) return false;
+    if (counts_.size() >= kMaxJsonDepth) {
+      problem = "lists and objects are nested more than " + std::to_string(kMaxJsonDepth) + " deep";
+      return false;
+    }
+    counts_.push_back(0);
+    return true;
+  }
+  bool close() {
+    counts_.pop_back();
+    return true;
+  }
+  std::vector<std::size_t> counts_;
+};
+
+bool jsonShapeIsBounded(const std::string& text, std::string* why) {
+  ShapeCheck check;
+  json::sax_parse(text, &check);
+  if (check.problem.empty()) return true;
+  if (why) *why = check.problem;
+  return false;
+}
+
 // Line and column of a byte offset, for parse errors.
 std::string placeOf(const std::string& text, std::size_t byte) {
   int line = 1, column = 1;
@@ -252,6 +310,10 @@ std::string toJsonText(const Session& s) {
 
 SessionParseResult parseSession(const std::string& text) {
   SessionParseResult r;
+  if (std::string why; !jsonShapeIsBounded(text, &why)) {
+    r.message = "not a readable session: " + why;
+    return r;
+  }
   json j;
   try {
     j = json::parse(text);
@@ -338,14 +400,17 @@ SessionParseResult parseSession(const std::string& text) {
 
 SessionParseResult loadSession(const std::string& path) {
   SessionParseResult r;
-  std::ifstream in(path, std::ios::binary);
-  if (!in) {
-    r.message = path + ": cannot be read";
+  FileBytes bytes;
+  std::string problem;
+  if (!readInputFile(path, kMaxSessionBytes, bytes, &problem)) {
+    r.message = path + ": " + problem;
     return r;
   }
-  std::ostringstream text;
-  text << in.rdbuf();
-  r = parseSession(text.str());
+  if (std::string enc = textEncodingProblem(bytes.view()); !enc.empty()) {
+    r.message = path + ": " + enc;
+    return r;
+  }
+  r = parseSession(std::string(bytes.view()));
   if (!r.ok) r.message = path + ": " + r.message;
   return r;
 }

@@ -4,8 +4,11 @@
 #include <algorithm>
 #include <cmath>
 #include <complex>
+#include <set>
 
 #include "core/models/analysis.h"
+#include "core/models/nonlinear_plant.h"
+#include "core/session/diagnosis_part.h"
 #include "core/session/discovery_part.h"
 #include "core/session/fit_request.h"
 #include "core/session/lqg_part.h"
@@ -34,8 +37,19 @@ class ModelsPart : public SessionPart {
       if (why) *why = "must be a list of models";
       return false;
     }
-    for (const auto& m : section)
-      if (!modelFromJson(m, why)) return false;
+    if (section.size() > kMaxPartItems) {
+      if (why) *why = "more than " + std::to_string(kMaxPartItems) + " models";
+      return false;
+    }
+    std::set<std::string> names;
+    for (const auto& m : section) {
+      auto spec = modelFromJson(m, why);
+      if (!spec) return false;
+      if (!names.insert(spec->name).second) {
+        if (why) *why = "the model name '" + spec->name + "' is used twice";
+        return false;
+      }
+    }
     return true;
   }
 
@@ -175,9 +189,23 @@ const std::vector<std::shared_ptr<const SessionPart>>& sessionParts() {
       makeDiscoveryPart(),
       makeLqgPart(),
       makeRecursivePart(),
+      makeDiagnosisPart(),
       std::make_shared<ViewPart>(),
   };
   return kParts;
+}
+
+const IdData* findLog(const ReplayContext& context, const std::string& name, bool raw, std::string* why) {
+  const auto* logs = raw ? context.rawLogs : &context.logs;
+  if (!logs || logs->empty()) {
+    if (why) *why = raw ? "the logs as read are not available" : "the session has no log";
+    return nullptr;
+  }
+  const IdData* d = nullptr;
+  for (const auto& [logName, data] : *logs)
+    if (name.empty() ? d == nullptr : logName == name) d = data;
+  if (!d && why) *why = "the session has no log named '" + name + "'";
+  return d;
 }
 
 const SessionPart* findSessionPart(const std::string& key) {

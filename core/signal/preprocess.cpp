@@ -1,6 +1,6 @@
 #include "core/signal/preprocess.h"
 
-#include <fftw3.h>
+#include "core/common/fft.h"
 
 #include <algorithm>
 #include <chrono>
@@ -177,9 +177,8 @@ AmplitudeSpectrum amplitudeSpectrum(const std::vector<double>& x, double sampleT
   }
   const int bins = len / 2 + 1;
   std::vector<double> power(static_cast<std::size_t>(bins), 0.0);
-  double* in = fftw_alloc_real(static_cast<std::size_t>(len));
-  fftw_complex* out = fftw_alloc_complex(static_cast<std::size_t>(bins));
-  fftw_plan plan = fftw_plan_dft_r2c_1d(len, in, out, FFTW_ESTIMATE);
+  RealFft fft(len);
+  double* in = fft.input();
   const int step = std::max(1, len / 2);
   int segments = 0;
   for (int start = 0; start + len <= n; start += step) {
@@ -188,13 +187,10 @@ AmplitudeSpectrum amplitudeSpectrum(const std::vector<double>& x, double sampleT
     mean /= len;
     for (int i = 0; i < len; ++i)
       in[i] = (x[static_cast<std::size_t>(start + i)] - mean) * window[static_cast<std::size_t>(i)];
-    fftw_execute(plan);
-    for (int k = 0; k < bins; ++k) power[static_cast<std::size_t>(k)] += out[k][0] * out[k][0] + out[k][1] * out[k][1];
+    const std::complex<double>* out = fft.transform();
+    for (int k = 0; k < bins; ++k) power[static_cast<std::size_t>(k)] += std::norm(out[k]);
     ++segments;
   }
-  fftw_destroy_plan(plan);
-  fftw_free(in);
-  fftw_free(out);
   s.frequencyHz.resize(static_cast<std::size_t>(bins));
   s.amplitude.resize(static_cast<std::size_t>(bins));
   for (int k = 0; k < bins; ++k) {
