@@ -321,6 +321,9 @@ SessionParseResult parseSession(const std::string& text) {
     r.message = "not a readable session: the JSON is damaged at " + placeOf(text, e.byte) +
                 (e.byte >= text.size() ? " (the file ends too early)" : "");
     return r;
+  } catch (const json::exception&) {  // e.g. a number beyond what a double holds
+    r.message = "not a readable session: it holds a number too large to read";
+    return r;
   }
   if (!j.is_object() || !j.contains("format") || j["format"] != kSessionFormat) {
     r.message = "not a FlexArm session (\"format\": \"flexarm-session\" is missing)";

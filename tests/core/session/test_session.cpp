@@ -149,6 +149,12 @@ TEST(Session, DamagedFilesAreRefusedWithThePlace) {
   EXPECT_NE(noSum.message.find("sha256"), std::string::npos) << noSum.message;
 
   EXPECT_FALSE(parseSession("{\"hello\": 1}").ok);
+
+  // A number beyond a double (found by fuzz_session) is a refusal, not an exception.
+  SessionParseResult huge;
+  ASSERT_NO_THROW(huge = parseSession("{\"format\": 2e66666666662666666666666}"));
+  EXPECT_FALSE(huge.ok);
+  EXPECT_NE(huge.message.find("too large"), std::string::npos) << huge.message;
 }
 
 TEST(Session, NewerVersionIsRefusedNamingBothVersions) {
