@@ -334,7 +334,9 @@ SessionParseResult parseSession(const std::string& text) {
     return r;
   }
   const int version = j["version"].get<int>();
-  const std::string writer = j.value("written_by", std::string("a newer FlexArm"));
+  const std::string writer = j.contains("written_by") && j["written_by"].is_string()
+                                 ? j["written_by"].get<std::string>()
+                                 : std::string("a newer FlexArm");
   if (version > kSessionVersion) {
     r.message = "this session is in session format " + std::to_string(version) + " (written by " +
                 writer + "); FlexArm " + FLEXARM_VERSION + " reads formats up to " +

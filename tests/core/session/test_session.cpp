@@ -155,6 +155,12 @@ TEST(Session, DamagedFilesAreRefusedWithThePlace) {
   ASSERT_NO_THROW(huge = parseSession("{\"format\": 2e66666666662666666666666}"));
   EXPECT_FALSE(huge.ok);
   EXPECT_NE(huge.message.find("too large"), std::string::npos) << huge.message;
+  // A writer that is no text (found by fuzz_session) does not stop the version message.
+  SessionParseResult odd;
+  ASSERT_NO_THROW(odd = parseSession(
+                      "{\"format\": \"flexarm-session\", \"version\": 99, \"written_by\": {}}"));
+  EXPECT_FALSE(odd.ok);
+  EXPECT_NE(odd.message.find("99"), std::string::npos) << odd.message;
 }
 
 TEST(Session, NewerVersionIsRefusedNamingBothVersions) {
