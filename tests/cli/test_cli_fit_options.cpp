@@ -117,8 +117,9 @@ TEST(CliFitOptions, GearRatioOneRecoversTheMotorSideTruth) {
   const double Ja = 12.0 * s * 1.3, ka = 1.5e5 * s * 0.8, da = 70.0 * s * 1.2;
   const std::string log = (scratchDir() / "two_mass_r1.csv").string();
   auto r = runFlexarm({"simulate", "--model", "two-mass", "--param", "r=1", "--param", "J_a=" + std::to_string(Ja),
-                       "--param", "k_a=" + std::to_string(ka), "--param", "d_a=" + std::to_string(da), "--duration",
-                       "6", "--seed", "9", "--out", log});
+                       "--param", "k_a=" + std::to_string(ka), "--param", "d_a=" + std::to_string(da),
+                       // the arm's load noise (2 N m) referred to the motor side, as the parameters are
+                       "--load-noise", std::to_string(2.0 * r0), "--duration", "6", "--seed", "9", "--out", log});
   ASSERT_EQ(r.code, 0) << r.err;
   r = runFlexarm({"fit", log, "--model", "two-mass", "--start", "r=1", "--json"});
   ASSERT_EQ(r.code, 0) << r.err;
@@ -129,6 +130,7 @@ TEST(CliFitOptions, GearRatioOneRecoversTheMotorSideTruth) {
   for (const auto& [name, t] : truth) {
     const double v = j["parameters"][name].get<double>(), sd = j["std"][name].get<double>();
     EXPECT_GT(sd, 0.0) << name;
+    EXPECT_LT(sd, 0.1 * t) << name << ": interval too wide";
     EXPECT_LT(std::abs(v - t), z * sd) << name << " = " << v << " +- " << sd << ", truth " << t;
   }
 }
