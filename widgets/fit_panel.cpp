@@ -11,6 +11,7 @@
 #include <QProgressBar>
 #include <QPushButton>
 #include <QSpinBox>
+#include <QLineEdit>
 #include <QTableWidget>
 #include <QTimer>
 #include <QVBoxLayout>
@@ -41,7 +42,7 @@ FitPanel::FitPanel(Workspace* workspace, QWidget* parent)
     : QWidget(parent), workspace_(workspace), model_(new QComboBox(this)),
       na_(new QSpinBox(this)), nb_(new QSpinBox(this)), nc_(new QSpinBox(this)),
       nd_(new QSpinBox(this)), nf_(new QSpinBox(this)), nk_(new QSpinBox(this)),
-      free_(new QListWidget(this)), ranges_(new QLabel(this)), decimation_(new QSpinBox(this)),
+      free_(new QListWidget(this)), startsBounds_(new QLineEdit(this)), ranges_(new QLabel(this)), decimation_(new QSpinBox(this)),
       noise_(new QComboBox(this)), closedLoop_(new QComboBox(this)), starts_(new QSpinBox(this)), iterations_(new QSpinBox(this)),
       estimate_(new QPushButton(tr("Estimate"), this)),
       cancel_(new QPushButton(tr("Cancel"), this)), progress_(new QProgressBar(this)),
@@ -67,6 +68,12 @@ FitPanel::FitPanel(Workspace* workspace, QWidget* parent)
   free_->setObjectName("freeParameterList");
   free_->setMaximumHeight(90);
   free_->setToolTip(tr("Checked parameters are estimated; the others keep their values"));
+  startsBounds_->setObjectName("startsBoundsEdit");
+  startsBounds_->setPlaceholderText(tr("e.g. J_m=1e-3, r=1, d_g=-inf:inf"));
+  startsBounds_->setToolTip(tr("Start values P=V (else the model's; r=1 refers the parameters behind "
+                               "the gear to the motor side) and bounds P=LO:HI, comma-separated. "
+                               "Dampings d_* are non-negative unless bounded otherwise; a parameter "
+                               "that ends on a bound is named in the notes"));
   ranges_->setObjectName("fitRangesLabel");
   ranges_->setWordWrap(true);
   decimation_->setRange(1, 100);
@@ -102,6 +109,7 @@ FitPanel::FitPanel(Workspace* workspace, QWidget* parent)
   form->addRow(tr("Model"), model_);
   form->addRow(tr("Orders"), orderRow);
   form->addRow(tr("Free parameters"), free_);
+  form->addRow(tr("Starts, bounds"), startsBounds_);
   form->addRow(tr("Ranges"), ranges_);
   form->addRow(tr("Decimation"), decimation_);
   form->addRow(tr("Noise model"), noise_);
@@ -283,6 +291,7 @@ void FitPanel::updateControls() {
   for (int i = 0; i < 5; ++i) orders[i]->setEnabled(s && used[static_cast<int>(*s)][i] && !busy);
   nk_->setEnabled(s.has_value() && !busy);
   free_->setEnabled(!s && !busy);
+  startsBounds_->setEnabled(!s && !busy);
   noise_->setEnabled(!s && !busy);
   closedLoop_->setEnabled(!s && !busy && noise_->currentIndex() == 0);
   starts_->setEnabled(!s && !busy);
@@ -373,6 +382,11 @@ std::optional<FitOptions> FitPanel::options(QString* name) {
     o.closedLoop = closedLoopChoiceFromString(closedLoop_->currentData().toString().toStdString())
                        .value_or(ClosedLoopChoice::Auto);
     o.randomStarts = starts_->value();
+    std::string bad;
+    if (!startsAndBoundsFromText(startsBounds_->text().toStdString(), o.startValues, o.bounds, &bad)) {
+      summary_->setPlainText(tr("Starts and bounds: %1.").arg(QString::fromStdString(bad)));
+      return std::nullopt;
+    }
   }
   if (!workspace_->current()) {
     summary_->setPlainText(tr("Open a log with an input and an output channel first."));

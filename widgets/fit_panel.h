@@ -23,6 +23,7 @@ class QPlainTextEdit;
 class QProgressBar;
 class QPushButton;
 class QSpinBox;
+class QLineEdit;
 class QTableWidget;
 class QTimer;
 
@@ -102,6 +103,7 @@ class FitPanel : public QWidget {
   QSpinBox* nf_;
   QSpinBox* nk_;
   QListWidget* free_;
+  QLineEdit* startsBounds_;  // start values P=V and bounds P=LO:HI (FitOptions)
   QLabel* ranges_;
   QSpinBox* decimation_;
   QComboBox* noise_;

@@ -38,6 +38,7 @@ bool ArgParser::parse(const std::vector<std::string>& args) {
         return false;
       }
       values_[name].push_back("");
+      sequence_.emplace_back(name, "");
     } else if (contains(valued_, name)) {
       if (!hasValue) {
         if (i + 1 >= args.size()) {
@@ -47,6 +48,7 @@ bool ArgParser::parse(const std::vector<std::string>& args) {
         value = args[++i];
       }
       values_[name].push_back(value);
+      sequence_.emplace_back(name, value);
     } else {
       error_ = "unknown option '--" + name + "'";
       return false;

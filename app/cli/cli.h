@@ -6,6 +6,7 @@
 #include <map>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace flexarm::cli {
@@ -49,6 +50,9 @@ class ArgParser {
   std::optional<std::string> value(const std::string& name) const;
   std::vector<std::string> values(const std::string& name) const;
   const std::vector<std::string>& positional() const { return positional_; }
+  // Every valued option and flag as given, in command-line order (name without "--", value;
+  // empty for a flag), for options whose order matters (the last one wins).
+  const std::vector<std::pair<std::string, std::string>>& sequence() const { return sequence_; }
 
   // Typed access; on a malformed value return false and set error().
   bool number(const std::string& name, double& out);
@@ -61,6 +65,7 @@ class ArgParser {
   std::vector<std::string> flags_, valued_;
   std::map<std::string, std::vector<std::string>> values_;
   std::vector<std::string> positional_;
+  std::vector<std::pair<std::string, std::string>> sequence_;
   std::string error_;
 };
 

@@ -48,42 +48,51 @@ std::vector<std::string> splitComma(const std::string& text) {
   return out;
 }
 
-// --free and --fix applied to the physical start model; false after printing a usage error.
-bool applyFreeAndFix(ArgParser& args, PhysicalModel& model, const std::string& pre, std::ostream& err) {
-  if (auto f = args.value("free")) {
-    for (const auto& p : model.parameters()) model.setFree(p.name, false);
-    for (const auto& n : splitComma(*f)) {
-      if (model.indexOf(n) < 0) {
-        err << pre << "--free: the " << model.structureName() << " model has no parameter '" << n << "'\n";
+// The parameter names of model, for messages.
+std::string parameterNames(const PhysicalModel& model) {
+  std::string out;
+  for (const auto& p : model.parameters()) out += (out.empty() ? "" : ", ") + p.name;
+  return out;
+}
+
+// --free, --fix, --start and --bound of a physical fit, in command-line order (a later --free
+// or --fix of a parameter overrides an earlier one): free flags on the start model, start
+// values and bounds into the options. False after printing a usage error.
+bool applyStartOptions(ArgParser& args, PhysicalModel& model, FitOptions& o, const std::string& pre,
+                       std::ostream& err) {
+  auto known = [&](const char* option, const std::string& name) {
+    if (model.indexOf(name) >= 0) return true;
+    err << pre << "--" << option << ": the " << model.structureName() << " model has no parameter '" << name
+        << "' (its parameters: " << parameterNames(model) << ")\n";
+    return false;
+  };
+  for (const auto& [option, text] : args.sequence()) {
+    if (option == "free") {
+      for (const auto& p : model.parameters()) model.setFree(p.name, false);
+      for (const auto& n : splitComma(text)) {
+        if (!known("free", n)) return false;
+        model.setFree(n, true);
+      }
+    } else if (option == "fix" || option == "start") {
+      const bool valued = text.find('=') != std::string::npos;
+      const auto v = parameterValueFromText(text);
+      if ((valued || option == "start") && !v) {
+        err << pre << "--" << option << " expects NAME=VALUE (a finite number), not '" << text << "'\n";
         return false;
       }
-      model.setFree(n, true);
+      const std::string name = v ? v->name : text;
+      if (!known(option.c_str(), name)) return false;
+      if (v) o.startValues.push_back(*v);
+      if (option == "fix") model.setFree(name, false);
+    } else if (option == "bound") {
+      const auto b = parameterBoundFromText(text);
+      if (!b) {
+        err << pre << "--bound expects NAME=LO:HI with LO <= HI (numbers, or -inf/inf), not '" << text << "'\n";
+        return false;
+      }
+      if (!known("bound", b->name)) return false;
+      o.bounds.push_back(*b);
     }
-  }
-  for (const auto& fx : args.values("fix")) {
-    const auto eq = fx.find('=');
-    double v = 0.0;
-    try {
-      if (eq == std::string::npos) throw std::invalid_argument(fx);
-      std::size_t used = 0;
-      v = std::stod(fx.substr(eq + 1), &used);
-      if (used != fx.size() - eq - 1) throw std::invalid_argument(fx);
-    } catch (const std::exception&) {
-      err << pre << "--fix expects NAME=VALUE, not '" << fx << "'\n";
-      return false;
-    }
-    const std::string name = fx.substr(0, eq);
-    if (model.indexOf(name) < 0) {
-      err << pre << "--fix: the " << model.structureName() << " model has no parameter '" << name << "'\n";
-      return false;
-    }
-    try {
-      model.setParameter(name, v);
-    } catch (const std::invalid_argument& e) {
-      err << pre << "--fix " << e.what() << "\n";
-      return false;
-    }
-    model.setFree(name, false);
   }
   return true;
 }
@@ -217,7 +226,7 @@ bool parseModelSpec(const std::string& text, FitModelSpec& spec, std::string* wh
 
 std::vector<std::string> fitValuedOptionNames() {
   std::vector<std::string> v = logReadOptionNames();
-  for (const char* n : {"model", "free", "fix", "decimate", "range", "log", "validation-log",
+  for (const char* n : {"model", "free", "fix", "start", "bound", "decimate", "range", "log", "validation-log",
                         "validation-range", "max-iterations", "starts", "seed", "closed-loop"})
     v.push_back(n);
   return v;
@@ -230,7 +239,21 @@ const char* fitOptionsHelp() {
          "                        bj:NB,NC,ND,NF,NK (orders of (4.8), delay NK), or a physical\n"
          "                        model two-mass|three-mass|four-mass|rigid (required)\n"
          "  --free P1,P2          physical models: estimate only these parameters\n"
-         "  --fix P=V             physical models: hold P at V (repeatable)\n"
+         "  --fix P[=V]           physical models: hold P (at V, else its start value; repeatable).\n"
+         "                        --free and --fix are applied in order: the last one naming a\n"
+         "                        parameter wins (--fix J_m=1e-3 --free J_m estimates J_m from\n"
+         "                        1e-3)\n"
+         "  --start P=V           physical models: start P from V (repeatable); names as the\n"
+         "                        parameter table prints them (J_m, k_g, d_a, ...). A fixed P is\n"
+         "                        held at V. --start r=1 fits motor-side parameters (gear ratio\n"
+         "                        1): the default J_a, J_g, k_*, d_* are referred to the motor\n"
+         "                        side (times r_default^2 = 1/118^2) unless given, so the start\n"
+         "                        has the default's dynamics; --fix r=V does the same\n"
+         "  --bound P=LO:HI       physical models: search P only in [LO, HI] (repeatable; -inf\n"
+         "                        and inf allowed). Defaults: the model's bounds with dampings\n"
+         "                        d_* >= 0 and inertias and stiffnesses > 0; a parameter that\n"
+         "                        ends on a bound is named in a warning (--bound d_g=-inf:inf\n"
+         "                        allows the seed's negative dampings, Table 5.7)\n"
          "  --noise-model         physical models: innovations form, K estimated (else K = 0)\n"
          "  --starts N            physical models: N random starts besides the nominal one,\n"
          "                        plus two whose notches and peaks match the SPA estimate\n"
@@ -310,10 +333,11 @@ int runFitPipeline(ArgParser& args, const std::string& verb, FitResult& result, 
     return kExitUsage;
   }
   const bool physical = o.model.kind == FitModelKind::Physical;
-  if (!physical && (args.value("free") || !args.values("fix").empty() || args.flag("noise-model") ||
-                    args.value("starts") || args.value("closed-loop"))) {
-    err << pre << "--free, --fix, --noise-model, --starts and --closed-loop apply to physical "
-                  "models only\n";
+  if (!physical && (args.value("free") || !args.values("fix").empty() || !args.values("start").empty() ||
+                    !args.values("bound").empty() || args.flag("noise-model") || args.value("starts") ||
+                    args.value("closed-loop"))) {
+    err << pre << "--free, --fix, --start, --bound, --noise-model, --starts and --closed-loop apply to "
+                  "physical models only\n";
     return kExitUsage;
   }
   int decimation = 1, maxIter = 100, starts = 0;
@@ -354,7 +378,7 @@ int runFitPipeline(ArgParser& args, const std::string& verb, FitResult& result, 
   }
   if (physical) {
     auto start = std::shared_ptr<PhysicalModel>(makePhysicalModel(*modelText));
-    if (!applyFreeAndFix(args, *start, pre, err)) return kExitUsage;
+    if (!applyStartOptions(args, *start, o, pre, err)) return kExitUsage;
     o.model.start = start;
   }
   auto readOptions = logReadOptions(args, err);

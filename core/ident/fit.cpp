@@ -116,6 +116,16 @@ bool FitOptions::isValidExceptData(std::string* why) const {
       return fail("the indirect closed-loop fit runs at the controller's rate; it excludes decimation");
     if (controller && !controller->isValid(why)) return false;
     if (!controllerIdent.isValid(why)) return false;
+    try {
+      const auto start = fitStartModel(*this);
+      bool anyFree = false;
+      for (const auto& p : start->parameters()) anyFree = anyFree || p.free;
+      if (!anyFree) return fail("a physical fit needs at least one free parameter");
+    } catch (const std::invalid_argument& e) {
+      return fail(e.what());
+    }
+  } else if (!startValues.empty() || !bounds.empty()) {
+    return fail("start values and bounds apply to physical models only");
   }
   return true;
 }
@@ -382,11 +392,21 @@ FitResult fitModel(const FitOptions& options, const ProgressCallback& progress) 
     }
   } catch (const std::invalid_argument& e) {
     return finish(Termination::Failed, std::string("the fit was refused: ") + e.what());
+  } catch (const std::exception& e) {  // numerical trouble is a failed fit, never a crash
+    return finish(Termination::Failed, std::string("the estimator met numerical trouble: ") + e.what());
   }
   if (!r.summary.ok()) return finish(r.summary.termination, r.summary.message);
+  if (r.summary.termination == Termination::MaxIterations)
+    r.warnings.push_back("the estimator stopped at its limit of " + std::to_string(options.maxIterations) +
+                         " iterations before it converged, so the estimate may not be the loss's minimum "
+                         "and its intervals may not hold; raise the iteration limit");
 
   // 5. Evaluation.
-  fit_detail::evaluate(options, r);
+  try {
+    fit_detail::evaluate(options, r);
+  } catch (const std::exception& e) {
+    return finish(Termination::Failed, std::string("the estimate could not be evaluated: ") + e.what());
+  }
   return finish(r.summary.termination, r.summary.message);
 }
 

@@ -64,6 +64,29 @@ enum class ClosedLoopChoice { Auto, Direct, TwoStage, Indirect };
 const char* toString(ClosedLoopChoice c);  // "auto", "direct", "two-stage", "indirect"
 std::optional<ClosedLoopChoice> closedLoopChoiceFromString(std::string_view s);
 
+// A value of one physical parameter, by the name parameters() gives it (e.g. "J_m", "k_g").
+struct ParameterValue {
+  std::string name;
+  double value = 0.0;
+};
+
+// The interval a fit searches one physical parameter in, by name.
+struct ParameterBound {
+  std::string name;
+  double lower = 0.0, upper = 0.0;
+};
+
+// "J_m=1e-3" as a start value and "d_g=-inf:0" (LO <= HI, numbers or -inf/inf) as a bound;
+// nullopt when the text is not of that form (the name is not checked here).
+std::optional<ParameterValue> parameterValueFromText(const std::string& text);
+std::optional<ParameterBound> parameterBoundFromText(const std::string& text);
+// Comma-separated start values and bounds ("J_m=1e-3, d_g=-inf:inf"), as the Fit panel takes
+// them; false with a sentence naming the item that is neither.
+bool startsAndBoundsFromText(const std::string& text, std::vector<ParameterValue>& starts,
+                             std::vector<ParameterBound>& bounds, std::string* why);
+// The same as text: start values, then bounds.
+std::string startsAndBoundsText(const std::vector<ParameterValue>& starts, const std::vector<ParameterBound>& bounds);
+
 // One experiment: a log and the part of it used.
 struct FitExperiment {
   std::shared_ptr<const IdData> data;
@@ -96,6 +119,17 @@ struct FitOptions {
   // cascade identified from the log.
   std::optional<ControllerOptions> controller;
   ControllerIdentOptions controllerIdent;
+  // Start values replacing the start model's, by name; a fixed parameter is held at its start
+  // value. A start value of the gear ratio r refers the start model to that ratio: the
+  // parameters behind the gear that have no start value of their own (arm- and gear-side
+  // inertias, stiffnesses and dampings) are scaled by (r_model / r)^2, which keeps the
+  // model's dynamics from the motor (the same transfer function from torque to motor
+  // velocity), so r = 1 (motor-side parameters) starts from a stable predictor.
+  std::vector<ParameterValue> startValues;
+  // Bounds replacing the defaults (fitBounds): a fit never leaves them, and a parameter that
+  // ends on one gets a warning naming it and the bound. A start value outside its bounds is
+  // invalid; a start model's value outside them is moved onto the bound, with a warning.
+  std::vector<ParameterBound> bounds;
   int randomStarts = 0;  // > 0 adds two starts at the SPA notches and peaks as well
   unsigned seed = 1;
   // Physical and black-box models.
@@ -188,6 +222,18 @@ struct FitResult {
   // "three-mass (K = 0)", "three-mass (innovations form)", "oe[2 2 1]", "spa".
   std::string modelName() const;
 };
+
+// The bounds a physical fit of options searches in, one per parameter of the start model in
+// its order: the model's own, with non-negative dampings (d_*; the model allows the seed's
+// negative ones, Tables 5.4 and 5.7) and positive inertias and stiffnesses, then
+// options.bounds. Throws std::invalid_argument when the options are not a physical fit.
+std::vector<ParameterBound> fitBounds(const FitOptions& options);
+
+// The start model of a physical fit: options.model.start with options.startValues (r's
+// rescaling included), the fit's bounds and its values moved into them. Sentences about
+// values moved are appended to notes (may be null). Throws std::invalid_argument as fitBounds,
+// or for a start value that is unknown or outside its bounds.
+std::shared_ptr<PhysicalModel> fitStartModel(const FitOptions& options, std::vector<std::string>* notes = nullptr);
 
 // Runs the pipeline. Data failures (no usable data, a constant input, a method the log cannot
 // support, a diverged or failed estimator) end in termination Failed or Diverged with a

@@ -1,5 +1,6 @@
 // Steps 2-4 of the fit pipeline for physical models: the closed-loop method, the starts and
 // the prediction-error estimator (5.7).
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 
@@ -92,9 +93,40 @@ std::optional<Loop> loopOf(const FitOptions& o, const PreparedData& d, std::stri
   return loop;
 }
 
+std::string number(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%g", v);
+  return buf;
+}
+
+// A warning for each free parameter that ended on one of its bounds (start: the model the
+// search started from, whose bounds it kept).
+void boundWarnings(const PhysicalModel& start, FitResult& r) {
+  const auto& params = start.parameters();
+  for (const auto& q : r.parameters) {
+    const int i = start.indexOf(q.name);
+    if (!q.free || i < 0) continue;
+    const ParameterInfo& p = params[static_cast<std::size_t>(i)];
+    // On a bound: within a billionth of the larger of the bound and the start value.
+    auto near = [&](double bound) {
+      return std::isfinite(bound) &&
+             std::abs(q.value - bound) <= 1e-9 * std::max({std::abs(bound), std::abs(p.value), 1e-300});
+    };
+    const bool low = near(p.lower), high = !low && near(p.upper);
+    if (!low && !high) continue;
+    r.warnings.push_back(q.name + " sits on its " + (low ? "lower" : "upper") + " bound " +
+                         number(low ? p.lower : p.upper) + "; the data would push it " +
+                         (low ? "below" : "above") + " (its interval does not account for the bound; " +
+                         "widen the bound to let it go further)");
+  }
+}
+
 void keepEstimate(PemResult&& e, const FitOptions& o, FitResult& r) {
   (void)o;
   r.summary = e.summary;
+  if (e.skippedStarts > 0)
+    r.warnings.push_back(std::to_string(e.skippedStarts) + " of " + std::to_string(e.starts) +
+                         " starts were skipped for numerical trouble (" + e.skipReason + ")");
   for (const auto& p : e.parameters) r.parameters.push_back({p.name, p.unit, p.value, p.std, p.lower, p.upper, p.free});
   r.physical = std::shared_ptr<const PhysicalModel>(static_cast<PhysicalModel*>(e.model.release()));
   r.K = e.K;
@@ -110,6 +142,8 @@ void keepEstimate(PemResult&& e, const FitOptions& o, FitResult& r) {
 
 bool fitPhysical(const FitOptions& o, FitResult& r, const ProgressCallback& progress) {
   const PreparedData& d = r.data;
+  // The start model with the start values and the fit's bounds (fitStartModel).
+  const std::shared_ptr<const PhysicalModel> start = fitStartModel(o, &r.warnings);
   const JoinedEstimation joined = joinedEstimation(r);  // every estimation experiment
   const Eigen::VectorXd& u = joined.u;
   const Eigen::VectorXd& y = joined.y;
@@ -160,9 +194,9 @@ bool fitPhysical(const FitOptions& o, FitResult& r, const ProgressCallback& prog
     if (m == ClosedLoopMethod::Indirect) {
       c.controller = loop->controller;
       c.loopWarmup = loop->warmup;
-      return pemClosedLoop(*o.model.start, {}, loop->angle, loop->reference, T, c, part);
+      return pemClosedLoop(*start, {}, loop->angle, loop->reference, T, c, part);
     }
-    return pemClosedLoop(*o.model.start, u, y,
+    return pemClosedLoop(*start, u, y,
                          m == ClosedLoopMethod::TwoStage ? d.estimationReference() : Eigen::VectorXd(), T, c,
                          part);
   };
@@ -220,6 +254,15 @@ bool fitPhysical(const FitOptions& o, FitResult& r, const ProgressCallback& prog
                           "reference to the motor angle";
   }
   keepEstimate(std::move(cl.pem), o, r);
+  if (r.summary.ok()) boundWarnings(*start, r);
+  // The estimate keeps the start model's own bounds (widened to hold its value), so that it
+  // can be edited and simulated as any model; the fit's bounds were the search's.
+  if (r.physical) {
+    auto estimate = std::shared_ptr<PhysicalModel>(static_cast<PhysicalModel*>(r.physical->clone().release()));
+    for (const auto& p : o.model.start->parameters())
+      estimate->setBounds(p.name, std::min(p.lower, estimate->value(p.name)), std::max(p.upper, estimate->value(p.name)));
+    r.physical = estimate;
+  }
   return true;
 }
 

@@ -374,7 +374,8 @@ PemResult pem(const ParametricModel& model0, const Eigen::VectorXd& u, const Eig
   tr.nK = innovations ? n : 0;
   for (int idx : tr.free) {
     const auto& p = params0[idx];
-    const bool lg = options.scaling == ParameterScaling::Log && p.lower >= 0.0 && p.value > 0.0;
+    // A parameter bounded at zero is scaled, not logged, so that it can reach its bound.
+    const bool lg = options.scaling == ParameterScaling::Log && p.lower > 0.0 && p.value > 0.0;
     tr.logParam.push_back(lg);
     tr.scale.push_back(options.scaling == ParameterScaling::None || p.value == 0.0
                            ? 1.0 : std::abs(p.value));
@@ -503,9 +504,9 @@ PemResult pem(const ParametricModel& model0, const Eigen::VectorXd& u, const Eig
     auto probe = model0.clone();
     for (int c = 0; c < options.screenCandidates; ++c) {
       auto v = randomPoint(options.screenFactor);
-      for (std::size_t i = 0; i < v.size(); ++i) probe->setParameter(params0[i].name, v[i]);
       NotchesPeaks np;
       try {
+        for (std::size_t i = 0; i < v.size(); ++i) probe->setParameter(params0[i].name, v[i]);
         np = notchesAndPeaks(frequencyResponse(*probe, grid), 1.0);
       } catch (const std::invalid_argument&) {
         continue;
@@ -533,8 +534,12 @@ PemResult pem(const ParametricModel& model0, const Eigen::VectorXd& u, const Eig
       if (tr.logParam[j] && !(th > 0.0)) admissible = false;
       phi0[j] = admissible ? tr.toPhi(j, th) : 0.0;
     }
-    for (std::size_t i = 0; i < params0.size(); ++i)
-      if (!params0[i].free) work->setParameter(params0[i].name, starts[si][i]);
+    try {
+      for (std::size_t i = 0; i < params0.size(); ++i)
+        if (!params0[i].free) work->setParameter(params0[i].name, starts[si][i]);
+    } catch (const std::invalid_argument&) {
+      admissible = false;
+    }
     if (!admissible) {
       result.startLosses.push_back(INFINITY);
       continue;
@@ -547,9 +552,18 @@ PemResult pem(const ParametricModel& model0, const Eigen::VectorXd& u, const Eig
                         "start " + std::to_string(si + 1) + " of " + std::to_string(starts.size()) +
                             ": " + stage);
       };
-    LeastSquaresSolution sol = levenbergMarquardt(problem, phi0, options.maxIterations,
-                                                  options.relativeTolerance,
-                                                  options.initialDamping, sub);
+    LeastSquaresSolution sol;
+    try {
+      sol = levenbergMarquardt(problem, phi0, options.maxIterations, options.relativeTolerance,
+                               options.initialDamping, sub);
+    } catch (const std::exception& e) {
+      // Numerical trouble in one start (a value the model refuses, a failed factorisation)
+      // skips that start; the others go on.
+      ++result.skippedStarts;
+      if (result.skipReason.empty()) result.skipReason = e.what();
+      result.startLosses.push_back(INFINITY);
+      continue;
+    }
     totalIterations += sol.summary.iterations;
     cancelled = sol.summary.termination == Termination::Cancelled;
     const bool ok = sol.summary.termination != Termination::Failed;

@@ -69,7 +69,8 @@ std::optional<CovarianceKind> covarianceKindFromString(std::string_view s);
 
 struct PemOptions {
   NoiseModel noiseModel = NoiseModel::OutputError;
-  // Log applies to parameters whose lower bound is >= 0 and value > 0; others are scaled.
+  // Log applies to parameters whose lower bound is > 0 and value > 0; others are scaled (a
+  // parameter bounded at zero can then reach its bound).
   ParameterScaling scaling = ParameterScaling::Log;
   int maxIterations = 100;
   double relativeTolerance = 1e-9;
@@ -128,6 +129,10 @@ struct PemResult {
   int starts = 0;        // number of starting points tried
   int bestStart = -1;    // 0: the model's own values; then user, notch/peak and random ones
   std::vector<double> startLosses;
+  // Starts skipped for numerical trouble (a value the model refuses during the search), and
+  // the first one's reason; their startLosses are infinite.
+  int skippedStarts = 0;
+  std::string skipReason;
   CovarianceKind covarianceKind = CovarianceKind::White;
   int covarianceLags = 0;  // lag window used by the sandwich covariance
 };

@@ -246,6 +246,20 @@ void PhysicalModel::setFree(const std::string& name, bool isFree) {
   params_[static_cast<std::size_t>(i)].free = isFree;
 }
 
+void PhysicalModel::setBounds(const std::string& name, double lower, double upper) {
+  const int i = indexOf(name);
+  if (i < 0)
+    throw std::invalid_argument("the " + structureName() + " model has no parameter '" + name +
+                                "'");
+  if (std::isnan(lower) || std::isnan(upper) || !(lower <= upper)) {
+    std::ostringstream s;
+    s << "the bounds of " << name << " must be an interval LO <= HI, not [" << lower << ", " << upper << "]";
+    throw std::invalid_argument(s.str());
+  }
+  params_[static_cast<std::size_t>(i)].lower = lower;
+  params_[static_cast<std::size_t>(i)].upper = upper;
+}
+
 double PhysicalModel::value(const std::string& name) const {
   const int i = indexOf(name);
   if (i < 0)

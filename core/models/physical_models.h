@@ -47,6 +47,9 @@ class PhysicalModel : public ParametricModel {
   // parameter's bounds.
   void setParameter(const std::string& name, double value) override;
   void setFree(const std::string& name, bool isFree) override;
+  // Sets the bounds a fit searches within (lower <= upper, not NaN); the value is left as it
+  // is. Throws std::invalid_argument for an unknown name or bounds that are no interval.
+  void setBounds(const std::string& name, double lower, double upper);
   StateSpace stateSpace() const override;
   StateSpaceDerivative derivative(int index) const override;
 

@@ -50,6 +50,13 @@ json fitRequestToJson(const FitRequest& r) {
     j["closed_loop"] = toString(o.closedLoop);
     j["random_starts"] = o.randomStarts;
     j["seed"] = o.seed;
+    json starts = json::object(), bounds = json::object();
+    for (const auto& v : o.startValues) starts[v.name] = v.value;
+    // JSON has no infinity: an open end is null.
+    auto end = [](double v) { return std::isfinite(v) ? json(v) : json(nullptr); };
+    for (const auto& b : o.bounds) bounds[b.name] = json::array({end(b.lower), end(b.upper)});
+    if (!starts.empty()) j["start_values"] = starts;
+    if (!bounds.empty()) j["bounds"] = bounds;
   } else {
     const PolyOrders& q = o.model.orders;
     j["kind"] = toString(FitModelKind::BlackBox);
@@ -105,6 +112,23 @@ std::optional<FitRequest> fitRequestFromJson(const json& j, std::string* why) {
         !readInt(j, "seed", 0, 1 << 30, seed, &reason))
       return fail(where + reason);
     o.seed = static_cast<unsigned>(seed);
+    if (j.contains("start_values")) {
+      if (!j["start_values"].is_object()) return fail(where + "start_values must map names to numbers");
+      for (const auto& [name, v] : j["start_values"].items()) {
+        if (!v.is_number()) return fail(where + "the start value of " + name + " must be a number");
+        o.startValues.push_back({name, v.get<double>()});
+      }
+    }
+    if (j.contains("bounds")) {
+      if (!j["bounds"].is_object()) return fail(where + "bounds must map names to [lower, upper]");
+      for (const auto& [name, v] : j["bounds"].items()) {
+        if (!v.is_array() || v.size() != 2 || !(v[0].is_number() || v[0].is_null()) ||
+            !(v[1].is_number() || v[1].is_null()))
+          return fail(where + "the bounds of " + name + " must be [lower, upper] (numbers, null for an open end)");
+        o.bounds.push_back({name, v[0].is_null() ? -INFINITY : v[0].get<double>(),
+                            v[1].is_null() ? INFINITY : v[1].get<double>()});
+      }
+    }
   } else if (kind == toString(FitModelKind::BlackBox)) {
     o.model.kind = FitModelKind::BlackBox;
     auto s = j.contains("structure") && j["structure"].is_string()

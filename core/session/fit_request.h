@@ -36,7 +36,8 @@ FitOptions fitOptionsOf(const FitRequest& request, std::shared_ptr<const IdData>
 // {"name", "kind": "physical" | "black-box", "decimation", "max_iterations", "estimation_s",
 // "validation_s", physical: "start" (a model), "noise_model", "closed_loop" ("auto", "direct",
 // "two-stage", "indirect"; absent in sessions written before it: "direct"), "random_starts",
-// "seed"; black-box: "structure", "orders"}.
+// "seed", optional "start_values" {name: value} and "bounds" {name: [lower, upper], null an
+// open end}; black-box: "structure", "orders"}.
 nlohmann::json fitRequestToJson(const FitRequest& request);
 // The request described by j; nullopt with a sentence for a malformed one.
 std::optional<FitRequest> fitRequestFromJson(const nlohmann::json& j, std::string* why);

@@ -206,7 +206,7 @@ TEST(CliIdent, BadRequestsExitWithUsageBadInputOrNumericalCodes) {
   r = runFlexarm({"fit", kChirp, "--model", "three-mass", "--free", "J_x"});
   EXPECT_EQ(r.code, 2);
   EXPECT_NE(r.err.find("no parameter 'J_x'"), std::string::npos) << r.err;
-  r = runFlexarm({"fit", kChirp, "--model", "three-mass", "--fix", "k_g"});
+  r = runFlexarm({"fit", kChirp, "--model", "three-mass", "--fix", "k_g=stiff"});
   EXPECT_EQ(r.code, 2);
   EXPECT_NE(r.err.find("NAME=VALUE"), std::string::npos) << r.err;
   // A value outside the parameter's bounds is refused with the bounds, not an abort.
@@ -255,8 +255,10 @@ TEST(CliIdent, BadRequestsExitWithUsageBadInputOrNumericalCodes) {
 // sample log's truth (Table 5.7 p6) lies inside its 99 % interval, and the estimate keeps
 // the velocity output for the fit % of the torque-to-velocity simulation.
 TEST(CliIdent, IndirectFitReadsTheControllerAndRecoversEveryParameter) {
+  // The truth's gear damping is the seed's negative d_g = -62 (Table 5.7 p6): the fit's
+  // default bound d_g >= 0 is opened for it.
   auto r = runFlexarm({"fit", kChirp, "--model", "three-mass", "--closed-loop", "indirect",
-                       "--json"});
+                       "--bound", "d_g=-inf:inf", "--json"});
   ASSERT_EQ(r.code, 0) << r.err;
   const auto j = nlohmann::json::parse(r.out);
   EXPECT_EQ(j["closed_loop_method"], "indirect");
@@ -286,7 +288,8 @@ TEST(CliIdent, IndirectFitReadsTheControllerAndRecoversEveryParameter) {
     for (std::string line; std::getline(in, line);)
       if (line.rfind("# controller_kv:", 0) != 0) out << line << "\n";
   }
-  r = runFlexarm({"fit", noKv, "--model", "three-mass", "--closed-loop", "indirect", "--json"});
+  r = runFlexarm({"fit", noKv, "--model", "three-mass", "--closed-loop", "indirect", "--bound", "d_g=-inf:inf",
+                  "--json"});
   ASSERT_EQ(r.code, 0) << r.err;
   auto k = nlohmann::json::parse(r.out);
   EXPECT_EQ(k["closed_loop_method"], "indirect");

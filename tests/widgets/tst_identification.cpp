@@ -6,6 +6,7 @@
 #include <QApplication>
 #include <QComboBox>
 #include <QDockWidget>
+#include <QLineEdit>
 #include <QListWidget>
 #include <QPushButton>
 #include <QSignalSpy>
@@ -214,6 +215,34 @@ class IdentificationTest : public QObject {
     test::saveShot(fit->grab().toImage(), "fit_panel_identity");
     window_->resize(1500, 1000);
     QTest::qWait(100);
+  }
+
+  // Start values and bounds typed in the panel reach the pipeline: a bound below the truth's
+  // J_m holds, and the note names the parameter and the bound; a malformed item is refused.
+  void startValuesAndBoundsFromThePanel() {
+    FitPanel* fit = window_->fitPanel();
+    showDock("fitDock");
+    QVERIFY(fit->setModelChoice("three-mass"));
+    fit->setFreeParameters({"J_m", "J_a", "k_g", "k_a"});
+    fit->setDecimation(10);
+    fit->setClosedLoopMethod(ClosedLoopChoice::TwoStage);
+    auto* edit = fit->findChild<QLineEdit*>("startsBoundsEdit");
+    QVERIFY(edit && edit->isEnabled());
+    edit->setText("J_a=1.5, J_m=1e-4:3e-4");
+    QVERIFY2(clickEstimate(fit), qPrintable(fit->summaryText()));
+    QTableWidget* t = fit->resultsTable();
+    QCOMPARE(t->item(0, 0)->text(), QString("J_m"));
+    QVERIFY2(std::abs(t->item(0, 1)->text().toDouble() - 3e-4) < 1e-9, qPrintable(t->item(0, 1)->text()));
+    QVERIFY2(fit->summaryText().contains("Note: J_m sits on its upper bound 0.0003; the data would push it above"),
+             qPrintable(fit->summaryText()));
+    test::saveShot(fit->grab().toImage(), "fit_panel_bounds");
+    edit->setText("J_m=abc");
+    QSignalSpy refused(fit, &FitPanel::estimated);
+    QTest::mouseClick(fit->findChild<QPushButton*>("estimateButton"), Qt::LeftButton);
+    QCOMPARE(refused.count(), 1);  // refused at once, before any estimate runs
+    QCOMPARE(refused.takeFirst().at(0).toBool(), false);
+    QVERIFY2(fit->summaryText().contains("'J_m=abc' is neither a start value"), qPrintable(fit->summaryText()));
+    edit->clear();
   }
 
   void blackBoxFitJoinsTheListToo() {

@@ -77,9 +77,30 @@ TEST(FitRequest, JsonRoundTripKeepsEveryField) {
   p.options.maxIterations = 40;
   p.estimation = SecondsRange{0.5, 12.0};
   p.validation = SecondsRange{12.0, 17.5};
+  p.options.startValues = {{"J_a", 1.5}, {"r", 1.0}};
+  p.options.bounds = {{"k_g", 1e4, INFINITY}, {"d_g", -INFINITY, INFINITY}};
   std::string why;
   auto back = fitRequestFromJson(fitRequestToJson(p), &why);
   ASSERT_TRUE(back) << why;
+  // Start values and bounds come back, open ends (null in JSON) as infinities.
+  ASSERT_EQ(back->options.startValues.size(), 2u);
+  EXPECT_EQ(back->options.startValues[0].name, "J_a");
+  EXPECT_EQ(back->options.startValues[0].value, 1.5);
+  ASSERT_EQ(back->options.bounds.size(), 2u);
+  EXPECT_EQ(back->options.bounds[0].name, "d_g");  // JSON objects keep names in order
+  EXPECT_EQ(back->options.bounds[0].lower, -INFINITY);
+  EXPECT_EQ(back->options.bounds[1].lower, 1e4);
+  EXPECT_EQ(back->options.bounds[1].upper, INFINITY);
+  {
+    json bad = fitRequestToJson(p);
+    bad["start_values"]["J_x"] = 1.0;
+    EXPECT_FALSE(fitRequestFromJson(bad, &why));
+    EXPECT_NE(why.find("no parameter 'J_x'"), std::string::npos) << why;
+    bad = fitRequestToJson(p);
+    bad["bounds"]["k_g"] = json::array({5.0});
+    EXPECT_FALSE(fitRequestFromJson(bad, &why));
+    EXPECT_NE(why.find("[lower, upper]"), std::string::npos) << why;
+  }
   EXPECT_EQ(fitRequestToJson(*back).dump(), fitRequestToJson(p).dump());
   EXPECT_TRUE(back->physical());
   EXPECT_EQ(back->options.model.start->value("k_g"), 123456.0);
@@ -265,6 +286,9 @@ TEST(FitsPart, IndirectRequestRecoversTheChirpTruthInsideItsIntervals) {
   FitRequest req = physicalRequest(std::move(start));
   req.name = "three-mass indirect";
   req.options.closedLoop = ClosedLoopChoice::Indirect;
+  // The truth's d_g is the seed's negative -62 (Table 5.7 p6): the request opens the fit's
+  // default bound d_g >= 0, and the session keeps the open bound.
+  req.options.bounds = {{"d_g", -INFINITY, INFINITY}};
   req.estimation = SecondsRange{0.0, 12.0};
   req.validation = SecondsRange{12.0, 17.5};
   std::string why;
