@@ -1,6 +1,7 @@
 #include "core/ident/blackbox.h"
 
 #include "core/ident/levenberg_marquardt.h"
+#include "core/ident/poly_predictor.h"
 
 #include <algorithm>
 #include <chrono>
@@ -156,87 +157,6 @@ Eigen::MatrixXd regressors(const std::vector<Block>& blocks, Eigen::Index first,
 }
 
 
-int criterionStart(const PolyOrders& o) {
-  return std::max({o.na, o.nb + o.nk - 1, o.nc, o.nd, o.nf});
-}
-
-bool isOne(const Poly& p) { return p.size() == 1 && p[0] == 1.0; }
-
-// Column `col` of psi = sign * x delayed by k samples (zeros shifted in).
-void setDelayed(Eigen::MatrixXd& psi, int col, const Eigen::VectorXd& x, int k, double sign) {
-  const Eigen::Index n = x.size(), len = std::max<Eigen::Index>(0, n - k);
-  psi.col(col).head(n - len).setZero();
-  psi.col(col).tail(len) = sign * x.head(len);
-}
-
-// The signals of the last evaluation without psi, so that the evaluation with psi at the
-// same parameters (the accepted step of the search) does not filter them again.
-struct ErrorCache {
-  Eigen::VectorXd theta, w, v, eps;  // eps before its first samples are zeroed
-};
-
-// psi (4.20) = -d eps / d theta for the general structure (4.8), obtained by filtering.
-void errorsAndPsi(const PolynomialModel& m, const Eigen::VectorXd& u, const Eigen::VectorXd& y,
-                  Eigen::VectorXd& eps, Eigen::MatrixXd* psi, bool skipStart = true,
-                  ErrorCache* cache = nullptr) {
-  const Poly one{1.0};
-  const auto& o = m.orders;
-  const bool white = isOne(m.c) && isOne(m.d);  // OE and ARX: no noise filter
-  Eigen::VectorXd w, v;
-  const Eigen::VectorXd theta = cache ? m.parameterVector() : Eigen::VectorXd();
-  if (cache && psi && cache->theta.size() == theta.size() && cache->theta == theta) {
-    w.swap(cache->w);
-    v.swap(cache->v);
-    eps.swap(cache->eps);
-    cache->theta.resize(0);
-  } else {
-    w = filter(m.b, m.f, u);
-    v = o.na ? filter(m.a, one, y) : y;
-    v -= w;
-    eps = white ? v : filter(m.d, m.c, v);
-    if (cache && !psi) {
-      cache->theta = theta;
-      cache->w = w;
-      cache->v = v;
-      cache->eps = eps;
-    }
-  }
-  // The criterion starts once every regressor holds data (as ARX does): the zero initial
-  // conditions would otherwise dominate the loss of a nearly noise-free system.
-  const Eigen::Index n0 =
-      skipStart ? std::min<Eigen::Index>(criterionStart(o), y.size()) : 0;
-  if (!psi) {
-    eps.head(n0).setZero();
-    return;
-  }
-  const Poly cf = polyMultiply(m.c, m.f);
-  psi->resize(y.size(), o.parameters());
-  int col = 0;
-  if (o.na) {
-    const Eigen::VectorXd yf = white ? y : filter(m.d, m.c, y);
-    for (int k = 1; k <= o.na; ++k) setDelayed(*psi, col++, yf, k, -1.0);
-  }
-  // B and F parts filter u and w through the same D/(C F).
-  Eigen::VectorXd uf, wf;
-  if (o.nf)
-    filter(m.d, cf, u, w, uf, wf);
-  else
-    uf = filter(m.d, cf, u);
-  for (int j = 0; j < o.nb; ++j) setDelayed(*psi, col++, uf, o.nk + j, 1.0);
-  if (o.nc) {
-    // eps before its first samples are left out of the criterion.
-    const Eigen::VectorXd ef = filter(one, m.c, eps);
-    for (int k = 1; k <= o.nc; ++k) setDelayed(*psi, col++, ef, k, 1.0);
-  }
-  if (o.nd) {
-    const Eigen::VectorXd vf = filter(one, m.c, v);
-    for (int k = 1; k <= o.nd; ++k) setDelayed(*psi, col++, vf, k, -1.0);
-  }
-  for (int k = 1; k <= o.nf; ++k) setDelayed(*psi, col++, wf, k, -1.0);
-  eps.head(n0).setZero();
-  psi->topRows(n0).setZero();
-}
-
 bool stabilize(PolynomialModel& m) {
   bool changed = false;
   changed |= reflectIntoUnitCircle(m.c);
@@ -335,10 +255,8 @@ PolynomialModel initialModel(const Eigen::VectorXd& u, const Eigen::VectorXd& y,
     if (a0.summary.ok()) {
       plain.a = a0.model.a;
       plain.b = a0.model.b;
-      Eigen::VectorXd em, ep;
-      errorsAndPsi(m, u, y, em, nullptr);
-      errorsAndPsi(plain, u, y, ep, nullptr);
-      const double lm = em.squaredNorm(), lp = ep.squaredNorm();
+      PolyPredictor predictor(u, y, o);
+      const double lm = predictor.run(m), lp = predictor.run(plain);
       if (!(lm <= lp)) return plain;
     }
     return m;
@@ -370,9 +288,7 @@ PolynomialModel initialModel(const Eigen::VectorXd& u, const Eigen::VectorXd& y,
 Eigen::VectorXd predictionErrors(const PolynomialModel& m, const Eigen::VectorXd& u,
                                  const Eigen::VectorXd& y) {
   checkData(u, y);
-  Eigen::VectorXd eps;
-  errorsAndPsi(m, u, y, eps, nullptr, false);
-  return eps;
+  return PolyPredictor(u, y, m.orders).errors(m);
 }
 
 PolyEstimate arx(const Eigen::VectorXd& u, const Eigen::VectorXd& y, int na, int nb, int nk,
@@ -450,11 +366,13 @@ PolyEstimate refinePolynomial(const Eigen::VectorXd& u, const Eigen::VectorXd& y
     return r;
   }
   PolynomialModel work = initial;
-  ErrorCache cache;
+  PolyPredictor predictor(u, y, initial.orders);
   LeastSquaresProblem problem;
-  problem.evaluate = [&](const Eigen::VectorXd& th, Eigen::VectorXd& eps, Eigen::MatrixXd* psi) {
+  problem.samples = n;
+  problem.normalEquations = [&](const Eigen::VectorXd& th, double bound, double& sumSquares,
+                                Eigen::MatrixXd* R, Eigen::VectorXd* g) {
     work.setParameterVector(th);
-    errorsAndPsi(work, u, y, eps, psi, true, &cache);
+    sumSquares = predictor.run(work, R, g, bound);
     return true;
   };
   if (options.enforceStability)
@@ -468,9 +386,9 @@ PolyEstimate refinePolynomial(const Eigen::VectorXd& u, const Eigen::VectorXd& y
   s = sol.summary;
   if (s.termination == Termination::Failed) return r;
   r.model.setParameterVector(sol.phi);
-  const Eigen::Index used = n - std::min<Eigen::Index>(criterionStart(initial.orders), n);
+  const Eigen::Index used = n - predictor.criterionStart();
   r.model.noiseVariance = sol.sumSquares / static_cast<double>(used - p);
-  r.model.covariance = gaussNewtonCovariance(sol.psi.bottomRows(used), sol.sumSquares);
+  r.model.covariance = gaussNewtonCovariance(sol.R, used, sol.sumSquares);
   if (r.model.covariance.size() == 0)
     s.message += "; the Hessian is singular, so no covariance (the model is over-parameterized)";
   fillStatistics(s, sol.sumSquares, used, p);
