@@ -1,5 +1,7 @@
 #include "core/ident/poly_predictor.h"
 
+#include "core/common/simd.h"
+
 #include <algorithm>
 #include <cstring>
 #include <stdexcept>
@@ -129,86 +131,56 @@ inline Run<N> iirRun(const Run<N>& s, const double* den, const double* den2, con
   return r;
 }
 
-// sums[k] += sum_{i < len} a[k][i] b[k][i] for k < count, every sum in four running parts
-// (samples 4m, 4m+1, 4m+2, 4m+3, in the lanes of vectors) added up as ((0 + 1) + (2 + 3))
-// with the tail after them: independent additions that need not wait for each other, and
-// the same result whether the lanes are two or four to a vector.
-typedef double Lanes2 __attribute__((vector_size(16)));
-
-inline Lanes2 load2(const double* p) {
-  Lanes2 v;
-  std::memcpy(&v, p, sizeof v);
-  return v;
-}
-
-template <int G>
-inline void addProducts2(const double* const* a, const double* const* b, Eigen::Index len,
-                         double* sums) {
-  Lanes2 lo[G], hi[G];
-  for (int k = 0; k < G; ++k) lo[k] = hi[k] = Lanes2{0.0, 0.0};
+// sums[k] += sum_{i < len} a[k][i] b[k][i] for G pairs, every sum in four running parts
+// (samples 4m, 4m+1, 4m+2, 4m+3, in the lanes of vectors V) added up as ((0 + 1) + (2 + 3))
+// with the tail after them: independent additions that need not wait for each other, and the
+// same result for two or four lanes to a vector.
+template <class V, int G>
+inline __attribute__((always_inline)) void addProducts(const double* const* a,
+                                                       const double* const* b, Eigen::Index len,
+                                                       double* sums) {
+  constexpr int L = simd::kLanes<V>, Q = 4 / L;
+  V acc[G][Q];
+  for (int k = 0; k < G; ++k)
+    for (int q = 0; q < Q; ++q) acc[k][q] = V{};
   Eigen::Index i = 0;
   for (; i + 4 <= len; i += 4)
-    for (int k = 0; k < G; ++k) {
-      lo[k] += load2(a[k] + i) * load2(b[k] + i);
-      hi[k] += load2(a[k] + i + 2) * load2(b[k] + i + 2);
-    }
+    for (int k = 0; k < G; ++k)
+      for (int q = 0; q < Q; ++q) {
+        V x, z;
+        simd::load(x, a[k] + i + q * L);
+        simd::load(z, b[k] + i + q * L);
+        acc[k][q] += x * z;
+      }
   for (int k = 0; k < G; ++k) {
+    double part[4];
+    for (int q = 0; q < Q; ++q) simd::store(part + q * L, acc[k][q]);
     double tail = 0.0;
     for (Eigen::Index j = i; j < len; ++j) tail += a[k][j] * b[k][j];
-    sums[k] += ((lo[k][0] + lo[k][1]) + (hi[k][0] + hi[k][1])) + tail;
+    sums[k] += ((part[0] + part[1]) + (part[2] + part[3])) + tail;
   }
 }
 
-void addProductsPortable(const double* const* a, const double* const* b, std::size_t count,
-                         Eigen::Index len, double* sums) {
+template <class V>
+inline __attribute__((always_inline)) void addProducts(const double* const* a,
+                                                       const double* const* b,
+                                                       std::size_t count, Eigen::Index len,
+                                                       double* sums) {
   std::size_t k = 0;
-  for (; k + 4 <= count; k += 4) addProducts2<4>(a + k, b + k, len, sums + k);
-  for (; k < count; ++k) addProducts2<1>(a + k, b + k, len, sums + k);
+  for (; k + 4 <= count; k += 4) addProducts<V, 4>(a + k, b + k, len, sums + k);
+  for (; k < count; ++k) addProducts<V, 1>(a + k, b + k, len, sums + k);
 }
 
-#if defined(__x86_64__) && defined(__GNUC__)
-// The same sums with four lanes to a vector, for processors with AVX2 (half the instructions).
-typedef double Lanes4 __attribute__((vector_size(32)));
-
-template <int G>
-__attribute__((target("avx2"), always_inline)) inline void addProducts4(
-    const double* const* a, const double* const* b, Eigen::Index len, double* sums) {
-  Lanes4 acc[G];
-  for (int k = 0; k < G; ++k) acc[k] = Lanes4{0.0, 0.0, 0.0, 0.0};
-  Eigen::Index i = 0;
-  for (; i + 4 <= len; i += 4)
-    for (int k = 0; k < G; ++k) {
-      Lanes4 x, y;
-      std::memcpy(&x, a[k] + i, sizeof x);
-      std::memcpy(&y, b[k] + i, sizeof y);
-      acc[k] += x * y;
-    }
-  for (int k = 0; k < G; ++k) {
-    double tail = 0.0;
-    for (Eigen::Index j = i; j < len; ++j) tail += a[k][j] * b[k][j];
-    sums[k] += ((acc[k][0] + acc[k][1]) + (acc[k][2] + acc[k][3])) + tail;
-  }
-}
-
-__attribute__((target("avx2"))) void addProductsAvx2(const double* const* a,
-                                                     const double* const* b, std::size_t count,
-                                                     Eigen::Index len, double* sums) {
-  std::size_t k = 0;
-  for (; k + 4 <= count; k += 4) addProducts4<4>(a + k, b + k, len, sums + k);
-  for (; k < count; ++k) addProducts4<1>(a + k, b + k, len, sums + k);
+FLEXARM_AVX2 void addProductsAvx2(const double* const* a, const double* const* b,
+                                  std::size_t count, Eigen::Index len, double* sums) {
+  addProducts<simd::Lanes4>(a, b, count, len, sums);
 }
 
 void addProducts(const double* const* a, const double* const* b, std::size_t count,
                  Eigen::Index len, double* sums) {
-  static const bool avx2 = __builtin_cpu_supports("avx2");
-  avx2 ? addProductsAvx2(a, b, count, len, sums) : addProductsPortable(a, b, count, len, sums);
+  if (simd::hasAvx2()) return addProductsAvx2(a, b, count, len, sums);
+  addProducts<simd::Lanes2>(a, b, count, len, sums);
 }
-#else
-void addProducts(const double* const* a, const double* const* b, std::size_t count,
-                 Eigen::Index len, double* sums) {
-  addProductsPortable(a, b, count, len, sums);
-}
-#endif
 
 // p from index `first` on, zero-padded to at least `size` entries (and at least two).
 std::vector<double> padded(const Poly& p, std::size_t first, std::size_t size) {
