@@ -1,16 +1,23 @@
 #include "core/io/log_io.h"
 
 #include <matio.h>
+#include <sys/mman.h>
+
+#include <Eigen/Core>
 
 #include <algorithm>
 #include <charconv>
+#include <climits>
 #include <cmath>
 #include <cstdio>
+#include <cstdint>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <numeric>
 #include <sstream>
 #include <system_error>
+#include <type_traits>
 #include <unistd.h>
 
 namespace flexarm {
@@ -463,10 +470,27 @@ LogReadResult readTable(const std::string& path, const LogReadOptions& options) 
 
 namespace {
 
-// Reads a real numeric vector variable from an open .mat file.
+// A vector of n doubles whose memory the kernel may back with huge pages: a channel of a
+// large log then costs a few page faults instead of thousands (most of reading a .mat file
+// that is already in the disk cache).
+template <class T>
+void sizeOnHugePages(std::vector<T>& v, std::size_t n) {
+  v.clear();
+  v.reserve(n);
+  constexpr std::uintptr_t kHuge = 2u << 20;
+  const auto b = (reinterpret_cast<std::uintptr_t>(v.data()) + kHuge - 1) & ~(kHuge - 1);
+  const auto e = (reinterpret_cast<std::uintptr_t>(v.data() + n)) & ~(kHuge - 1);
+  if (e > b) ::madvise(reinterpret_cast<void*>(b), e - b, MADV_HUGEPAGE);
+  v.resize(n);
+}
+
+// Reads a real numeric vector variable from an open .mat file. A variable whose doubles would take
+// more than maxBytes is refused before anything is allocated (matio believes the sizes a file
+// states).
 bool readMatVector(mat_t* mat, const std::string& path, const std::string& name,
-                   std::vector<double>& out, LogReadResult& fail, bool required) {
-  matvar_t* var = Mat_VarRead(mat, name.c_str());
+                   std::vector<double>& out, LogReadResult& fail, bool required,
+                   std::uint64_t maxBytes) {
+  matvar_t* var = Mat_VarReadInfo(mat, name.c_str());
   if (!var) {
     if (required) fail = failure(path, 0, 0, name, "the variable '" + name + "' is missing");
     return false;
@@ -476,30 +500,52 @@ bool readMatVector(mat_t* mat, const std::string& path, const std::string& name,
     ~Free() { Mat_VarFree(v); }
   } guard{var};
   if (var->isComplex || var->rank != 2 || (var->dims[0] != 1 && var->dims[1] != 1) ||
-      var->data == nullptr) {
+      var->dims[0] * var->dims[1] == 0) {
     fail = failure(path, 0, 0, name, "the variable must be a real vector");
     return false;
   }
   const std::size_t n = var->dims[0] * var->dims[1];
-  out.resize(n);
-  auto copy = [&](auto* p) {
-    for (std::size_t i = 0; i < n; ++i) out[i] = static_cast<double>(p[i]);
+  if (n > maxBytes / sizeof(double)) {
+    fail = failure(path, 0, 0, name,
+                   "the variable claims " + std::to_string(n) + " elements, more than the " +
+                       humanBytes(maxBytes) + " FlexArm reads at once");
+    return false;
+  }
+  // Read as the variable's class T (matio converts what the file stores to it): doubles
+  // straight into `out`, other classes through one buffer of their own.
+  const auto readAs = [&](auto zero) {
+    using T = decltype(zero);
+    constexpr bool direct = std::is_same_v<T, double>;
+    sizeOnHugePages(out, n);
+    std::vector<T> own(direct ? 0 : n);
+    void* into = direct ? static_cast<void*>(out.data()) : static_cast<void*>(own.data());
+    if (n > static_cast<std::size_t>(INT_MAX) ||
+        Mat_VarReadDataLinear(mat, var, into, 0, 1, static_cast<int>(n)) != 0) {
+      fail = failure(path, 0, 0, name, "the variable's data cannot be read (the file is damaged)");
+      return false;
+    }
+    if constexpr (!direct) std::copy(own.begin(), own.end(), out.begin());
+    return true;
   };
-  switch (var->data_type) {
-    case MAT_T_DOUBLE: copy(static_cast<const double*>(var->data)); break;
-    case MAT_T_SINGLE: copy(static_cast<const float*>(var->data)); break;
-    case MAT_T_INT32: copy(static_cast<const std::int32_t*>(var->data)); break;
-    case MAT_T_INT16: copy(static_cast<const std::int16_t*>(var->data)); break;
+  bool read = false;
+  switch (var->class_type) {
+    case MAT_C_DOUBLE: read = readAs(double{}); break;
+    case MAT_C_SINGLE: read = readAs(float{}); break;
+    case MAT_C_INT32: read = readAs(std::int32_t{}); break;
+    case MAT_C_INT16: read = readAs(std::int16_t{}); break;
     default:
       fail = failure(path, 0, 0, name, "the variable is not a numeric vector");
       return false;
   }
-  for (std::size_t i = 0; i < n; ++i)
-    if (!std::isfinite(out[i])) {
-      fail = failure(path, 0, 0, name,
-                     "element " + std::to_string(i + 1) + " is not a finite number");
-      return false;
-    }
+  if (!read) return false;
+  // x - x is 0 for a finite x and NaN otherwise: one vectorized sum finds any non-finite one.
+  const Eigen::Map<const Eigen::ArrayXd> x(out.data(), static_cast<Eigen::Index>(n));
+  if (!std::isfinite((x - x).sum())) {
+    const auto bad = std::find_if(out.begin(), out.end(), [](double v) { return !std::isfinite(v); });
+    fail = failure(path, 0, 0, name,
+                   "element " + std::to_string(bad - out.begin() + 1) + " is not a finite number");
+    return false;
+  }
   return true;
 }
 
@@ -543,8 +589,8 @@ LogReadResult readMat(const std::string& path, const LogReadOptions& options) {
 
   IdData data;
   std::vector<double> u, y, t;
-  if (!readMatVector(mat, path, uName, u, fail, true)) return fail;
-  if (!readMatVector(mat, path, yName, y, fail, true)) return fail;
+  if (!readMatVector(mat, path, uName, u, fail, true, options.maxFileBytes)) return fail;
+  if (!readMatVector(mat, path, yName, y, fail, true, options.maxFileBytes)) return fail;
   if (u.size() != y.size())
     return failure(path, 0, 0, yName,
                    "has " + std::to_string(y.size()) + " samples but '" + uName + "' has " +
@@ -552,11 +598,12 @@ LogReadResult readMat(const std::string& path, const LogReadOptions& options) {
   if (u.size() < 2) return failure(path, 0, 0, uName, "at least two samples are needed");
   data.sampleTime = options.sampleTime;
   if (has(columns::kTime)) {
-    if (!readMatVector(mat, path, columns::kTime, t, fail, true)) return fail;
+    if (!readMatVector(mat, path, columns::kTime, t, fail, true, options.maxFileBytes)) return fail;
     if (t.size() != u.size())
       return failure(path, 0, 0, columns::kTime, "has a different length than the signals");
-    std::vector<int> idx(t.size());
-    for (std::size_t i = 0; i < idx.size(); ++i) idx[i] = static_cast<int>(i + 1);
+    std::vector<int> idx;  // sample numbers, for the sentence of a failing check
+    sizeOnHugePages(idx, t.size());
+    std::iota(idx.begin(), idx.end(), 1);
     if (!checkTime(path, t, idx, 0, columns::kTime, options.maxSampleJitter, data, fail)) {
       fail.error.problem = "sample " + std::to_string(fail.error.line) + ": " + fail.error.problem;
       fail.error.line = 0;
@@ -573,7 +620,7 @@ LogReadResult readMat(const std::string& path, const LogReadOptions& options) {
     if (n == uName || n == yName || n == columns::kTime) continue;
     std::vector<double> v;
     LogReadResult ignore;
-    if (readMatVector(mat, path, n, v, ignore, false) && v.size() == data.samples())
+    if (readMatVector(mat, path, n, v, ignore, false, options.maxFileBytes) && v.size() == data.samples())
       push(n, std::move(v), n == columns::kAngleRef ? ChannelRole::Reference : ChannelRole::None);
   }
   if (data.channel(columns::kMotorVelocity) && uName == columns::kTorqueRef &&
