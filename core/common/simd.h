@@ -30,7 +30,10 @@ inline __attribute__((always_inline)) void store(double* p, const V& v) {
 #define FLEXARM_AVX2 __attribute__((target("avx2")))
 // True when the processor runs AVX2 code.
 inline bool hasAvx2() {
-  static const bool yes = __builtin_cpu_supports("avx2");
+  static const bool yes = [] {
+    __builtin_cpu_init();  // needed when called before the runtime's own initialisation
+    return __builtin_cpu_supports("avx2") != 0;
+  }();
   return yes;
 }
 #else

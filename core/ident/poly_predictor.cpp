@@ -324,7 +324,8 @@ void PolyPredictor::pass(const Coefficients& c, double* epsOut) {
           push(pyf, x);
         }
         if (doUf) {
-          const Run<N> x = iirRun<N, LCF>(monicRun<N, K>(D, u, t, c.ld), CF, CF2, puf, uf, t, c.lcf);
+          const Run<N> in = monicRun<N, K>(D, u, t, c.ld);
+          const Run<N> x = iirRun<N, LCF>(in, CF, CF2, puf, uf, t, c.lcf);
           store(uf, t, x);
           push(puf, x);
         }

@@ -541,7 +541,8 @@ bool readMatVector(mat_t* mat, const std::string& path, const std::string& name,
   // x - x is 0 for a finite x and NaN otherwise: one vectorized sum finds any non-finite one.
   const Eigen::Map<const Eigen::ArrayXd> x(out.data(), static_cast<Eigen::Index>(n));
   if (!std::isfinite((x - x).sum())) {
-    const auto bad = std::find_if(out.begin(), out.end(), [](double v) { return !std::isfinite(v); });
+    const auto bad =
+        std::find_if(out.begin(), out.end(), [](double v) { return !std::isfinite(v); });
     fail = failure(path, 0, 0, name,
                    "element " + std::to_string(bad - out.begin() + 1) + " is not a finite number");
     return false;
@@ -620,7 +621,8 @@ LogReadResult readMat(const std::string& path, const LogReadOptions& options) {
     if (n == uName || n == yName || n == columns::kTime) continue;
     std::vector<double> v;
     LogReadResult ignore;
-    if (readMatVector(mat, path, n, v, ignore, false, options.maxFileBytes) && v.size() == data.samples())
+    if (readMatVector(mat, path, n, v, ignore, false, options.maxFileBytes) &&
+        v.size() == data.samples())
       push(n, std::move(v), n == columns::kAngleRef ? ChannelRole::Reference : ChannelRole::None);
   }
   if (data.channel(columns::kMotorVelocity) && uName == columns::kTorqueRef &&
