@@ -7,8 +7,7 @@
 #include <cstdio>
 #include <stdexcept>
 
-#include <fftw3.h>
-
+#include "core/common/fft.h"
 #include "core/common/simd.h"
 
 namespace flexarm {
@@ -37,31 +36,10 @@ bool positiveOmega(const std::vector<double>& omega, std::string* why) {
 
 using Clock = std::chrono::steady_clock;
 
-// DFTs X(k) = sum_t x(t) e^{-i 2 pi k t / N}, k = 0..N/2, of u and y (scaling cancels in the
-// ratios), through one FFTW plan: its twiddle factors, most of the planner's cost, are made once.
-void spectra(const Eigen::VectorXd& u, const Eigen::VectorXd& y,
-             std::vector<std::complex<double>>& U, std::vector<std::complex<double>>& Y) {
-  const int n = static_cast<int>(u.size()), bins = n / 2 + 1;
-  double* in = fftw_alloc_real(static_cast<std::size_t>(n));
-  fftw_complex* out = fftw_alloc_complex(static_cast<std::size_t>(bins));
-  fftw_plan plan = fftw_plan_dft_r2c_1d(n, in, out, FFTW_ESTIMATE);
-  const auto transform = [&](const Eigen::VectorXd& x, std::vector<std::complex<double>>& X) {
-    std::copy(x.data(), x.data() + n, in);
-    fftw_execute(plan);
-    // fftw_complex is double[2], laid out as std::complex<double> (FFTW manual, 4.1.1).
-    const auto* c = reinterpret_cast<const std::complex<double>*>(out);
-    X.assign(c, c + bins);
-  };
-  transform(u, U);
-  transform(y, Y);
-  fftw_destroy_plan(plan);
-  fftw_free(in);
-  fftw_free(out);
-}
-
 // out[k] = sum_{j < taps} w[j] p[k + j] for k < n, each sum in the order of j: the smoothing
 // (4.25) of a whole spectrum at once (p holds taps - 1 more values than out), eight bins at a
-// time in the lanes of vectors V.
+// time in the lanes of vectors V. out may be p itself: a value is overwritten only after the
+// last sum that reads it.
 template <class V>
 inline __attribute__((always_inline)) void correlate(const double* p, const double* w, int taps,
                                                      double* out, int n) {
@@ -152,9 +130,11 @@ NonparametricEstimate etfe(const Eigen::VectorXd& u, const Eigen::VectorXd& y, d
   const auto t0 = Clock::now();
   NonparametricEstimate r;
   if (!checkSignals(u, y, ts, r, 8)) return r;
-  std::vector<std::complex<double>> U, Y;
-  spectra(u, y, U, Y);
   const int n = static_cast<int>(u.size());
+  // DFTs of u and y (4.24); their scaling cancels in the ratios.
+  std::vector<std::complex<double>> U(static_cast<std::size_t>(n / 2 + 1)), Y(U.size());
+  realDft(u.data(), n, U.data());
+  realDft(y.data(), n, Y.data());
   const int nb = n / 2;
   const double dw = 2.0 * M_PI / (n * ts);
   const int width = std::max(1, options.smoothingWidth);
@@ -179,11 +159,12 @@ NonparametricEstimate etfe(const Eigen::VectorXd& u, const Eigen::VectorXd& y, d
     std::vector<double> weight;
     for (int j = -pad; j <= pad; ++j)
       weight.push_back(0.5 * (1.0 + std::cos(M_PI * (static_cast<double>(j) / width))));
-    std::vector<double> num(static_cast<std::size_t>(nb)), numIm(num.size()), den(num.size());
+    // The smoothed spectra of bins 1..nb replace the raw ones in place, from index 1 on.
+    double *num = cross.data() + 1, *numIm = crossIm.data() + 1, *den = power.data() + 1;
     const int taps = static_cast<int>(weight.size());
-    correlate(cross.data() + 1, weight.data(), taps, num.data(), nb);
-    correlate(crossIm.data() + 1, weight.data(), taps, numIm.data(), nb);
-    correlate(power.data() + 1, weight.data(), taps, den.data(), nb);
+    correlate(num, weight.data(), taps, num, nb);
+    correlate(numIm, weight.data(), taps, numIm, nb);
+    correlate(den, weight.data(), taps, den, nb);
     response.omega.resize(static_cast<std::size_t>(nb));
     response.value.resize(response.omega.size());
     for (int k = 1; k <= nb; ++k) {

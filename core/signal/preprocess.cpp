@@ -1,11 +1,11 @@
 #include "core/signal/preprocess.h"
 
-#include <fftw3.h>
-
 #include <algorithm>
 #include <cmath>
 #include <complex>
 #include <stdexcept>
+
+#include "core/common/fft.h"
 
 namespace flexarm {
 namespace {
@@ -324,9 +324,8 @@ AmplitudeSpectrum amplitudeSpectrum(const std::vector<double>& x, double sampleT
   }
   const int bins = len / 2 + 1;
   std::vector<double> power(static_cast<std::size_t>(bins), 0.0);
-  double* in = fftw_alloc_real(static_cast<std::size_t>(len));
-  fftw_complex* out = fftw_alloc_complex(static_cast<std::size_t>(bins));
-  fftw_plan plan = fftw_plan_dft_r2c_1d(len, in, out, FFTW_ESTIMATE);
+  std::vector<double> in(static_cast<std::size_t>(len));
+  std::vector<std::complex<double>> out(static_cast<std::size_t>(bins));
   const int step = std::max(1, len / 2);
   int segments = 0;
   for (int start = 0; start + len <= n; start += step) {
@@ -334,14 +333,15 @@ AmplitudeSpectrum amplitudeSpectrum(const std::vector<double>& x, double sampleT
     for (int i = 0; i < len; ++i) mean += x[static_cast<std::size_t>(start + i)];
     mean /= len;
     for (int i = 0; i < len; ++i)
-      in[i] = (x[static_cast<std::size_t>(start + i)] - mean) * window[static_cast<std::size_t>(i)];
-    fftw_execute(plan);
-    for (int k = 0; k < bins; ++k) power[static_cast<std::size_t>(k)] += out[k][0] * out[k][0] + out[k][1] * out[k][1];
+      in[static_cast<std::size_t>(i)] =
+          (x[static_cast<std::size_t>(start + i)] - mean) * window[static_cast<std::size_t>(i)];
+    realDft(in.data(), len, out.data());
+    for (int k = 0; k < bins; ++k) {
+      const auto& X = out[static_cast<std::size_t>(k)];
+      power[static_cast<std::size_t>(k)] += X.real() * X.real() + X.imag() * X.imag();
+    }
     ++segments;
   }
-  fftw_destroy_plan(plan);
-  fftw_free(in);
-  fftw_free(out);
   s.frequencyHz.resize(static_cast<std::size_t>(bins));
   s.amplitude.resize(static_cast<std::size_t>(bins));
   for (int k = 0; k < bins; ++k) {
