@@ -1,7 +1,6 @@
 #include "core/io/log_io.h"
 
 #include <matio.h>
-#include <sys/mman.h>
 
 #include <Eigen/Core>
 
@@ -20,17 +19,15 @@
 #include <type_traits>
 #include <unistd.h>
 
+#include "core/io/csv_rows.h"
+#include "core/io/huge_pages.h"
+#include "core/io/text_lines.h"
+
 namespace flexarm {
 namespace {
 
 namespace fs = std::filesystem;
-
-std::string trim(std::string_view s) {
-  std::size_t b = 0, e = s.size();
-  while (b < e && (s[b] == ' ' || s[b] == '\t' || s[b] == '\r')) ++b;
-  while (e > b && (s[e - 1] == ' ' || s[e - 1] == '\t' || s[e - 1] == '\r')) --e;
-  return std::string(s.substr(b, e - b));
-}
+using namespace textio;
 
 std::string humanBytes(std::uint64_t n) {
   char buf[64];
@@ -51,9 +48,9 @@ LogReadResult failure(const std::string& file, int line, int column, std::string
   return r;
 }
 
-// Loads the whole file after checking that it exists, is a regular file and is not larger
-// than the limit. Returns false with the error filled otherwise.
-bool loadText(const std::string& path, std::uint64_t maxBytes, std::string& text,
+// Opens the file for reading line by line after checking that it exists, is a regular file
+// and is not larger than the limit. Returns false with the error filled otherwise.
+bool openText(const std::string& path, std::uint64_t maxBytes, LineReader& reader,
               LogReadResult& fail) {
   std::error_code ec;
   if (!fs::exists(path, ec)) {
@@ -76,96 +73,19 @@ bool loadText(const std::string& path, std::uint64_t maxBytes, std::string& text
                        " FlexArm reads at once; cut it into shorter logs or decimate it first");
     return false;
   }
-  std::ifstream in(path, std::ios::binary);
-  if (!in) {
+  if (!reader.open(path)) {
     fail = failure(path, 0, 0, {}, std::string("cannot open the file: ") + std::strerror(errno));
-    return false;
-  }
-  text.resize(size);
-  if (size > 0 && !in.read(text.data(), static_cast<std::streamsize>(size))) {
-    fail = failure(path, 0, 0, {}, "the file could not be read completely");
     return false;
   }
   return true;
 }
 
-// Iterates over the lines of a text buffer, counting them from 1.
-class LineCursor {
- public:
-  explicit LineCursor(const std::string& text) : text_(text) {}
-  bool next(std::string_view& line) {
-    if (pos_ >= text_.size()) return false;
-    std::size_t e = text_.find('\n', pos_);
-    if (e == std::string::npos) e = text_.size();
-    line = std::string_view(text_).substr(pos_, e - pos_);
-    if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
-    pos_ = e + 1;
-    ++number_;
-    return true;
-  }
-  int number() const { return number_; }
-
- private:
-  const std::string& text_;
-  std::size_t pos_ = 0;
-  int number_ = 0;
-};
-
-bool isBlank(std::string_view s) {
-  return std::all_of(s.begin(), s.end(), [](char c) { return c == ' ' || c == '\t'; });
-}
-
-enum class FieldStatus { Ok, Empty, NotNumber, NotFinite };
-
-FieldStatus parseNumber(std::string_view field, double& value) {
-  std::size_t b = 0, e = field.size();
-  while (b < e && (field[b] == ' ' || field[b] == '\t')) ++b;
-  while (e > b && (field[e - 1] == ' ' || field[e - 1] == '\t')) --e;
-  if (b == e) return FieldStatus::Empty;
-  const char* first = field.data() + b;
-  const char* last = field.data() + e;
-  if (*first == '+') ++first;  // from_chars does not accept a leading '+'
-  auto res = std::from_chars(first, last, value);
-  if (res.ec == std::errc::result_out_of_range) return FieldStatus::NotFinite;
-  if (res.ec != std::errc() || res.ptr != last) return FieldStatus::NotNumber;
-  if (!std::isfinite(value)) return FieldStatus::NotFinite;
-  return FieldStatus::Ok;
-}
-
-std::string fieldProblem(FieldStatus s, std::string_view field) {
-  switch (s) {
-    case FieldStatus::Empty: return "the field is empty";
-    case FieldStatus::NotNumber: return "'" + trim(field) + "' is not a number";
-    case FieldStatus::NotFinite: return "'" + trim(field) + "' is not a finite number";
-    case FieldStatus::Ok: break;
-  }
-  return {};
-}
-
-// Splits on the delimiter (',' for CSV) or on runs of blanks (delimiter 0).
-void splitFields(std::string_view line, char delimiter, std::vector<std::string_view>& out) {
-  out.clear();
-  if (delimiter) {
-    std::size_t start = 0;
-    for (;;) {
-      std::size_t p = line.find(delimiter, start);
-      if (p == std::string_view::npos) {
-        out.push_back(line.substr(start));
-        return;
-      }
-      out.push_back(line.substr(start, p - start));
-      start = p + 1;
-    }
-  }
-  std::size_t i = 0;
-  while (i < line.size()) {
-    while (i < line.size() && (line[i] == ' ' || line[i] == '\t')) ++i;
-    if (i >= line.size()) break;
-    std::size_t j = i;
-    while (j < line.size() && line[j] != ' ' && line[j] != '\t') ++j;
-    out.push_back(line.substr(i, j - i));
-    i = j;
-  }
+// Whether reading stopped on an error (then fail names it).
+bool readFailed(const std::string& path, const LineReader& reader, LogReadResult& fail) {
+  const std::string why = reader.error();
+  if (why.empty()) return false;
+  fail = failure(path, reader.number(), 0, {}, "the file could not be read completely: " + why);
+  return true;
 }
 
 // Checks that times increase and are uniformly spaced; fills sampleTime and startTime.
@@ -259,14 +179,12 @@ bool LogReadOptions::isValid(std::string* why) const {
 }
 
 LogReadResult readFlexArmCsv(const std::string& path, const LogReadOptions& options) {
-  std::string text;
+  LineReader cursor;
   LogReadResult fail;
-  if (!loadText(path, options.maxFileBytes, text, fail)) return fail;
-  if (text.empty() || isBlank(text) || text.find_first_not_of(" \t\r\n") == std::string::npos)
-    return failure(path, 1, 0, {}, "the file is empty");
+  if (!openText(path, options.maxFileBytes, cursor, fail)) return fail;
 
   IdData data;
-  LineCursor cursor(text);
+  bool empty = true;  // no line but blank ones so far
   std::string_view line;
   std::vector<std::string_view> fields;
   std::vector<std::string> header;
@@ -275,6 +193,7 @@ LogReadResult readFlexArmCsv(const std::string& path, const LogReadOptions& opti
   double declaredRate = 0.0;
   while (cursor.next(line)) {
     if (isBlank(line)) continue;
+    empty = false;
     std::string t = trim(line);
     if (t[0] == '#') {
       std::string body = trim(std::string_view(t).substr(1));
@@ -308,6 +227,8 @@ LogReadResult readFlexArmCsv(const std::string& path, const LogReadOptions& opti
     }
     break;
   }
+  if (readFailed(path, cursor, fail)) return fail;
+  if (empty) return failure(path, 1, 0, {}, "the file is empty");
   if (headerLine == 0) return failure(path, cursor.number(), 0, {}, "no header line: the file holds only comments");
   double probe = 0;
   if (parseNumber(header[0], probe) == FieldStatus::Ok)
@@ -322,29 +243,14 @@ LogReadResult readFlexArmCsv(const std::string& path, const LogReadOptions& opti
       static_cast<int>(std::find(header.begin(), header.end(), columns::kTime) - header.begin());
 
   const std::size_t nCols = header.size();
-  std::vector<std::vector<double>> cols(nCols);
-  const std::size_t estimate = text.size() / (nCols * 8 + 1) + 16;
-  for (auto& c : cols) c.reserve(estimate);
-  std::vector<int> lines;
-  lines.reserve(estimate);
-  while (cursor.next(line)) {
-    if (isBlank(line)) continue;
-    if (trim(line)[0] == '#') continue;
-    splitFields(line, ',', fields);
-    if (fields.size() != nCols)
-      return failure(path, cursor.number(), 0, {},
-                     "the line has " + std::to_string(fields.size()) + " fields, the header has " +
-                         std::to_string(nCols));
-    for (std::size_t i = 0; i < nCols; ++i) {
-      double v = 0;
-      FieldStatus s = parseNumber(fields[i], v);
-      if (s != FieldStatus::Ok)
-        return failure(path, cursor.number(), static_cast<int>(i + 1), header[i],
-                       fieldProblem(s, fields[i]));
-      cols[i].push_back(v);
-    }
-    lines.push_back(cursor.number());
-  }
+  CsvRows rows = readCsvRows(path, cursor, nCols);
+  if (!rows.ok)
+    return failure(path, rows.errorLine, rows.errorColumn,
+                   rows.errorColumn > 0 ? header[static_cast<std::size_t>(rows.errorColumn - 1)]
+                                        : std::string(),
+                   rows.problem);
+  auto& cols = rows.columns;
+  const auto& lines = rows.lines;
   if (lines.empty())
     return failure(path, headerLine, 0, {}, "the header is not followed by any data rows");
   if (lines.size() < 2)
@@ -382,13 +288,11 @@ LogReadResult readFlexArmCsv(const std::string& path, const LogReadOptions& opti
 LogReadResult readTable(const std::string& path, const LogReadOptions& options) {
   std::string why;
   if (!options.isValid(&why)) return failure(path, 0, 0, {}, "bad column mapping: " + why);
-  std::string text;
+  LineReader cursor;
   LogReadResult fail;
-  if (!loadText(path, options.maxFileBytes, text, fail)) return fail;
-  if (text.find_first_not_of(" \t\r\n") == std::string::npos)
-    return failure(path, 1, 0, {}, "the file is empty");
+  if (!openText(path, options.maxFileBytes, cursor, fail)) return fail;
 
-  LineCursor cursor(text);
+  bool empty = true;  // no line but blank ones so far
   std::string_view line;
   std::vector<std::string_view> fields;
   std::vector<std::vector<double>> cols;
@@ -397,6 +301,7 @@ LogReadResult readTable(const std::string& path, const LogReadOptions& options) 
   bool first = true;
   while (cursor.next(line)) {
     if (isBlank(line)) continue;
+    empty = false;
     std::string t = trim(line);
     if (t[0] == '#' || t[0] == '%') continue;
     if (first) delimiter = t.find(',') != std::string::npos ? ',' : 0;
@@ -434,6 +339,8 @@ LogReadResult readTable(const std::string& path, const LogReadOptions& options) 
     }
     lines.push_back(cursor.number());
   }
+  if (readFailed(path, cursor, fail)) return fail;
+  if (empty) return failure(path, 1, 0, {}, "the file is empty");
   if (lines.size() < 2) return failure(path, lines.empty() ? 1 : lines[0], 0, {},
                                        "at least two rows of numbers are needed");
   IdData data;
@@ -469,20 +376,6 @@ LogReadResult readTable(const std::string& path, const LogReadOptions& options) 
 }
 
 namespace {
-
-// A vector of n doubles whose memory the kernel may back with huge pages: a channel of a
-// large log then costs a few page faults instead of thousands (most of reading a .mat file
-// that is already in the disk cache).
-template <class T>
-void sizeOnHugePages(std::vector<T>& v, std::size_t n) {
-  v.clear();
-  v.reserve(n);
-  constexpr std::uintptr_t kHuge = 2u << 20;
-  const auto b = (reinterpret_cast<std::uintptr_t>(v.data()) + kHuge - 1) & ~(kHuge - 1);
-  const auto e = (reinterpret_cast<std::uintptr_t>(v.data() + n)) & ~(kHuge - 1);
-  if (e > b) ::madvise(reinterpret_cast<void*>(b), e - b, MADV_HUGEPAGE);
-  v.resize(n);
-}
 
 // Reads a real numeric vector variable from an open .mat file. A variable whose doubles would take
 // more than maxBytes is refused before anything is allocated (matio believes the sizes a file
