@@ -16,6 +16,7 @@
 #include <QLabel>
 #include <QMenuBar>
 #include <QMessageBox>
+#include <QScrollArea>
 #include <QMimeData>
 #include <QProgressDialog>
 #include <QSettings>
@@ -41,6 +42,7 @@
 #include "widgets/model_panel.h"
 #include "widgets/playhead.h"
 #include "widgets/preprocess_panel.h"
+#include "widgets/recursive_panel.h"
 #include "widgets/residuals_panel.h"
 #include "widgets/transport_bar.h"
 #include "widgets/workspace.h"
@@ -132,7 +134,11 @@ MainWindow::MainWindow(QWidget* parent)
   lqgDock_ = addPanel(lqgPanel_ = new LqgPanel(workspace_, this), tr("LQG"), "lqgDock",
                       "Ctrl+Shift+L", preprocessDock_);
   discoveryDock_ = addPanel(discoveryPanel_ = new DiscoveryPanel(workspace_, this), tr("Discovery"), "discoveryDock", "Ctrl+Shift+D", preprocessDock_);
+  recursiveDock_ = addPanel(recursivePanel_ = new RecursivePanel(workspace_, this), tr("Recursive"),
+                            "recursiveDock", "Ctrl+Shift+I", preprocessDock_);
   preprocessDock_->raise();
+  // A row of the time-stamp report shows its place in the Log panel.
+  connect(preprocessPanel_, &PreprocessPanel::timeSelected, logPanel_, &LogPanel::showAround);
   // The playhead spans the log as read (preprocessing keeps its times); every panel that
   // shows time follows it.
   connect(workspace_, &Workspace::logChanged, this, [this] {
@@ -147,6 +153,7 @@ MainWindow::MainWindow(QWidget* parent)
   comparePanel_->setPlayhead(playhead_);
   modelPanel_->setPlayhead(playhead_);
   discoveryPanel_->setPlayhead(playhead_);
+  recursivePanel_->setPlayhead(playhead_);
   transportBar_ = new TransportBar(playhead_, this);
   auto* transport = new QToolBar(tr("Playhead"), this);
   transport->setObjectName("transportToolBar");
@@ -242,7 +249,17 @@ QDockWidget* MainWindow::addPanel(QWidget* panel, const QString& title, const ch
                                   const QString& shortcut, QDockWidget* tabWith) {
   auto* dock = new QDockWidget(title, this);
   dock->setObjectName(objectName);
-  dock->setWidget(panel);
+  if (panel == armPanel_) {  // the 3D view fills its dock at any size
+    dock->setWidget(panel);
+  } else {
+    // Tall panels scroll in a short dock, so that the window fits a 1366x768 screen.
+    auto* scroll = new QScrollArea(dock);
+    scroll->setObjectName(QString(objectName) + "Scroll");
+    scroll->setWidget(panel);
+    scroll->setWidgetResizable(true);
+    scroll->setFrameShape(QFrame::NoFrame);
+    dock->setWidget(scroll);
+  }
   addDockWidget(Qt::RightDockWidgetArea, dock);
   if (tabWith) tabifyDockWidget(tabWith, dock);
   QAction* toggle = dock->toggleViewAction();
@@ -301,6 +318,10 @@ void MainWindow::onReadFinished() {
     return;
   }
   LogReadResult r = reader_.result();
+  if (!r.ok && r.irregularTime && !readingOptions_.keepIrregularTime) {
+    offerResampling(QString::fromStdString(r.error.toString()));
+    return;
+  }
   if (!r.ok) {
     const QString msg = QString::fromStdString(r.error.toString());
     statusBar()->showMessage(tr("Could not open %1").arg(readingPath_), 10000);
@@ -321,7 +342,33 @@ void MainWindow::onReadFinished() {
                                .arg(samples)
                                .arg(rate, 0, 'g', 6)
                                .arg(seconds, 0, 'f', 2));
+  if (!workspace_->raw()->isUniform()) {
+    statusBar()->showMessage(tr("Opened %1 with irregular time stamps: resample it in the Preprocess panel")
+                                 .arg(QFileInfo(readingPath_).fileName()));
+    preprocessDock_->show();
+    preprocessDock_->raise();
+  }
   emit logOpened(readingPath_);
+}
+
+void MainWindow::offerResampling(const QString& problem) {
+  // Reading stays strict: the log opens as recorded only when the engineer asks, and then
+  // waits for the explicit resampling step before any analysis.
+  auto* box = new QMessageBox(QMessageBox::Question, tr("Irregular time stamps"),
+                              tr("%1\n\nOpen the log as recorded and put it on a uniform grid in "
+                                 "the Preprocess panel?").arg(problem),
+                              QMessageBox::Open | QMessageBox::Cancel, this);
+  box->setObjectName("irregularTimeBox");
+  box->setAttribute(Qt::WA_DeleteOnClose);
+  const QString path = readingPath_;
+  LogReadOptions options = readingOptions_;
+  options.keepIrregularTime = true;
+  connect(box, &QMessageBox::finished, this, [this, path, options](int result) {
+    if (result == QMessageBox::Open) openFile(path, options);
+    else statusBar()->showMessage(tr("Opening %1 cancelled").arg(path), 5000);
+  });
+  statusBar()->showMessage(tr("%1 has irregular time stamps").arg(QFileInfo(path).fileName()), 10000);
+  box->open();
 }
 
 void MainWindow::showError(const QString& title, const QString& message) {
@@ -333,8 +380,10 @@ void MainWindow::showError(const QString& title, const QString& message) {
 }
 
 void MainWindow::exportData() {
-  if (!workspace_->hasLog()) {
-    statusBar()->showMessage(tr("Nothing to export: open a log first"), 5000);
+  if (!workspace_->current()) {
+    statusBar()->showMessage(workspace_->needsResampling()
+                                 ? tr("Nothing to export: resample the log in the Preprocess panel first")
+                                 : tr("Nothing to export: open a log first"), 5000);
     return;
   }
   QSettings settings;

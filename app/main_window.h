@@ -26,6 +26,7 @@ class LqgPanel;
 class ModelPanel;
 class Playhead;
 class PreprocessPanel;
+class RecursivePanel;
 class TransportBar;
 class ResidualsPanel;
 class SessionController;
@@ -55,6 +56,8 @@ class MainWindow : public QMainWindow {
   LqgPanel* lqgPanel() const { return lqgPanel_; }
   SessionController* sessionController() const { return session_; }
   DiscoveryPanel* discoveryPanel() const { return discoveryPanel_; }
+  RecursivePanel* recursivePanel() const { return recursivePanel_; }
+  QDockWidget* recursiveDock() const { return recursiveDock_; }
   QStringList recentFiles() const;
   Playhead* playhead() const { return playhead_; }
   TransportBar* transportBar() const { return transportBar_; }
@@ -81,6 +84,8 @@ class MainWindow : public QMainWindow {
   void rebuildRecentMenu();
   void onReadFinished();
   void showError(const QString& title, const QString& message);
+  // The log was refused for its time stamps alone: asks whether to open it for resampling.
+  void offerResampling(const QString& problem);
 
   Workspace* workspace_;
   Playhead* playhead_;
@@ -105,6 +110,8 @@ class MainWindow : public QMainWindow {
   QDockWidget* lqgDock_ = nullptr;
   SessionController* session_ = nullptr;
   QDockWidget* discoveryDock_ = nullptr;
+  RecursivePanel* recursivePanel_ = nullptr;
+  QDockWidget* recursiveDock_ = nullptr;
   QMenu* recentMenu_ = nullptr;
   QMenu* viewMenu_ = nullptr;
   QFutureWatcher<LogReadResult> reader_;

@@ -8,9 +8,11 @@
 #include "core/session/fit_request.h"
 #include "core/session/lqg_part.h"
 #include "core/session/model_json.h"
+#include "core/session/recursive_part.h"
 #include "widgets/discovery_panel.h"
 #include "widgets/lqg_panel.h"
 #include "widgets/model_panel.h"
+#include "widgets/recursive_panel.h"
 #include "widgets/workspace.h"
 
 namespace flexarm {
@@ -154,6 +156,40 @@ void resetLqg(MainWindow& w) {
   if (w.lqgPanel()) w.lqgPanel()->setDesign(LqgOptions::seedCaseI(), 0.0, w.lqgPanel()->tableSourceText());
 }
 
+// The Recursive panel's runs (the overlaid previous one and the current one): each request
+// with the summary of its result when it ran to the end. Opening a session sets the panel's
+// controls from the last request and runs nothing; the runs are kept as read until the panel
+// makes a run of its own.
+constexpr const char* kKeptRecursive = "flexarmKeptRecursive";
+
+json captureRecursive(const MainWindow& w) {
+  const RecursivePanel* panel = w.recursivePanel();
+  json runs = json::array();
+  if (panel)
+    for (const auto* run : panel->runs()) {
+      json entry = {{"request", recursiveRequestToJson(run->request)}};
+      if (run->result) entry["result"] = recursiveResultToJson(*run->result);
+      runs.push_back(entry);
+    }
+  if (!runs.empty()) return {{"runs", runs}};
+  const QByteArray kept = w.property(kKeptRecursive).toByteArray();
+  return kept.isEmpty() ? json(nullptr) : json::parse(kept.toStdString(), nullptr, false);
+}
+
+void resetRecursive(MainWindow& w) {
+  w.setProperty(kKeptRecursive, QByteArray());
+  if (w.recursivePanel()) w.recursivePanel()->clearRuns();
+}
+
+void restoreRecursive(const json& section, MainWindow& w) {
+  resetRecursive(w);
+  w.setProperty(kKeptRecursive, QByteArray::fromStdString(section.dump()));
+  std::string why;
+  if (!section["runs"].empty() && w.recursivePanel())
+    if (auto q = recursiveRequestFromJson(section["runs"].back()["request"], &why))
+      w.recursivePanel()->setRequest(*q);
+}
+
 json captureView(const MainWindow& w) {
   return {{"window_state", w.saveState().toBase64().toStdString()},
           {"selected_model", w.modelPanel() ? w.modelPanel()->currentIndex() : -1}};
@@ -175,6 +211,7 @@ const std::vector<WindowSessionPart>& windowSessionParts() {
       {"fits", &captureFits, &restoreFits},
       {"discovery", &captureDiscovery, &restoreDiscovery, &resetDiscovery},
       {"lqg", &captureLqg, &restoreLqg, &resetLqg},
+      {"recursive", &captureRecursive, &restoreRecursive, &resetRecursive},
       {"view", &captureView, &restoreView},
   };
   return kParts;

@@ -152,6 +152,21 @@ inline std::vector<Json> runPeer(const std::string& command, std::string* why = 
   return out;
 }
 
+// Runs a command and returns its standard output; *ok tells whether it exited with 0.
+inline std::string capture(const std::string& command, bool* ok) {
+  std::string out;
+  FILE* p = popen(command.c_str(), "r");
+  if (!p) {
+    *ok = false;
+    return out;
+  }
+  char buf[65536];
+  std::size_t got;
+  while ((got = std::fread(buf, 1, sizeof buf, p)) > 0) out.append(buf, got);
+  *ok = pclose(p) == 0;
+  return out;
+}
+
 // The first object of a peer's output whose "name" is `name` (null when absent).
 inline Json peerResult(const std::vector<Json>& results, const std::string& name) {
   for (const auto& r : results)

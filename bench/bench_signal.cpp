@@ -2,7 +2,10 @@
 // (16x: ten minutes): motor velocity by central differences against numpy.gradient, and
 // decimation by ten of the three channels (linear-phase FIR, zero phase) against
 // scipy.signal.decimate (FIR, zero_phase) and Octave's decimate (signal package, FIR).
-// Agreement: the derivative to rounding; the decimated signals within the filters' difference
+// On the ten-minute log, rate changes by rational factors (the resampling step: 2000 -> 1500,
+// 2000 -> 250 and, of the same numbers taken as a 1 kHz log, 1000 -> 2000 Hz) against
+// scipy.signal.resample_poly.
+// Agreement: the derivative to rounding; the resampled signals within the filters' difference
 // (the peers' FIRs are shorter and have less stopband attenuation), as RMS of the difference
 // relative to the RMS of the signal.
 #include <fstream>
@@ -10,6 +13,7 @@
 #include "bench_common.h"
 #include "bench_data.h"
 #include "core/signal/preprocess.h"
+#include "core/signal/uniform_grid.h"
 
 using namespace flexarm;
 using namespace flexarm::bench;
@@ -37,22 +41,27 @@ std::vector<double> readRaw(const std::string& path) {
 }
 
 // Largest over channels of RMS(mine - theirs) / RMS(mine), ignoring `skip` samples at each
-// end (where the peers' edge handling differs); theirs holds the channels one after another.
+// end (where the peers' edge handling differs); theirs holds the channels one after another,
+// each as long as mine or (a grid that ends one sample later or earlier) one sample longer
+// or shorter.
 double relativeRms(const std::vector<std::vector<double>>& mine, const std::vector<double>& theirs,
                    std::size_t skip) {
+  if (mine.empty() || theirs.size() % mine.size() != 0) return INFINITY;
+  const std::size_t each = theirs.size() / mine.size();
   double worst = 0.0;
   std::size_t at = 0;
   for (const auto& m : mine) {
-    if (at + m.size() > theirs.size()) return INFINITY;
+    if (each + 1 < m.size() || m.size() + 1 < each) return INFINITY;
+    const std::size_t n = std::min(m.size(), each);
     double d2 = 0.0, s2 = 0.0;
-    for (std::size_t i = skip; i + skip < m.size(); ++i) {
+    for (std::size_t i = skip; i + skip < n; ++i) {
       d2 += (m[i] - theirs[at + i]) * (m[i] - theirs[at + i]);
       s2 += m[i] * m[i];
     }
     worst = std::max(worst, std::sqrt(d2 / std::max(s2, 1e-300)));
-    at += m.size();
+    at += each;
   }
-  return at == theirs.size() ? worst : INFINITY;
+  return worst;
 }
 
 std::string percent(const std::string& what, double rel) {
@@ -60,6 +69,51 @@ std::string percent(const std::string& what, double rel) {
   s.precision(2);
   s << what << " " << 100.0 * rel << " % of RMS";
   return s.str();
+}
+
+std::vector<std::vector<double>> channelsOf(const IdData& d) {
+  std::vector<std::vector<double>> out;
+  for (const char* name : kChannels) out.push_back(d.channel(name)->values);
+  return out;
+}
+
+// The ten-minute log (or the same numbers taken at another rate) to a new rate through the
+// resampling step, against scipy.signal.resample_poly with the same factors.
+void resampleRow(const TempDir& dir, const IdData& log, const std::string& raw, double fromHz, double toHz,
+                 int up, int down, int reps) {
+  IdData in = log;
+  in.sampleTime = 1.0 / fromHz;
+  UniformGridOptions o;
+  o.rateHz = toHz;
+  UniformGridResult res;
+  Row r;
+  r.group = "preprocess";
+  r.task = "resample " + std::to_string(static_cast<int>(fromHz)) + " -> " + std::to_string(static_cast<int>(toHz)) + " Hz";
+  r.size = std::to_string(in.samples() / 1000) + "k samples x 3";
+  r.flexarmSeconds = medianSeconds(reps, [&] { res = resampleToUniform(in, o); }, true);
+  r.peer = "scipy.signal.resample_poly";
+  if (res.termination != Termination::Converged) {
+    r.extra["note"] = res.message;
+    emit(r);
+    return;
+  }
+  std::string why;
+  const std::string out = dir.file("resampled.f64");
+  const auto peer = runPeer(python("peer_signal.py", "resample " + raw + " " + out + " " + std::to_string(reps) + " " +
+                                                         std::to_string(in.samples()) + " " + std::to_string(up) +
+                                                         " " + std::to_string(down)),
+                            &why);
+  if (!peer.empty()) {
+    r.peerSeconds = peer[0]["seconds"].get<double>();
+    // Within 0.5 % of the RMS away from the ends: FlexArm's FIR passes to 0.8 of the lower
+    // Nyquist frequency within 1e-4 and stops 80 dB; SciPy's (Kaiser, beta 5) is shorter.
+    const double rel = relativeRms(channelsOf(res.data), readRaw(out), 2000);
+    r.agree = rel < 5e-3;
+    r.agreement = percent("values (up " + std::to_string(up) + ", down " + std::to_string(down) + "): differ by", rel);
+  } else {
+    r.extra["note"] = why;
+  }
+  emit(r);
 }
 
 }  // namespace
@@ -105,8 +159,7 @@ int main() {
     o.factor = factor;
     IdData dec;
     const double tDec = medianSeconds(reps, [&] { dec = decimate(log, o); });
-    std::vector<std::vector<double>> mine;
-    for (const char* name : kChannels) mine.push_back(dec.channel(name)->values);
+    const std::vector<std::vector<double>> mine = channelsOf(dec);
     const std::string out = dir.file("dec.f64");
     for (const bool octavePeer : {false, true}) {
       Row r;
@@ -133,6 +186,11 @@ int main() {
         r.extra["note"] = why;
       }
       emit(r);
+    }
+    if (scale == 16) {
+      resampleRow(dir, log, raw, 2000.0, 1500.0, 3, 4, reps);
+      resampleRow(dir, log, raw, 2000.0, 250.0, 1, 8, reps);
+      resampleRow(dir, log, raw, 1000.0, 2000.0, 2, 1, reps);
     }
   }
   return 0;

@@ -13,21 +13,6 @@ using namespace flexarm::bench;
 
 namespace {
 
-// Runs a command and returns its standard output (empty on failure).
-std::string capture(const std::string& command, bool* ok) {
-  std::string out;
-  FILE* p = popen(command.c_str(), "r");
-  if (!p) {
-    *ok = false;
-    return out;
-  }
-  char buf[65536];
-  std::size_t got;
-  while ((got = std::fread(buf, 1, sizeof buf, p)) > 0) out.append(buf, got);
-  *ok = pclose(p) == 0;
-  return out;
-}
-
 double logSeconds(const std::string& path) {
   const LogReadResult r = readLog(path);
   return r.ok ? r.data.duration() : 0.0;

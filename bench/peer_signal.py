@@ -4,6 +4,8 @@ Usage: peer_signal.py gradient IN OUT REPEATS N
          numpy.gradient (second order inside and at the ends) of the second channel
        peer_signal.py decimate IN OUT REPEATS N FACTOR
          scipy.signal.decimate(ftype="fir", zero_phase=True) of each channel
+       peer_signal.py resample IN OUT REPEATS N UP DOWN
+         scipy.signal.resample_poly(up, down) of each channel
 Writes the result to OUT (raw float64) and prints {"name", "seconds"}."""
 import sys
 
@@ -19,6 +21,10 @@ def main():
     if mode == "gradient":
         angle = x[1]
         sec, out = median_seconds(repeats, lambda: np.gradient(angle, 0.0005, edge_order=2))
+    elif mode == "resample":
+        up, down = int(sys.argv[6]), int(sys.argv[7])
+        sec, out = median_seconds(repeats, lambda: np.concatenate(
+            [signal.resample_poly(c, up, down) for c in x]))
     else:
         q = int(sys.argv[6])
         sec, out = median_seconds(repeats, lambda: np.concatenate(

@@ -1,86 +1,560 @@
 #include "widgets/arm_panel.h"
 
+#include <QCheckBox>
+#include <QComboBox>
+#include <QDialog>
+#include <QDialogButtonBox>
+#include <QDoubleSpinBox>
+#include <QFileDialog>
+#include <QFormLayout>
 #include <QHBoxLayout>
 #include <QLabel>
+#include <QLineEdit>
+#include <QMenu>
+#include <QMessageBox>
+#include <QPointer>
+#include <QProgressBar>
+#include <QPushButton>
+#include <QSettings>
 #include <QSpinBox>
+#include <QToolButton>
 #include <QVBoxLayout>
+#include <QtConcurrent>
+#include <algorithm>
 #include <cmath>
 
 #include "widgets/arm/arm_scene.h"
+#include "widgets/arm/frame_exporter.h"
 #include "widgets/arm/vtk_view.h"
 #include "widgets/playhead.h"
 
 namespace flexarm {
+namespace {
+
+constexpr int kLogSource = -1, kExternalSource = -2;
+constexpr int kTracePoints = 400;
+constexpr double kTraceSeconds = 1.0;
+// Auto scales: the log's largest motion about axis one is drawn at about this angle, and the
+// largest deflection at about that one (radians).
+constexpr double kMotionDrawn = 0.6, kDeflectionDrawn = 0.5;
+
+// A deflection in milliradians with four decimals, without the "-0.0000" of a tiny negative.
+QString mrad(double rad) { return QString::number(std::round(1e7 * rad) / 1e4 + 0.0, 'f', 4); }
+
+// The largest of 1, 2, 5 times a power of ten that is at most x, clamped to [lo, hi].
+int niceDown(double x, int lo, int hi) {
+  if (!(x > 0) || !std::isfinite(x)) return lo;
+  const double p = std::pow(10.0, std::floor(std::log10(x)));
+  const double m = x / p;
+  const double nice = (m >= 5 ? 5 : m >= 2 ? 2 : 1) * p;
+  return static_cast<int>(std::clamp(nice, static_cast<double>(lo), static_cast<double>(hi)));
+}
+
+double gearRatioOf(const IdData& d) {
+  const std::string r = d.meta("gear_ratio");
+  const double v = r.empty() ? 1.0 / 118.0 : std::atof(r.c_str());
+  return v > 0 && std::isfinite(v) ? v : 1.0 / 118.0;
+}
+
+}  // namespace
 
 ArmPanel::ArmPanel(Workspace* workspace, QWidget* parent)
     : QWidget(parent), workspace_(workspace), scene_(std::make_unique<ArmScene>()),
-      view_(new VtkView(this)), magnify_(new QSpinBox(this)), label_(new QLabel(this)) {
+      view_(new VtkView(this)), source_(new QComboBox(this)),
+      measured_(new QCheckBox(tr("measured motor angle"), this)), magnify_(new QSpinBox(this)),
+      exaggerate_(new QSpinBox(this)), ghost_(new QCheckBox(tr("Rigid ghost"), this)),
+      trace_(new QCheckBox(tr("Tip trace"), this)), export_(new QToolButton(this)),
+      progress_(new QProgressBar(this)), cancel_(new QToolButton(this)),
+      label_(new QLabel(this)) {
   setObjectName("armPanel");
   view_->setObjectName("armView");
   view_->setRenderer(scene_->renderer());
   view_->setResetCamera([this] { scene_->resetCamera(); });
+  overlay_.colour = [this](double deflection) {
+    double rgb[3];
+    scene_->deflectionColor(deflection, rgb);
+    return QColor::fromRgbF(static_cast<float>(rgb[0]), static_cast<float>(rgb[1]),
+                            static_cast<float>(rgb[2]));
+  };
+  view_->setOverlay([this](QPainter& p, const QRect& area) { paintArmOverlay(p, area, overlay_); });
+  source_->setObjectName("armSourceCombo");
+  source_->setToolTip(tr("Where the angles come from: the log's motor angle through the gear "
+                         "(rigid), or a model of the list simulated on the log's torque"));
+  source_->setSizeAdjustPolicy(QComboBox::AdjustToMinimumContentsLengthWithIcon);
+  source_->setMinimumContentsLength(14);
+  measured_->setObjectName("armMeasuredAngle");
+  measured_->setChecked(true);
+  measured_->setToolTip(tr("Turn the bodies about the log's measured motor angle and add the "
+                           "simulated deflections (an open-loop simulation of a closed-loop "
+                           "log drifts in angle, not in deflection); off: all simulated"));
+  magnify_->setObjectName("armMagnify");
   magnify_->setRange(1, 100000);
-  magnify_->setValue(100);
-  magnify_->setPrefix(QString::fromUtf8("\u00d7"));
-  magnify_->setToolTip(tr("Magnification of the arm motion (the gear turns the arm 1/118 of "
-                          "the motor angle)"));
+  magnify_->setPrefix(tr("motion ") + QString::fromUtf8("\u00d7"));
+  magnify_->setToolTip(tr("Magnification of the motion about axis one (the gear turns the arm "
+                          "1/118 of the motor angle)"));
+  exaggerate_->setObjectName("armExaggeration");
+  exaggerate_->setRange(0, 1000000);
+  exaggerate_->setPrefix(tr("deflection ") + QString::fromUtf8("\u00d7"));
+  exaggerate_->setToolTip(tr("Exaggeration of the spring deflections (fractions of a "
+                             "milliradian): a body is drawn this many times its deflection "
+                             "behind the one before it"));
+  ghost_->setObjectName("armGhost");
+  ghost_->setChecked(true);
+  trace_->setObjectName("armTrace");
+  trace_->setChecked(true);
+  trace_->setToolTip(tr("Where the tool tip was over the last second (time runs downwards), "
+                        "beside the rigid ghost's tip"));
+  export_->setObjectName("armExport");
+  export_->setText(tr("Export"));
+  export_->setPopupMode(QToolButton::InstantPopup);
+  auto* menu = new QMenu(export_);
+  menu->addAction(tr("Save still..."), this, &ArmPanel::saveStill);
+  menu->addAction(tr("Export frames (PNG + ffmpeg)..."), this, &ArmPanel::askExportFrames);
+  export_->setMenu(menu);
+  progress_->setObjectName("armProgress");
+  progress_->setRange(0, 1000);
+  progress_->setMaximumHeight(14);
+  progress_->setVisible(false);
+  cancel_->setText(tr("Cancel"));
+  cancel_->setVisible(false);
   label_->setObjectName("armLabel");
+  label_->setWordWrap(true);
+
+  auto* top = new QHBoxLayout;
+  top->addWidget(new QLabel(tr("Angles"), this));
+  top->addWidget(source_, 1);
+  top->addWidget(measured_);
   auto* controls = new QHBoxLayout;
-  controls->addWidget(label_, 1);
   controls->addWidget(magnify_);
+  controls->addWidget(exaggerate_);
+  controls->addWidget(ghost_);
+  controls->addWidget(trace_);
+  controls->addStretch(1);
+  controls->addWidget(export_);
+  auto* busy = new QHBoxLayout;
+  busy->addWidget(progress_, 1);
+  busy->addWidget(cancel_);
   auto* layout = new QVBoxLayout(this);
   layout->setContentsMargins(2, 2, 2, 2);
+  layout->addLayout(top);
   layout->addWidget(view_, 1);
   layout->addLayout(controls);
-  connect(magnify_, QOverload<int>::of(&QSpinBox::valueChanged), this, [this] {
-    showTime(playhead_ ? playhead_->time() : 0.0);
+  layout->addLayout(busy);
+  layout->addWidget(label_);
+
+  connect(source_, QOverload<int>::of(&QComboBox::currentIndexChanged), this, [this] {
+    if (!filling_) onSourceChanged();
   });
-  connect(workspace_, &Workspace::currentChanged, this, &ArmPanel::onDataChanged);
-  onDataChanged();
+  connect(measured_, &QCheckBox::toggled, this, &ArmPanel::onSourceChanged);
+  connect(magnify_, QOverload<int>::of(&QSpinBox::valueChanged), this, [this](int m) {
+    scene_->setMagnification(m);
+    updateCaption();
+    redraw();
+  });
+  connect(exaggerate_, QOverload<int>::of(&QSpinBox::valueChanged), this, [this](int e) {
+    scene_->setExaggeration(e);
+    updateCaption();
+    redraw();
+  });
+  connect(ghost_, &QCheckBox::toggled, this, &ArmPanel::setGhostVisible);
+  connect(trace_, &QCheckBox::toggled, this, &ArmPanel::setTraceVisible);
+  connect(cancel_, &QToolButton::clicked, this, [this] {
+    if (cancelFlag_) cancelFlag_->store(true);
+  });
+  connect(&watcher_, &QFutureWatcher<BodyAngles>::finished, this, &ArmPanel::onSimulated);
+  connect(workspace_, &Workspace::logChanged, this, &ArmPanel::onLogChanged);
+  connect(workspace_, &Workspace::modelsChanged, this, [this](int index) {
+    const int shown = source_->currentData().toInt();
+    refillSources();
+    if (index < 0 || index == shown) onSourceChanged();  // the model shown was edited
+  });
+  scene_->setMagnification(magnify_->value());
+  refillSources();
+  onLogChanged();
 }
 
-ArmPanel::~ArmPanel() = default;
+ArmPanel::~ArmPanel() {
+  if (cancelFlag_) cancelFlag_->store(true);
+  watcher_.waitForFinished();
+}
 
 void ArmPanel::setPlayhead(Playhead* playhead) {
   if (playhead_) disconnect(playhead_, nullptr, this, nullptr);
   playhead_ = playhead;
   if (playhead_) connect(playhead_, &Playhead::timeChanged, this, &ArmPanel::showTime);
-  onDataChanged();
+  redraw();
 }
 
 QString ArmPanel::labelText() const { return label_->text(); }
 
-void ArmPanel::onDataChanged() {
-  const IdData* d = workspace_->raw();
-  const bool usable = d && d->channel(columns::kMotorAngle);
-  if (!usable) {
-    label_->setText(d ? tr("The data have no motor_angle_rad channel to move the arm")
-                      : tr("Drag to rotate, wheel to zoom, double click to reset"));
-    scene_->setPose(0, 0);
-    view_->update();
-    return;
-  }
-  const std::string r = d->meta("gear_ratio");
-  gearRatio_ = r.empty() ? 1.0 / 118.0 : std::atof(r.c_str());
-  if (!(gearRatio_ > 0 && std::isfinite(gearRatio_))) gearRatio_ = 1.0 / 118.0;
-  showTime(playhead_ ? playhead_->time() : d->startTime);
+int ArmPanel::magnification() const { return magnify_->value(); }
+int ArmPanel::exaggeration() const { return exaggerate_->value(); }
+void ArmPanel::setMagnification(int m) { magnify_->setValue(m); }
+void ArmPanel::setExaggeration(int e) { exaggerate_->setValue(e); }
+
+void ArmPanel::setGhostVisible(bool on) {
+  if (ghost_->isChecked() != on) ghost_->setChecked(on);  // comes back here
+  scene_->setGhostVisible(on && angles_ != nullptr);
+  redraw();
 }
 
-void ArmPanel::showTime(double t) {
+void ArmPanel::setAnnotationsVisible(bool on) {
+  overlay_.visible = on;
+  view_->requestOverlay();
+}
+
+void ArmPanel::setTraceVisible(bool on) {
+  if (trace_->isChecked() != on) trace_->setChecked(on);
+  if (!on) scene_->setTrace({});
+  redraw();
+}
+
+void ArmPanel::refillSources() {
+  filling_ = true;
+  const int was = source_->currentData().toInt();
+  const QString wasName = source_->currentText();
+  source_->clear();
+  source_->addItem(tr("Log: motor angle, rigid"), kLogSource);
+  const auto& models = workspace_->models();
+  for (std::size_t i = 0; i < models.size(); ++i)
+    if (models[i].model)
+      source_->addItem((models[i].fitRequest ? tr("Fit: %1") : tr("Model: %1")).arg(models[i].name),
+                       static_cast<int>(i));
+  if (external_) source_->addItem(external_->name, kExternalSource);
+  int at = source_->findText(wasName);
+  if (at < 0) at = source_->findData(was);
+  source_->setCurrentIndex(std::max(0, at));
+  filling_ = false;
+}
+
+bool ArmPanel::selectModel(int index) { return selectSource(index < 0 ? kLogSource : index); }
+
+bool ArmPanel::selectSource(int data) {
+  const int at = source_->findData(data);
+  if (at < 0) return false;
+  if (source_->currentIndex() == at) onSourceChanged();  // recompute on request
+  else source_->setCurrentIndex(at);
+  return true;
+}
+
+void ArmPanel::setExternalModel(const QString& name, std::shared_ptr<const PhysicalModel> model,
+                                std::vector<Effect> effects) {
+  if (!model) {
+    clearExternalModel();
+    return;
+  }
+  external_ = External{name, std::move(model), std::move(effects)};
+  refillSources();
+  selectSource(kExternalSource);
+}
+
+void ArmPanel::clearExternalModel() {
+  if (!external_) return;
+  const bool shown = source_->currentData().toInt() == kExternalSource;
+  external_.reset();
+  refillSources();
+  if (shown) onSourceChanged();
+}
+
+void ArmPanel::onLogChanged() {
+  const IdData* d = workspace_->raw();
+  gearRatio_ = d ? gearRatioOf(*d) : 1.0 / 118.0;
+  measured_->setEnabled(d && d->channel(columns::kMotorAngle));
+  // Auto magnification: the log's largest motion about axis one drawn at about 35 degrees.
+  if (const Channel* angle = d ? d->channel(columns::kMotorAngle) : nullptr) {
+    const auto [lo, hi] = std::minmax_element(angle->values.begin(), angle->values.end());
+    magnify_->setValue(niceDown(kMotionDrawn / (gearRatio_ * std::max(1e-12, *hi - *lo)), 1, 100000));
+  }
+  onSourceChanged();
+}
+
+void ArmPanel::onSourceChanged() {
+  ++generation_;  // a result still on its way is for an older choice
+  if (cancelFlag_) cancelFlag_->store(true);
+  angles_.reset();
+  scene_->setSprings(0);
+  scene_->setGhostVisible(false);
+  const int source = source_->currentData().toInt();
+  if (source != kLogSource && workspace_->raw()) startSimulation();
+  placeParameterFault();
+  updateCaption();
+  redraw();
+}
+
+void ArmPanel::startSimulation() {
+  const int source = source_->currentData().toInt();
+  std::shared_ptr<const PhysicalModel> model;
+  std::vector<Effect> effects;
+  if (source == kExternalSource && external_) {
+    model = external_->model;
+    effects = external_->effects;
+    computingName_ = external_->name;
+  } else if (source >= 0 && source < static_cast<int>(workspace_->models().size())) {
+    const ModelEntry& e = workspace_->models()[static_cast<std::size_t>(source)];
+    model = e.model;
+    effects = e.effects;
+    computingName_ = (e.fitRequest ? tr("%1 (fit)") : tr("%1 (model list)")).arg(e.name);
+  }
+  if (!model) return;
+  // The worker reads its own copy of the log: the workspace may replace it meanwhile.
+  IdData data = *workspace_->raw();
+  BodyAnglesOptions options;
+  options.motorAngle = measured_->isChecked() ? MotorAngleSource::Measured : MotorAngleSource::Simulated;
+  auto cancel = std::make_shared<std::atomic<bool>>(false);
+  cancelFlag_ = cancel;
+  simGeneration_ = generation_;
+  progress_->setValue(0);
+  progress_->setVisible(true);
+  cancel_->setVisible(true);
+  QPointer<QProgressBar> bar = progress_;
+  watcher_.setFuture(QtConcurrent::run([model, effects, data = std::move(data), options, cancel, bar]() {
+    int shown = -1;
+    auto progress = [&](double f, const std::string&) {
+      const int v = static_cast<int>(1000 * f);
+      if (v - shown >= 10) {
+        shown = v;
+        QMetaObject::invokeMethod(bar, [bar, v] { if (bar) bar->setValue(v); }, Qt::QueuedConnection);
+      }
+      return cancel->load() ? ProgressAction::Abort : ProgressAction::Continue;
+    };
+    try {
+      return simulateBodyAngles(*model, effects, data, options, progress);
+    } catch (const std::exception& e) {
+      BodyAngles failed;
+      failed.message = e.what();
+      return failed;
+    }
+  }));
+}
+
+void ArmPanel::onSimulated() {
+  BodyAngles result = watcher_.result();
+  progress_->setVisible(false);
+  cancel_->setVisible(false);
+  // The watcher reports only its latest simulation, but the source may have changed to one
+  // that needs none since it started: then this result is for an old choice.
+  if (simGeneration_ != generation_ || result.termination == Termination::Cancelled) {
+    updateCaption();
+    return;
+  }
+  const bool ok = result.termination == Termination::Converged;
+  if (ok) {
+    angles_ = std::make_shared<const BodyAngles>(std::move(result));
+    scene_->setSprings(angles_->springs);
+    const double largest = angles_->maxGearDeflection + angles_->maxArmDeflection;
+    scene_->setDeflectionRange(std::max({angles_->maxGearDeflection, angles_->maxArmDeflection,
+                                         angles_->maxParallelDeflection}));
+    exaggerate_->setValue(niceDown(kDeflectionDrawn / std::max(1e-12, largest), 1, 1000000));
+    scene_->setGhostVisible(ghost_->isChecked());
+    placeParameterFault();
+  }
+  updateCaption();
+  if (!ok) {
+    label_->setText(tr("%1: %2 The arm plays rigidly.")
+                        .arg(computingName_, QString::fromStdString(result.message)));
+  }
+  redraw();
+  emit anglesReady(ok, ok ? QString::fromStdString(angles_->message)
+                          : QString::fromStdString(result.message));
+}
+
+void ArmPanel::updateCaption() {
+  const IdData* d = workspace_->raw();
+  const bool angle = d && d->channel(columns::kMotorAngle);
+  QString text;
+  if (angles_) {
+    text = tr("Angles: %1, simulated on the log's torque; motor angle %2")
+               .arg(computingName_, QString::fromStdString(toString(angles_->motorAngleSource)));
+    text += tr("\nmotion x%1, deflections x%2 (true size: %3 mrad at most); ghost: rigid arm")
+                .arg(magnify_->value())
+                .arg(exaggerate_->value())
+                .arg(1e3 * std::max(angles_->maxGearDeflection, angles_->maxArmDeflection), 0, 'g', 3);
+  } else if (isComputing()) {
+    text = tr("Angles: the log's motor angle, rigid (simulating %1...)").arg(computingName_);
+    text += tr("\nmotion x%1").arg(magnify_->value());
+  } else if (angle) {
+    text = tr("Angles: the log's motor angle through the gear, rigid (no model)");
+    text += tr("\nmotion x%1").arg(magnify_->value());
+  } else {
+    text = d ? tr("The log has no motor angle: choose a model to simulate on its torque")
+             : tr("No log: drag to rotate, wheel to zoom, double click to reset");
+  }
+  if (fault_) text += tr("\nFault: %1 (%2 in red)").arg(faultReason_, toString(*fault_));
+  sourceText_ = text.section('\n', 0, 0);
+  label_->setText(sourceText_);
+  overlay_.caption = text;
+  overlay_.legend = angles_ && angles_->springs > 0;
+  overlay_.maxDeflection = scene_->deflectionRange();
+  view_->requestOverlay();
+}
+
+BodyPose ArmPanel::poseAt(double t) const {
+  if (angles_ && angles_->samples() > 0) return angles_->atTime(t);
+  BodyPose p;
   const IdData* d = workspace_->raw();
   const Channel* angle = d ? d->channel(columns::kMotorAngle) : nullptr;
-  if (!angle || angle->values.empty()) return;
+  if (!angle || angle->values.empty()) return p;
   const double pos = std::round((t - d->startTime) / d->sampleTime);
   const auto i = static_cast<std::size_t>(
       std::clamp(pos, 0.0, static_cast<double>(angle->values.size() - 1)));
-  const double motor = angle->values[i];
-  const double axis = gearRatio_ * motor * magnify_->value();
-  scene_->setPose(axis, 0.0);
-  label_->setText(tr("t = %1 s   motor %2 rad   axis one %3 mrad")
-                      .arg(d->timeAt(i), 0, 'f', 3)
-                      .arg(motor, 0, 'g', 4)
-                      .arg(1000.0 * gearRatio_ * motor, 0, 'g', 4));
-  view_->update();
+  p.motor = angle->values[i];
+  p.gearInput = p.gear = p.arm = p.parallel = gearRatio_ * p.motor;
+  return p;
+}
+
+void ArmPanel::redraw() {
+  // Settings changed: show the same time again even though the pose did not change.
+  scene_->markChanged();
+  showTime(playhead_ ? playhead_->time() : shownTime_);
+}
+
+void ArmPanel::showTime(double t) {
+  shownTime_ = t;
+  const IdData* d = workspace_->raw();
+  const BodyPose pose = poseAt(t);
+  if (!scene_->setPose(pose)) return;  // nothing changed: no render
+  if (trace_->isChecked() && d && (angles_ || d->channel(columns::kMotorAngle))) {
+    std::vector<BodyPose> history(kTracePoints);
+    for (int j = 0; j < kTracePoints; ++j)
+      history[static_cast<std::size_t>(j)] =
+          poseAt(t - kTraceSeconds * (kTracePoints - 1 - j) / (kTracePoints - 1));
+    scene_->setTrace(history);
+  }
+  QString status;
+  if (d && (angles_ || d->channel(columns::kMotorAngle))) {
+    status = tr("t = %1 s   motor %2 rad   arm %3 mrad")
+                 .arg(t, 0, 'f', 3)
+                 .arg(pose.motor, 0, 'g', 4)
+                 .arg(1e3 * pose.arm, 0, 'g', 4);
+    if (angles_ && angles_->springs >= 1)
+      status += tr("\nr phi_m - phi_g %1 mrad").arg(mrad(pose.gearDeflection));
+    if (angles_ && angles_->springs >= 2)
+      status += tr("   phi_g - phi_a %1 mrad").arg(mrad(pose.armDeflection));
+    if (angles_ && angles_->springs >= 3)
+      status += tr("   phi_g - phi_p %1 mrad").arg(mrad(pose.parallelDeflection));
+  }
+  overlay_.status = status;
+  view_->requestRender();
+}
+
+void ArmPanel::showFault(ArmPart part, const QString& reason) {
+  faultParameter_.clear();
+  if (fault_) scene_->setHighlight(*fault_, false);
+  fault_ = part;
+  faultReason_ = reason;
+  scene_->setHighlight(part, true);
+  updateCaption();
+  redraw();
+}
+
+bool ArmPanel::showParameterFault(const QString& parameter, const QString& reason) {
+  const auto part = armPartForParameter(shownStructure(), parameter.toStdString());
+  if (!part) return false;
+  showFault(*part, reason);
+  faultParameter_ = parameter;
+  return true;
+}
+
+std::string ArmPanel::shownStructure() const { return angles_ ? angles_->structure : "rigid"; }
+
+void ArmPanel::placeParameterFault() {
+  if (faultParameter_.isEmpty()) return;
+  const auto part = armPartForParameter(shownStructure(), faultParameter_.toStdString());
+  if (!part || part == fault_) return;
+  const QString parameter = faultParameter_;
+  showFault(*part, faultReason_);
+  faultParameter_ = parameter;
+}
+
+void ArmPanel::clearFault() {
+  faultParameter_.clear();
+  if (!fault_) return;
+  scene_->clearHighlights();
+  fault_.reset();
+  faultReason_.clear();
+  updateCaption();
+  redraw();
+}
+
+QImage ArmPanel::renderAt(double t) {
+  showTime(t);
+  QImage image = view_->grabFramebuffer();
+  return image;
+}
+
+void ArmPanel::saveStill() {
+  QSettings settings;
+  const QString path = QFileDialog::getSaveFileName(
+      this, tr("Save the arm view"), settings.value("lastDir").toString() + "/arm.png",
+      tr("PNG image (*.png)"));
+  if (path.isEmpty()) return;
+  if (!view_->grabFramebuffer().save(path))
+    QMessageBox::warning(this, tr("Save still"), tr("Cannot write %1.").arg(path));
+}
+
+void ArmPanel::askExportFrames() {
+  const IdData* d = workspace_->raw();
+  if (!d || !playhead_ || !playhead_->hasSpan()) {
+    QMessageBox::information(this, tr("Export frames"), tr("Open a log first."));
+    return;
+  }
+  QDialog dialog(this);
+  dialog.setWindowTitle(tr("Export the animation as PNG frames"));
+  auto* form = new QFormLayout(&dialog);
+  auto* folder = new QLineEdit(QSettings().value("lastDir").toString() + "/arm_frames", &dialog);
+  auto* browse = new QPushButton(tr("Browse..."), &dialog);
+  connect(browse, &QPushButton::clicked, &dialog, [&] {
+    const QString f = QFileDialog::getExistingDirectory(&dialog, tr("Folder for the frames"), folder->text());
+    if (!f.isEmpty()) folder->setText(f);
+  });
+  auto* row = new QHBoxLayout;
+  row->addWidget(folder, 1);
+  row->addWidget(browse);
+  auto number = [&](double v, double lo, double hi, const QString& suffix) {
+    auto* s = new QDoubleSpinBox(&dialog);
+    s->setDecimals(4);
+    s->setRange(lo, hi);
+    s->setValue(v);
+    s->setSuffix(suffix);
+    return s;
+  };
+  // By default the loop selection, else two seconds from the playhead.
+  const auto sel = playhead_->selection();
+  const double t0 = sel ? sel->first : playhead_->time();
+  const double t1 = sel ? sel->second : std::min(playhead_->end(), playhead_->time() + 2.0);
+  auto* from = number(t0, playhead_->start(), playhead_->end(), " s");
+  auto* to = number(t1, playhead_->start(), playhead_->end(), " s");
+  auto* fps = number(30, 1, 120, tr(" frames/s"));
+  auto* speed = number(playhead_->speed(), Playhead::kMinSpeed, Playhead::kMaxSpeed, "");
+  speed->setPrefix(QString::fromUtf8("\u00d7"));
+  form->addRow(tr("Folder"), row);
+  form->addRow(tr("From"), from);
+  form->addRow(tr("To"), to);
+  form->addRow(tr("Frame rate"), fps);
+  form->addRow(tr("Speed (log time per video time)"), speed);
+  auto* buttons = new QDialogButtonBox(QDialogButtonBox::Ok | QDialogButtonBox::Cancel, &dialog);
+  form->addRow(buttons);
+  connect(buttons, &QDialogButtonBox::accepted, &dialog, &QDialog::accept);
+  connect(buttons, &QDialogButtonBox::rejected, &dialog, &QDialog::reject);
+  if (dialog.exec() != QDialog::Accepted) return;
+  exportFrames(folder->text(), from->value(), to->value(), fps->value(), speed->value());
+}
+
+void ArmPanel::exportFrames(const QString& folder, double t0, double t1, double fps,
+                            double speed, bool runFfmpeg) {
+  if (exporting_) return;
+  exporting_ = true;
+  auto* exporter = new FrameExporter([this](double t) { return renderAt(t); }, folder,
+                                     FrameExporter::frameTimes(t0, t1, fps, speed), fps,
+                                     runFfmpeg, this);
+  connect(exporter, &FrameExporter::finished, this, [this, exporter](bool ok, const QString& message) {
+    exporting_ = false;
+    exporter->deleteLater();
+    redraw();  // back to the playhead's time
+    label_->setText(message);
+    emit exportFinished(ok, message);
+  });
+  exporter->start();
 }
 
 }  // namespace flexarm

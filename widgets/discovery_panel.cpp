@@ -233,8 +233,10 @@ QString DiscoveryPanel::comparisonText() const { return comparison_->text(); }
 
 void DiscoveryPanel::findMissingEffect() {
   if (watcher_.isRunning()) return;
-  if (!workspace_->hasLog()) {
-    verdict_->setText(tr("Open a log first."));
+  if (!workspace_->current()) {
+    verdict_->setText(workspace_->needsResampling()
+                          ? tr("Resample the log in the Preprocess panel first: its time stamps are irregular.")
+                          : tr("Open a log first."));
     return;
   }
   std::vector<Effect> existing;

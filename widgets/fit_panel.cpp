@@ -312,7 +312,7 @@ void FitPanel::updateControls() {
   noise_->setEnabled(!s && !busy);
   closedLoop_->setEnabled(!s && !busy && noise_->currentIndex() == 0);
   starts_->setEnabled(!s && !busy);
-  estimate_->setEnabled(!busy && workspace_->hasLog());
+  estimate_->setEnabled(!busy && workspace_->current());  // none while a log awaits resampling
   cancel_->setEnabled(busy);
   study_button_->setEnabled(!busy && last_.estimate != nullptr);
   model_->setEnabled(!busy);

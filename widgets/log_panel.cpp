@@ -164,7 +164,7 @@ void LogPanel::rebuild() {
   estimationRects_.clear();
   validationRects_.clear();
   loopRects_.clear();
-  const IdData* data = workspace_->current();
+  const IdData* data = workspace_->shown();
   if (!plot_->layer("ranges")) {
     plot_->addLayer("ranges", plot_->layer("main"), QCustomPlot::limBelow);
     plot_->addLayer("cursor", plot_->layer("main"), QCustomPlot::limAbove);
@@ -199,10 +199,29 @@ void LogPanel::rebuild() {
     g->setPen(QPen(kTraceColors[c % 8], 1.2));
     // Millions of samples are drawn through a min/max envelope of the visible range, so
     // opening, zooming and panning cost the same for a 10-minute log as for a short one.
-    envelopes_.push_back(std::make_unique<EnvelopePyramid>(ch.values));
-    const auto [lo, hi] = std::minmax_element(ch.values.begin(), ch.values.end());
-    const double pad = std::max(1e-12, 0.05 * (*hi - *lo));
-    y->setRange(*lo - pad, *hi + pad);
+    if (std::any_of(ch.values.begin(), ch.values.end(), [](double v) { return std::isnan(v); })) {
+      // A channel logged at a lower rate than the rows: drawn through its own samples.
+      std::vector<double> held = ch.values;
+      double previous = 0.0;
+      for (double v : held)
+        if (!std::isnan(v)) {
+          previous = v;
+          break;
+        }
+      for (double& v : held) std::isnan(v) ? (v = previous) : (previous = v);
+      envelopes_.push_back(std::make_unique<EnvelopePyramid>(held));
+    } else {
+      envelopes_.push_back(std::make_unique<EnvelopePyramid>(ch.values));
+    }
+    double lo = HUGE_VAL, hi = -HUGE_VAL;  // NaN marks "not sampled here" in irregular logs
+    for (double v : ch.values)
+      if (!std::isnan(v)) {
+        lo = std::min(lo, v);
+        hi = std::max(hi, v);
+      }
+    if (!(hi >= lo)) lo = hi = 0.0;
+    const double pad = std::max(1e-12, 0.05 * (hi - lo));
+    y->setRange(lo - pad, hi + pad);
     rects_.push_back(rect);
     connect(x, QOverload<const QCPRange&>::of(&QCPAxis::rangeChanged), this,
             [this, rect, c](const QCPRange&) {
@@ -257,10 +276,23 @@ void LogPanel::rebuild() {
 }
 
 void LogPanel::showAll() {
-  const IdData* data = workspace_->current();
+  const IdData* data = workspace_->shown();
   if (!data || rects_.empty()) return;
   for (auto* r : rects_)
     r->axis(QCPAxis::atBottom)->setRange(data->startTime, data->timeAt(data->samples() - 1));
+  plot_->replot();
+}
+
+void LogPanel::showAround(double t) {
+  const IdData* data = workspace_->shown();
+  if (!data || rects_.empty()) return;
+  const double half = std::max(25.0 * data->sampleTime, 0.01);
+  for (auto* r : rects_) r->axis(QCPAxis::atBottom)->setRange(t - half, t + half);
+  for (auto* c : cursors_) {
+    c->point1->setCoords(t, 0);
+    c->point2->setCoords(t, 1);
+    c->setVisible(true);
+  }
   plot_->replot();
 }
 
@@ -274,19 +306,18 @@ void LogPanel::syncTimeAxes(QCPAxisRect* source) {
 }
 
 void LogPanel::refreshChannel(std::size_t c) {
-  const IdData* data = workspace_->current();
+  const IdData* data = workspace_->shown();
   if (!data || c >= rects_.size() || c >= envelopes_.size()) return;
   const QCPRange r = rects_[c]->axis(QCPAxis::atBottom)->range();
-  const double n = static_cast<double>(data->samples());
-  const double first = std::clamp(std::floor((r.lower - data->startTime) / data->sampleTime) - 1.0, 0.0, n);
-  const double last = std::clamp(std::ceil((r.upper - data->startTime) / data->sampleTime) + 2.0, 0.0, n);
+  const std::size_t n = data->samples();
+  const std::size_t first = data->indexNear(r.lower) > 1 ? data->indexNear(r.lower) - 2 : 0;
+  const std::size_t last = std::min(n, data->indexNear(r.upper) + 3);
   static thread_local std::vector<double> position, value;
-  envelopes_[c]->visiblePoints(static_cast<std::size_t>(first), static_cast<std::size_t>(last),
-                               static_cast<std::size_t>(2 * std::max(rects_[c]->width(), 800)),
+  envelopes_[c]->visiblePoints(first, last, static_cast<std::size_t>(2 * std::max(rects_[c]->width(), 800)),
                                position, value);
   QVector<QCPGraphData> points(static_cast<int>(position.size()));
-  for (std::size_t i = 0; i < position.size(); ++i)
-    points[static_cast<int>(i)] = QCPGraphData(data->startTime + position[i] * data->sampleTime, value[i]);
+  for (std::size_t i = 0; i < position.size(); ++i)  // positions are sample indices
+    points[static_cast<int>(i)] = QCPGraphData(data->timeAt(static_cast<std::size_t>(position[i])), value[i]);
   plot_->graph(static_cast<int>(c))->data()->set(points, true);
 }
 
@@ -336,7 +367,7 @@ void LogPanel::onMousePress(QMouseEvent* e) {
 }
 
 void LogPanel::onMouseMove(QMouseEvent* e) {
-  const IdData* data = workspace_->current();
+  const IdData* data = workspace_->shown();
   if (!data || rects_.empty()) return;
   const double t = timeAtPixel(e->position().x());
   for (auto* c : cursors_) {
@@ -344,9 +375,9 @@ void LogPanel::onMouseMove(QMouseEvent* e) {
     c->point2->setCoords(t, 1);
     c->setVisible(true);
   }
-  const double pos = (t - data->startTime) / data->sampleTime;
-  if (pos >= -0.5 && pos <= static_cast<double>(data->samples()) - 0.5) {
-    const std::size_t i = static_cast<std::size_t>(std::llround(std::max(0.0, pos)));
+  if (data->samples() > 0 && t >= data->timeAt(0) - 0.5 * data->sampleTime &&
+      t <= data->timeAt(data->samples() - 1) + 0.5 * data->sampleTime) {
+    const std::size_t i = data->indexNear(t);
     QString text = QString("t = %1 s").arg(data->timeAt(i), 0, 'f', 4);
     for (const auto& ch : data->channels)
       text += QString("   %1 = %2").arg(QString::fromStdString(ch.name)).arg(ch.values[i], 0, 'g', 6);
@@ -365,7 +396,7 @@ void LogPanel::onMouseMove(QMouseEvent* e) {
 void LogPanel::onMouseRelease(QMouseEvent* e) {
   if (!selecting_) return;
   selecting_ = false;
-  const IdData* data = workspace_->current();
+  const IdData* data = workspace_->shown();
   double t0 = selectStart_, t1 = timeAtPixel(e->position().x());
   if (t1 < t0) std::swap(t0, t1);
   t0 = std::max(t0, data->startTime);

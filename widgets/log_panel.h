@@ -50,6 +50,9 @@ class LogPanel : public QWidget {
   QString readoutText() const;
   // Shows the whole log.
   void showAll();
+  // Zooms to a short window centred on time t with the cursor line there (e.g. a gap of the
+  // Preprocess panel's time-stamp report).
+  void showAround(double t);
 
  private:
   void rebuild();

@@ -2,17 +2,23 @@
 
 #include <QCheckBox>
 #include <QComboBox>
+#include <QDoubleSpinBox>
 #include <QFormLayout>
+#include <QGroupBox>
 #include <QHBoxLayout>
 #include <QLabel>
 #include <QProgressBar>
 #include <QPushButton>
+#include <QScrollArea>
 #include <QSpinBox>
 #include <QTimer>
 #include <QVBoxLayout>
 #include <QtConcurrent>
 #include <chrono>
+#include <cmath>
 #include <qcustomplot.h>
+
+#include "widgets/timing_table.h"
 
 namespace flexarm {
 namespace {
@@ -27,16 +33,56 @@ void setSpectrum(QCPGraph* g, const AmplitudeSpectrum& s) {
   g->setData(f, a, true);
 }
 
+// Values of a channel without the instants where it was not sampled (irregular logs).
+std::vector<double> sampled(const std::vector<double>& v) {
+  std::vector<double> out;
+  out.reserve(v.size());
+  for (double x : v)
+    if (!std::isnan(x)) out.push_back(x);
+  return out;
+}
+
 }  // namespace
 
 PreprocessPanel::PreprocessPanel(Workspace* workspace, QWidget* parent)
-    : QWidget(parent), workspace_(workspace), differentiate_(new QCheckBox(this)),
+    : QWidget(parent), workspace_(workspace), resample_(new QGroupBox(this)),
+      rate_(new QDoubleSpinBox(this)), method_(new QComboBox(this)),
+      maxGap_(new QDoubleSpinBox(this)), timing_(new TimingTable(this)),
+      differentiate_(new QCheckBox(this)),
       factor_(new QSpinBox(this)), filter_(new QComboBox(this)), detrend_(new QComboBox(this)),
       channel_(new QComboBox(this)), plot_(new QCustomPlot(this)), summary_(new QLabel(this)),
       busy_(new QProgressBar(this)), cancel_(new QPushButton(tr("Cancel"), this)),
       apply_(new QPushButton(tr("Apply"), this)), reset_(new QPushButton(tr("Reset"), this)),
       debounce_(new QTimer(this)) {
   setObjectName("preprocessPanel");
+  resample_->setObjectName("resampleGroup");
+  resample_->setTitle(tr("Resample onto a uniform grid"));
+  resample_->setCheckable(true);
+  resample_->setChecked(false);
+  resample_->setToolTip(tr("Any rate by a rational factor (polyphase FIR, >= 80 dB from the lower "
+                           "Nyquist frequency); required for a log whose time stamps jitter, skip, "
+                           "repeat or run backwards"));
+  rate_->setObjectName("resampleRateSpin");
+  rate_->setRange(0.001, 1e6);
+  rate_->setDecimals(3);
+  rate_->setSuffix(" Hz");
+  rate_->setValue(2000.0);
+  method_->setObjectName("resampleMethodCombo");
+  method_->addItem(tr("Band-limited (exact for short gaps)"), "bandlimited");
+  method_->addItem(tr("PCHIP (monotone cubic)"), "pchip");
+  method_->addItem(tr("Linear"), "linear");
+  method_->setToolTip(tr("How irregular time stamps are filled onto the grid"));
+  maxGap_->setObjectName("maxGapSpin");
+  maxGap_->setRange(0.0, 1e6);
+  maxGap_->setDecimals(3);
+  maxGap_->setSuffix(" ms");
+  maxGap_->setSpecialValueText(tr("ten sample intervals"));
+  maxGap_->setToolTip(tr("A longer gap is refused with its place"));
+  auto* resampleForm = new QFormLayout(resample_);
+  resampleForm->addRow(tr("Rate"), rate_);
+  resampleForm->addRow(tr("Irregular stamps by"), method_);
+  resampleForm->addRow(tr("Longest gap bridged"), maxGap_);
+  timing_->setMaximumHeight(150);
   differentiate_->setText(tr("Motor velocity from the angle (d/dt, becomes the output)"));
   differentiate_->setObjectName("differentiateCheck");
   factor_->setRange(1, 1000);
@@ -100,10 +146,27 @@ PreprocessPanel::PreprocessPanel(Workspace* workspace, QWidget* parent)
   buttons->addWidget(reset_);
   buttons->addWidget(apply_);
 
+  // The settings, report and spectra scroll when the dock is short (a 1366x768 screen);
+  // the buttons stay in view.
+  auto* content = new QWidget(this);
+  auto* inner = new QVBoxLayout(content);
+  inner->setContentsMargins(0, 0, 0, 0);
+  inner->addWidget(resample_);
+  auto* timingLabel = new QLabel(tr("Time stamps (click a row to show it in the Log panel):"), content);
+  timingLabel->setObjectName("timingLabel");
+  inner->addWidget(timingLabel);
+  inner->addWidget(timing_);
+  inner->addLayout(form);
+  inner->addWidget(plot_, 1);
+  inner->addWidget(summary_);
+  auto* scroll = new QScrollArea(this);
+  scroll->setObjectName("preprocessScroll");
+  scroll->setWidget(content);
+  scroll->setWidgetResizable(true);
+  scroll->setFrameShape(QFrame::NoFrame);
+  scroll->setHorizontalScrollBarPolicy(Qt::ScrollBarAlwaysOff);
   auto* layout = new QVBoxLayout(this);
-  layout->addLayout(form);
-  layout->addWidget(plot_, 1);
-  layout->addWidget(summary_);
+  layout->addWidget(scroll, 1);
   layout->addLayout(buttons);
 
   debounce_->setSingleShot(true);
@@ -114,6 +177,11 @@ PreprocessPanel::PreprocessPanel(Workspace* workspace, QWidget* parent)
     schedulePreview();
   });
   connect(factor_, QOverload<int>::of(&QSpinBox::valueChanged), this, &PreprocessPanel::schedulePreview);
+  connect(resample_, &QGroupBox::toggled, this, &PreprocessPanel::schedulePreview);
+  for (QDoubleSpinBox* b : {rate_, maxGap_})
+    connect(b, QOverload<double>::of(&QDoubleSpinBox::valueChanged), this, &PreprocessPanel::schedulePreview);
+  connect(method_, QOverload<int>::of(&QComboBox::currentIndexChanged), this, &PreprocessPanel::schedulePreview);
+  connect(timing_, &TimingTable::timeSelected, this, &PreprocessPanel::timeSelected);
   for (QComboBox* c : {filter_, detrend_, channel_})
     connect(c, QOverload<int>::of(&QComboBox::currentIndexChanged), this, &PreprocessPanel::schedulePreview);
   connect(cancel_, &QPushButton::clicked, this, [this] {
@@ -125,16 +193,41 @@ PreprocessPanel::PreprocessPanel(Workspace* workspace, QWidget* parent)
   connect(apply_, &QPushButton::clicked, this, &PreprocessPanel::apply);
   connect(reset_, &QPushButton::clicked, this, &PreprocessPanel::reset);
   connect(&watcher_, &QFutureWatcher<Outcome>::finished, this, &PreprocessPanel::onFinished);
-  connect(workspace_, &Workspace::logChanged, this, [this] {
-    result_.reset();
-    refillChannels();
-    schedulePreview();
-  });
-  refillChannels();
+  connect(workspace_, &Workspace::logChanged, this, &PreprocessPanel::onLogChanged);
+  onLogChanged();
 }
+
+void PreprocessPanel::onLogChanged() {
+  result_.reset();
+  timing_->setReports({});
+  const IdData* raw = workspace_->raw();
+  // A log with irregular time stamps cannot be used without resampling: the step is on.
+  const bool irregular = raw && !raw->isUniform();
+  {
+    QSignalBlocker block(resample_), blockRate(rate_);
+    resample_->setCheckable(!irregular);
+    if (!irregular) resample_->setChecked(false);
+    if (raw) {
+      const double rate = raw->sampleRateHz();
+      const double digits = std::pow(10.0, std::floor(std::log10(rate)) - 5.0);
+      rate_->setValue(std::round(rate / digits) * digits);
+    }
+  }
+  refillChannels();
+  schedulePreview();
+}
+
+QString PreprocessPanel::summaryText() const { return summary_->text(); }
 
 PreprocessOptions PreprocessPanel::options() const {
   PreprocessOptions o;
+  if (!resample_->isCheckable() || resample_->isChecked()) {
+    UniformGridOptions u;
+    u.rateHz = rate_->value();
+    u.method = *interpolationMethodFromString(method_->currentData().toString().toStdString());
+    u.maxGapSeconds = maxGap_->value() / 1000.0;
+    o.resample = u;
+  }
   o.differentiateAngle = differentiate_->isChecked() && differentiate_->isEnabled();
   o.decimation.factor = factor_->value();
   o.decimation.filter = *antiAliasFilterFromString(filter_->currentData().toString().toStdString());
@@ -143,6 +236,12 @@ PreprocessOptions PreprocessPanel::options() const {
 }
 
 void PreprocessPanel::setOptions(const PreprocessOptions& o) {
+  if (resample_->isCheckable()) resample_->setChecked(o.resample.has_value());
+  if (o.resample) {
+    if (o.resample->rateHz > 0.0) rate_->setValue(o.resample->rateHz);
+    method_->setCurrentIndex(method_->findData(QString(toString(o.resample->method))));
+    maxGap_->setValue(o.resample->maxGapSeconds * 1000.0);
+  }
   differentiate_->setChecked(o.differentiateAngle);
   factor_->setValue(o.decimation.factor);
   filter_->setCurrentIndex(filter_->findData(QString(toString(o.decimation.filter))));
@@ -193,13 +292,24 @@ void PreprocessPanel::preview() {
     Outcome out;
     const auto t0 = std::chrono::steady_clock::now();
     try {
-      auto result = std::make_shared<IdData>(preprocess(*input, o));
-      const IdData beforeData = o.differentiateAngle ? addDerivative(*input) : *input;
-      if (const Channel* c = beforeData.channel(channel))
-        out.before = amplitudeSpectrum(c->values, beforeData.sampleTime);
-      if (const Channel* c = result->channel(channel))
-        out.after = amplitudeSpectrum(c->values, result->sampleTime);
-      out.data = std::move(result);
+      PreprocessResult r = runPreprocess(*input, o);
+      if (r.resampling) {
+        for (const auto& g : r.resampling->groups) out.timing.push_back(g.timing);
+        out.resampling = QString::fromStdString(r.resampling->message);
+      }
+      if (r.termination != Termination::Converged) {
+        out.error = QString::fromStdString(r.message);
+      } else {
+        auto result = std::make_shared<IdData>(std::move(r.data));
+        // Before: the log as read (irregular stamps: its samples at the nominal interval).
+        const bool derive = o.differentiateAngle && input->isUniform();
+        const IdData beforeData = derive ? addDerivative(*input) : *input;
+        if (const Channel* c = beforeData.channel(channel))
+          out.before = amplitudeSpectrum(sampled(c->values), beforeData.sampleTime);
+        if (const Channel* c = result->channel(channel))
+          out.after = amplitudeSpectrum(c->values, result->sampleTime);
+        out.data = std::move(result);
+      }
     } catch (const std::exception& e) {
       out.error = QString::fromStdString(e.what());
     }
@@ -213,12 +323,16 @@ void PreprocessPanel::onFinished() {
   if (running_ != generation_) return;  // cancelled or superseded
   busy_->setVisible(false);
   cancel_->setVisible(false);
+  timing_->setReports(out.timing);
   if (!out.error.isEmpty() || !out.data) {
+    result_.reset();
     summary_->setText(tr("Preprocessing failed: %1").arg(out.error));
+    emit previewReady();
     return;
   }
   result_ = out.data;
   resultOptions_ = options();
+  const IdData* raw = workspace_->raw();
   setSpectrum(plot_->graph(0), out.before);
   setSpectrum(plot_->graph(1), out.after);
   plot_->rescaleAxes();
@@ -227,17 +341,18 @@ void PreprocessPanel::onFinished() {
   if (nyq) {
     nyq->point1->setCoords(nyquist, 1e-30);
     nyq->point2->setCoords(nyquist, 1);
-    nyq->setVisible(resultOptions_.decimation.factor > 1);
+    nyq->setVisible(result_->sampleRateHz() < raw->sampleRateHz() * (1.0 - 1e-9));
   }
   plot_->replot();
-  const IdData* raw = workspace_->raw();
-  summary_->setText(tr("%1 Hz -> %2 Hz, %3 -> %4 samples (new Nyquist %5 Hz, dashed); %6 ms")
-                        .arg(raw->sampleRateHz(), 0, 'g', 6)
-                        .arg(result_->sampleRateHz(), 0, 'g', 6)
-                        .arg(raw->samples())
-                        .arg(result_->samples())
-                        .arg(nyquist, 0, 'g', 4)
-                        .arg(out.seconds * 1000.0, 0, 'f', 0));
+  QString text = tr("%1 Hz -> %2 Hz, %3 -> %4 samples (new Nyquist %5 Hz, dashed); %6 ms")
+                     .arg(raw->sampleRateHz(), 0, 'g', 6)
+                     .arg(result_->sampleRateHz(), 0, 'g', 6)
+                     .arg(raw->samples())
+                     .arg(result_->samples())
+                     .arg(nyquist, 0, 'g', 4)
+                     .arg(out.seconds * 1000.0, 0, 'f', 0);
+  if (!out.resampling.isEmpty()) text += tr("\nResampled: %1").arg(out.resampling);
+  summary_->setText(text);
   apply_->setEnabled(true);
   emit previewReady();
 }

@@ -1,8 +1,10 @@
 #pragma once
-// Preprocess panel: differentiation, decimation factor and anti-alias filter, detrending;
-// amplitude spectra of a channel before and after (log axes, with the new Nyquist frequency
-// marked); Apply makes the result the data every later panel uses. The computation runs off
-// the GUI thread, with a busy bar and Cancel.
+// Preprocess panel: resampling onto a uniform grid (rate, method for irregular time stamps,
+// longest gap to bridge, and the time-stamp report of jitter, gaps, duplicates and
+// reversals, whose rows show their place in the Log panel), differentiation, decimation
+// factor and anti-alias filter, detrending; amplitude spectra of a channel before and after
+// (log axes, with the new Nyquist frequency marked); Apply makes the result the data every
+// later panel uses. The computation runs off the GUI thread, with a busy bar and Cancel.
 #include <QFutureWatcher>
 #include <QWidget>
 #include <memory>
@@ -13,6 +15,8 @@
 class QCheckBox;
 class QComboBox;
 class QCustomPlot;
+class QDoubleSpinBox;
+class QGroupBox;
 class QLabel;
 class QProgressBar;
 class QPushButton;
@@ -20,6 +24,8 @@ class QSpinBox;
 class QTimer;
 
 namespace flexarm {
+
+class TimingTable;
 
 class PreprocessPanel : public QWidget {
   Q_OBJECT
@@ -33,26 +39,37 @@ class PreprocessPanel : public QWidget {
   bool isBusy() const { return watcher_.isRunning(); }
   bool hasPreview() const { return result_ != nullptr; }
   QCustomPlot* plot() const { return plot_; }
+  TimingTable* timingTable() const { return timing_; }
+  QString summaryText() const;
 
  public slots:
   void apply();
   void reset();
 
  signals:
-  void previewReady();
+  void previewReady();  // also when it failed (hasPreview() is then false)
+  // A row of the time-stamp report was chosen: the Log panel shows this time.
+  void timeSelected(double seconds);
 
  private:
   struct Outcome {
     std::shared_ptr<IdData> data;
     AmplitudeSpectrum before, after;
-    QString error;
+    std::vector<TimingReport> timing;
+    QString error, resampling;
     double seconds = 0.0;
   };
   void schedulePreview();
   void onFinished();
   void refillChannels();
+  void onLogChanged();
 
   Workspace* workspace_;
+  QGroupBox* resample_;
+  QDoubleSpinBox* rate_;
+  QComboBox* method_;
+  QDoubleSpinBox* maxGap_;
+  TimingTable* timing_;
   QCheckBox* differentiate_;
   QSpinBox* factor_;
   QComboBox* filter_;

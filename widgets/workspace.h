@@ -58,8 +58,15 @@ class Workspace : public QObject {
   const LogReadOptions& logReadOptions() const { return read_; }
   const IdData* raw() const { return raw_.get(); }
 
-  // The preprocessed data if preprocessing was applied, otherwise the raw log.
-  const IdData* current() const { return processed_ ? processed_.get() : raw_.get(); }
+  // The preprocessed data if preprocessing was applied, otherwise the raw log; null when
+  // there is no log or its time stamps are irregular (it must be resampled first).
+  const IdData* current() const {
+    return processed_ ? processed_.get() : raw_ && raw_->isUniform() ? raw_.get() : nullptr;
+  }
+  // What the Log panel draws: current(), or the raw log when it waits for resampling.
+  const IdData* shown() const { return processed_ ? processed_.get() : raw_.get(); }
+  // The raw log has irregular time stamps and no resampling has been applied yet.
+  bool needsResampling() const { return raw_ && !raw_->isUniform() && !processed_; }
   bool isPreprocessed() const { return processed_ != nullptr; }
   const PreprocessOptions& preprocessOptions() const { return options_; }
   // Applying and clearing preprocessing, and setting ranges, go through the undo stack.

@@ -21,6 +21,8 @@ const std::vector<Verb>& verbs() {
       {"run", "replay a saved session headless and write its PDF/HTML report", runRun},
       {"discover", "find the effect a physical model misses and show the gap shrink",
        runDiscover},
+      {"recursive", "estimate physical parameters sample by sample (chapter 6's RPEM)",
+       runRecursive},
   };
   return kVerbs;
 }

@@ -61,6 +61,9 @@ class ArgParser {
   std::string error_;
 };
 
+// The non-empty items of a comma-separated list ("k_T,J_a,f_m").
+std::vector<std::string> splitList(const std::string& text);
+
 // Verbs. Each lives in its own verb_*.cpp.
 int runInfo(const std::vector<std::string>& args, std::ostream& out, std::ostream& err);
 int runPreprocess(const std::vector<std::string>& args, std::ostream& out, std::ostream& err);
@@ -71,5 +74,6 @@ int runBode(const std::vector<std::string>& args, std::ostream& out, std::ostrea
 int runLqg(const std::vector<std::string>& args, std::ostream& out, std::ostream& err);
 int runRun(const std::vector<std::string>& args, std::ostream& out, std::ostream& err);
 int runDiscover(const std::vector<std::string>& args, std::ostream& out, std::ostream& err);
+int runRecursive(const std::vector<std::string>& args, std::ostream& out, std::ostream& err);
 
 }  // namespace flexarm::cli

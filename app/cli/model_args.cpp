@@ -1,6 +1,9 @@
 #include "app/cli/model_args.h"
 
+#include "core/session/model_json.h"
+
 #include <charconv>
+#include <fstream>
 #include <cmath>
 #include <ostream>
 #include <stdexcept>
@@ -44,27 +47,93 @@ std::unique_ptr<PhysicalModel> modelFromArgs(const ArgParser& args, const std::s
   std::unique_ptr<PhysicalModel> model;
   try {
     model = makeModel(args.value("model").value_or("three-mass"), options);
-    for (const auto& p : args.values("param")) {
-      const auto eq = p.find('=');
-      if (eq == std::string::npos) {
-        err << "flexarm " << verb << ": --param expects NAME=VALUE, got '" << p << "'\n";
-        return nullptr;
-      }
-      const std::string name = p.substr(0, eq), text = p.substr(eq + 1);
-      double v = 0.0;
-      const auto res = std::from_chars(text.data(), text.data() + text.size(), v);
-      if (res.ec != std::errc() || res.ptr != text.data() + text.size() || !std::isfinite(v)) {
-        err << "flexarm " << verb << ": --param " << name << ": '" << text
-            << "' is not a number\n";
-        return nullptr;
-      }
-      model->setParameter(name, v);
-    }
+    if (!applyParams(args, *model, verb, err)) return nullptr;
     for (const auto& n : args.values("free")) model->setFree(n, true);
     for (const auto& n : args.values("fixed")) model->setFree(n, false);
   } catch (const std::invalid_argument& e) {
     err << "flexarm " << verb << ": " << e.what() << "\n";
     return nullptr;
+  }
+  return model;
+}
+
+bool applyParams(const ArgParser& args, PhysicalModel& model, const std::string& verb,
+                 std::ostream& err) {
+  for (const auto& p : args.values("param")) {
+    const auto eq = p.find('=');
+    if (eq == std::string::npos) {
+      err << "flexarm " << verb << ": --param expects NAME=VALUE, got '" << p << "'\n";
+      return false;
+    }
+    const std::string name = p.substr(0, eq), text = p.substr(eq + 1);
+    double v = 0.0;
+    const auto res = std::from_chars(text.data(), text.data() + text.size(), v);
+    if (res.ec != std::errc() || res.ptr != text.data() + text.size() || !std::isfinite(v)) {
+      err << "flexarm " << verb << ": --param " << name << ": '" << text << "' is not a number\n";
+      return false;
+    }
+    try {
+      model.setParameter(name, v);
+    } catch (const std::invalid_argument& e) {
+      err << "flexarm " << verb << ": " << e.what() << "\n";
+      return false;
+    }
+  }
+  return true;
+}
+
+std::unique_ptr<PhysicalModel> modelFromFile(const std::string& path, std::string* why) {
+  std::ifstream in(path);
+  if (!in) {
+    *why = "cannot be read";
+    return nullptr;
+  }
+  nlohmann::json j;
+  try {
+    in >> j;
+  } catch (const nlohmann::json::exception& e) {
+    *why = std::string("is not JSON: ") + e.what();
+    return nullptr;
+  }
+  if (!j.is_object()) {
+    *why = "holds no model (a JSON object is expected)";
+    return nullptr;
+  }
+  // A session's or `flexarm model`'s model: {"structure", "parameters": [{name, value}, ...]}.
+  if (j.contains("structure")) {
+    if (!j.contains("name")) j["name"] = path;  // `flexarm model --json` names none
+    auto spec = modelFromJson(j, why);
+    if (!spec) return nullptr;
+    return std::unique_ptr<PhysicalModel>(
+        dynamic_cast<PhysicalModel*>(spec->model->clone().release()));
+  }
+  // `flexarm fit --json`: "model": "three-mass (K = 0)", "parameters": {name: value}.
+  if (!j.contains("model") || !j["model"].is_string() || !j.contains("parameters") ||
+      !j["parameters"].is_object()) {
+    *why = "is neither a fit (\"model\" and \"parameters\") nor a model (\"structure\")";
+    return nullptr;
+  }
+  const std::string name = j["model"].get<std::string>();
+  const std::string structure = name.substr(0, name.find(' '));
+  std::unique_ptr<PhysicalModel> model;
+  try {
+    model = makeModel(structure);
+  } catch (const std::invalid_argument&) {
+    *why = "its model '" + name + "' is not a physical model (" + structure + ")";
+    return nullptr;
+  }
+  for (const auto& [key, value] : j["parameters"].items()) {
+    if (model->indexOf(key) < 0) continue;  // e.g. the innovations gain K1..Kn
+    if (!value.is_number()) {
+      *why = "the value of " + key + " is not a number";
+      return nullptr;
+    }
+    try {
+      model->setParameter(key, value.get<double>());
+    } catch (const std::invalid_argument& e) {
+      *why = e.what();
+      return nullptr;
+    }
   }
   return model;
 }

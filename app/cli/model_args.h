@@ -22,6 +22,15 @@ std::string modelOptionsHelp();
 std::unique_ptr<PhysicalModel> modelFromArgs(const ArgParser& args, const std::string& verb,
                                              std::ostream& err);
 
+// Sets the --param NAME=VALUE values on model; false after printing "flexarm VERB: ..." to err.
+bool applyParams(const ArgParser& args, PhysicalModel& model, const std::string& verb,
+                 std::ostream& err);
+
+// The physical model a JSON file holds: the output of `flexarm fit --json` ("model":
+// "three-mass (K = 0)", "parameters": {name: value}) or a model as sessions store it
+// ("structure", "parameters": [...]). nullptr with a sentence (to follow the file name).
+std::unique_ptr<PhysicalModel> modelFromFile(const std::string& path, std::string* why);
+
 // {"structure", "description", "parameters": [{name, unit, value, lower, upper, free}]}.
 nlohmann::json modelJson(const PhysicalModel& model);
 

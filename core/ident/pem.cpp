@@ -8,6 +8,7 @@
 
 #include <unsupported/Eigen/MatrixFunctions>
 
+#include "core/common/balancing.h"
 #include "core/ident/levenberg_marquardt.h"
 
 namespace flexarm {
@@ -79,42 +80,13 @@ Eigen::MatrixXd augmented(const Eigen::MatrixXd& A, const Eigen::MatrixXd& B) {
   return M;
 }
 
-// Diagonal similarity D (powers of two) that makes row and column norms of M comparable
-// (Parlett-Reinsch balancing). The physical states differ by orders of magnitude (a spring
-// twist of micro-radians next to motor speeds), and the matrix exponential and its derivative
-// are only accurate on the balanced matrix D^{-1} M D.
-Eigen::VectorXd balancing(const Eigen::MatrixXd& M0) {
-  Eigen::MatrixXd M = M0;
-  const Eigen::Index n = M.rows();
-  Eigen::VectorXd d = Eigen::VectorXd::Ones(n);
-  for (int sweep = 0; sweep < 100; ++sweep) {
-    bool changed = false;
-    for (Eigen::Index i = 0; i < n; ++i) {
-      const double c0 = M.col(i).cwiseAbs().sum() - std::abs(M(i, i));
-      const double r0 = M.row(i).cwiseAbs().sum() - std::abs(M(i, i));
-      if (c0 == 0.0 || r0 == 0.0) continue;
-      double c = c0, r = r0, f = 1.0;
-      while (c < r / 2.0) { c *= 2.0; r /= 2.0; f *= 2.0; }
-      while (c >= r * 2.0) { c /= 2.0; r *= 2.0; f /= 2.0; }
-      if (f != 1.0 && (c + r) < 0.95 * (c0 + r0)) {
-        d[i] *= f;
-        M.col(i) *= f;
-        M.row(i) /= f;
-        changed = true;
-      }
-    }
-    if (!changed) break;
-  }
-  return d;
-}
-
 // e^M and, for each dM, the derivative L(M, dM) = d/dh e^{M + h dM} at h = 0, from the
 // block-triangular identity exp([[M dM],[0 M]]) = [[e^M, L],[0, e^M]], computed on the
 // balanced matrix.
 void expWithDerivatives(const Eigen::MatrixXd& M, const std::vector<Eigen::MatrixXd>& dMs,
                         Eigen::MatrixXd& E, std::vector<Eigen::MatrixXd>& dEs) {
   const Eigen::Index k = M.rows();
-  const Eigen::VectorXd d = balancing(M);
+  const Eigen::VectorXd d = balancingScales(M);
   const Eigen::VectorXd di = d.cwiseInverse();
   const Eigen::MatrixXd Mb = di.asDiagonal() * M * d.asDiagonal();
   E = d.asDiagonal() * Mb.exp() * di.asDiagonal();

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cerrno>
+#include <cmath>
 #include <cstring>
 #include <exception>
 #include <filesystem>
@@ -22,7 +23,7 @@ constexpr unsigned kMaxThreads = 4;
 // The rows of the lines that start before byte `end`, numbered from 1 after the line the
 // reader returned last.
 void readStretch(LineReader& reader, std::uint64_t end, std::size_t nCols, std::size_t estimate,
-                 CsvRows& out) {
+                 int holesExcept, CsvRows& out) {
   out.columns.resize(nCols);
   for (auto& c : out.columns) reserveOnHugePages(c, estimate);
   reserveOnHugePages(out.lines, estimate);
@@ -50,7 +51,10 @@ void readStretch(LineReader& reader, std::uint64_t end, std::size_t nCols, std::
     }
     for (std::size_t i = 0; i < nCols; ++i) {
       const FieldStatus s = parseNumber(fields[i], row[i]);
-      if (s != FieldStatus::Ok) {
+      if (s == FieldStatus::Empty && holesExcept >= 0 && static_cast<int>(i) != holesExcept) {
+        row[i] = std::nan("");  // this channel has no sample at this time
+        out.holes = true;
+      } else if (s != FieldStatus::Ok) {
         out.ok = false;
         out.errorLine = number;
         out.errorColumn = static_cast<int>(i + 1);
@@ -72,7 +76,7 @@ void readStretch(LineReader& reader, std::uint64_t end, std::size_t nCols, std::
 }  // namespace
 
 CsvRows readCsvRows(const std::string& path, LineReader& reader, std::size_t nCols,
-                    unsigned threads) {
+                    unsigned threads, int holesExcept) {
   const std::uint64_t start = reader.offset();
   std::error_code ec;
   const std::uint64_t size = std::filesystem::file_size(path, ec);
@@ -91,7 +95,7 @@ CsvRows readCsvRows(const std::string& path, LineReader& reader, std::size_t nCo
   const auto read = [&](unsigned k, LineReader& r) {
     try {
       const int first = r.number();
-      readStretch(r, cut[k + 1], nCols, estimate, part[k]);
+      readStretch(r, cut[k + 1], nCols, estimate, holesExcept, part[k]);
       lineCount[k] = r.number() - first;
     } catch (const std::exception& e) {  // out of memory in a thread
       part[k] = CsvRows{};
@@ -136,6 +140,7 @@ CsvRows readCsvRows(const std::string& path, LineReader& reader, std::size_t nCo
       return rows;
     }
     for (int& line : part[k].lines) line += lineBase;
+    rows.holes = rows.holes || part[k].holes;
     lineBase += lineCount[k];
     total += part[k].lines.size();
   }

@@ -13,6 +13,7 @@ struct CsvRows {
   std::vector<int> lines;                    // the file's line number of each row
   // The first bad row, when there is one: its line, the field (1-based; 0 when the problem is
   // the whole line) and the problem as a sentence.
+  bool holes = false;  // an empty field was read as a hole (NaN)
   bool ok = true;
   int errorLine = 0;
   int errorColumn = 0;
@@ -23,8 +24,9 @@ struct CsvRows {
 // returned the header line. Blank lines and '#' comments are skipped; a row must hold
 // `columns` finite numbers. The rows, their values and the first bad row are the same
 // whatever the number of threads: `threads` stretches when given, otherwise one per 8 MB of
-// rows, up to the processor's cores (at most 4).
+// rows, up to the processor's cores (at most 4). With `holesExcept` >= 0 an empty field of any
+// column but that one is a hole, NaN, instead of an error.
 CsvRows readCsvRows(const std::string& path, LineReader& reader, std::size_t columns,
-                    unsigned threads = 0);
+                    unsigned threads = 0, int holesExcept = -1);
 
 }  // namespace flexarm::textio

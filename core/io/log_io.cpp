@@ -22,6 +22,7 @@
 #include "core/io/csv_rows.h"
 #include "core/io/huge_pages.h"
 #include "core/io/text_lines.h"
+#include "core/signal/timing.h"
 
 namespace flexarm {
 namespace {
@@ -88,17 +89,43 @@ bool readFailed(const std::string& path, const LineReader& reader, LogReadResult
   return true;
 }
 
-// Checks that times increase and are uniformly spaced; fills sampleTime and startTime.
+// A refusal for the time stamps: marked as such, with every irregularity counted.
+void timeFailure(LogReadResult& fail, const std::vector<double>& t, const std::vector<int>& lines,
+                 double jitter) {
+  fail.irregularTime = true;
+  TimingOptions o;
+  o.jitterTolerance = std::min(jitter, 0.49);
+  fail.error.problem += ". The time stamps have " + analyzeTiming(t, lines, o).summary() +
+                        "; resampling puts them on a uniform grid (flexarm preprocess --resample, "
+                        "or Resample in the Preprocess panel)";
+}
+
+// Checks that times increase and are uniformly spaced; fills sampleTime and startTime. With
+// keepIrregularTime, stamps that are not keep their times for a resampling step instead.
 bool checkTime(const std::string& path, const std::vector<double>& t, const std::vector<int>& lines,
-               int timeColumn, const std::string& timeName, double jitter, IdData& data,
-               LogReadResult& fail) {
+               int timeColumn, const std::string& timeName, const LogReadOptions& options,
+               IdData& data, LogReadResult& fail) {
+  const double jitter = options.maxSampleJitter;
   const std::size_t n = t.size();
+  if (options.keepIrregularTime && n >= 2) {
+    TimingOptions o;
+    o.jitterTolerance = std::min(jitter, 0.49);
+    const TimingReport report = analyzeTiming(t, lines, o);
+    if (!report.regular()) {
+      data.timeStamps = t;
+      data.sourceLines = lines;
+      data.startTime = t[0];
+      data.sampleTime = report.interval > 0.0 ? report.interval : 1.0;
+      return true;
+    }
+  }
   for (std::size_t i = 1; i < n; ++i)
     if (!(t[i] > t[i - 1])) {
       char buf[160];
       std::snprintf(buf, sizeof buf, "time %.9g does not increase (line %d has %.9g)", t[i],
                     lines[i - 1], t[i - 1]);
       fail = failure(path, lines[i], timeColumn, timeName, buf);
+      timeFailure(fail, t, lines, jitter);
       return false;
     }
   data.startTime = n ? t[0] : 0.0;
@@ -114,6 +141,7 @@ bool checkTime(const std::string& path, const std::vector<double>& t, const std:
                     "the log first)",
                     t[i - 1], t[i], step, 100.0 * std::abs(step - dt) / dt, dt, 100.0 * jitter);
       fail = failure(path, lines[i], timeColumn, timeName, buf);
+      timeFailure(fail, t, lines, jitter);
       return false;
     }
   }
@@ -243,7 +271,10 @@ LogReadResult readFlexArmCsv(const std::string& path, const LogReadOptions& opti
       static_cast<int>(std::find(header.begin(), header.end(), columns::kTime) - header.begin());
 
   const std::size_t nCols = header.size();
-  CsvRows rows = readCsvRows(path, cursor, nCols);
+  // With keepIrregularTime an empty field of a channel (not the time) is a hole: the channel
+  // has no sample at that time.
+  CsvRows rows = readCsvRows(path, cursor, nCols, 0,
+                             options.keepIrregularTime ? timeIndex : -1);
   if (!rows.ok)
     return failure(path, rows.errorLine, rows.errorColumn,
                    rows.errorColumn > 0 ? header[static_cast<std::size_t>(rows.errorColumn - 1)]
@@ -251,15 +282,20 @@ LogReadResult readFlexArmCsv(const std::string& path, const LogReadOptions& opti
                    rows.problem);
   auto& cols = rows.columns;
   const auto& lines = rows.lines;
+  const bool holes = rows.holes;
   if (lines.empty())
     return failure(path, headerLine, 0, {}, "the header is not followed by any data rows");
   if (lines.size() < 2)
     return failure(path, lines[0], 0, {}, "only one data row: at least two samples are needed");
 
   if (!checkTime(path, cols[static_cast<std::size_t>(timeIndex)], lines, timeIndex + 1,
-                 columns::kTime, options.maxSampleJitter, data, fail))
+                 columns::kTime, options, data, fail))
     return fail;
-  if (declaredRate > 0) {
+  if (holes && data.timeStamps.empty()) {  // channels at different rates: stamps and NaN holes
+    data.timeStamps = cols[static_cast<std::size_t>(timeIndex)];
+    data.sourceLines = lines;
+  }
+  if (declaredRate > 0 && data.timeStamps.empty()) {
     const double measured = 1.0 / data.sampleTime;
     if (std::abs(measured - declaredRate) > options.maxSampleJitter * declaredRate) {
       char buf[200];
@@ -347,7 +383,7 @@ LogReadResult readTable(const std::string& path, const LogReadOptions& options) 
   data.sampleTime = options.sampleTime;
   if (options.timeColumn > 0) {
     if (!checkTime(path, cols[static_cast<std::size_t>(options.timeColumn - 1)], lines,
-                   options.timeColumn, "time", options.maxSampleJitter, data, fail))
+                   options.timeColumn, "time", options, data, fail))
       return fail;
   }
   for (std::size_t i = 0; i < cols.size(); ++i) {
@@ -498,7 +534,7 @@ LogReadResult readMat(const std::string& path, const LogReadOptions& options) {
     std::vector<int> idx;  // sample numbers, for the sentence of a failing check
     sizeOnHugePages(idx, t.size());
     std::iota(idx.begin(), idx.end(), 1);
-    if (!checkTime(path, t, idx, 0, columns::kTime, options.maxSampleJitter, data, fail)) {
+    if (!checkTime(path, t, idx, 0, columns::kTime, options, data, fail)) {
       fail.error.problem = "sample " + std::to_string(fail.error.line) + ": " + fail.error.problem;
       fail.error.line = 0;
       return fail;

@@ -25,6 +25,9 @@ struct LogReadResult {
   bool ok = false;
   IdData data;
   ReadError error;
+  // Refused for its time stamps (jitter, gaps, duplicates, reversals) alone: read with
+  // LogReadOptions::keepIrregularTime, the log opens for an explicit resampling step.
+  bool irregularTime = false;
 };
 
 enum class LogFormat { Auto, FlexArmCsv, Table, Mat };
@@ -35,6 +38,10 @@ struct LogReadOptions {
                                        // when the first data line is not numeric, else Table
   std::uint64_t maxFileBytes = 2ull << 30;  // larger files are refused with a clear message
   double maxSampleJitter = 0.01;            // relative deviation from the mean interval
+  // Keep irregular time stamps (IdData::timeStamps) instead of refusing them, and read an
+  // empty field of a FlexArm CSV log as "not sampled here" (NaN): for resampling onto a
+  // uniform grid (core/signal/uniform_grid.h), the step such data need before analysis.
+  bool keepIrregularTime = false;
 
   // Headerless tables and .mat files without FlexArm names: which column (1-based) or
   // variable is the input u and the output y, an optional time column, and the sample time

@@ -168,6 +168,26 @@ bool TorqueResponseOptions::isValid(std::string* why) const {
 
 TorqueResponse simulateTorque(const NonlinearPlant& plant, const std::vector<double>& torque,
                               double Ts, const TorqueResponseOptions& options) {
+  const std::size_t N = torque.size();
+  TorqueResponse r;
+  for (auto* v : {&r.motorAngle, &r.motorVelocity, &r.armAcceleration, &r.gearDeflection,
+                  &r.gearTorque})
+    v->resize(N);
+  simulateTorque(plant, torque, Ts, options,
+                 [&](std::size_t k, const NonlinearPlant::State& x, double u) {
+                   r.motorAngle[k] = plant.motorAngle(x);
+                   r.motorVelocity[k] = plant.motorVelocity(x);
+                   r.armAcceleration[k] = plant.armAcceleration(x, u, 0.0);
+                   r.gearDeflection[k] = plant.gearDeflection(x);
+                   r.gearTorque[k] = plant.gearTorque(x);
+                   return true;
+                 });
+  return r;
+}
+
+std::size_t simulateTorque(const NonlinearPlant& plant, const std::vector<double>& torque,
+                           double Ts, const TorqueResponseOptions& options,
+                           const PlantStateVisitor& visit) {
   std::string why;
   if (!options.isValid(&why)) throw std::invalid_argument("simulateTorque: " + why);
   if (!(Ts > 0.0) || !std::isfinite(Ts))
@@ -180,10 +200,6 @@ TorqueResponse simulateTorque(const NonlinearPlant& plant, const std::vector<dou
     for (int i = 0; i < plant.states(); ++i) x[static_cast<std::size_t>(i)] = options.initialState[static_cast<std::size_t>(i)];
   }
   const std::size_t N = torque.size();
-  TorqueResponse r;
-  for (auto* v : {&r.motorAngle, &r.motorVelocity, &r.armAcceleration, &r.gearDeflection,
-                  &r.gearTorque})
-    v->resize(N);
   const double delay = plant.inputDelay();
   // Applied torque: the sample held over [k Ts, (k+1) Ts), shifted by the delay.
   auto torqueAt = [&torque, Ts, delay, N](double t) {
@@ -195,14 +211,10 @@ TorqueResponse simulateTorque(const NonlinearPlant& plant, const std::vector<dou
   const double h = Ts / options.substeps;
   for (std::size_t k = 0; k < N; ++k) {
     const double t = static_cast<double>(k) * Ts;
-    r.motorAngle[k] = plant.motorAngle(x);
-    r.motorVelocity[k] = plant.motorVelocity(x);
-    r.armAcceleration[k] = plant.armAcceleration(x, torqueAt(t), 0.0);
-    r.gearDeflection[k] = plant.gearDeflection(x);
-    r.gearTorque[k] = plant.gearTorque(x);
+    if (!visit(k, x, torqueAt(t))) return k + 1;
     for (int i = 0; i < options.substeps; ++i) plant.step(x, t + i * h, h, torqueAt, 0.0);
   }
-  return r;
+  return N;
 }
 
 }  // namespace flexarm

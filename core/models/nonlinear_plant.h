@@ -8,6 +8,7 @@
 // phi_m. Integration is classical Runge-Kutta with fine steps, without heap allocation.
 #include <array>
 #include <cstddef>
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -97,5 +98,14 @@ struct TorqueResponse {
 // Throws std::invalid_argument for sampleTime <= 0 or invalid options.
 TorqueResponse simulateTorque(const NonlinearPlant& plant, const std::vector<double>& torque,
                               double sampleTime, const TorqueResponseOptions& options = {});
+
+// The same simulation, handing the whole state at every sample instant k (before the step to
+// k + 1), the applied torque there, to visit; visit returns false to stop early. Returns the
+// number of samples visited.
+using PlantStateVisitor =
+    std::function<bool(std::size_t k, const NonlinearPlant::State& x, double appliedTorque)>;
+std::size_t simulateTorque(const NonlinearPlant& plant, const std::vector<double>& torque,
+                           double sampleTime, const TorqueResponseOptions& options,
+                           const PlantStateVisitor& visit);
 
 }  // namespace flexarm

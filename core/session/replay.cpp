@@ -58,7 +58,7 @@ PreparedSession prepareSession(const Session& session, const std::string& sessio
     }
     log.raw = std::move(read.data);
     try {
-      if (session.preprocessed && session.preprocess.range &&
+      if (session.preprocessed && session.preprocess.range && !session.preprocess.resample &&
           session.preprocess.range->end > log.raw.samples())
         throw std::invalid_argument("the preprocessing keeps samples up to " +
                                     std::to_string(session.preprocess.range->end) +

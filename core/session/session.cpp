@@ -1,6 +1,7 @@
 #include "core/session/session.h"
 
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -99,7 +100,8 @@ json readOptionsToJson(const LogReadOptions& o) {
           {"output_column", o.outputColumn},    {"time_column", o.timeColumn},
           {"sample_time_s", o.sampleTime},      {"input_name", o.inputName},
           {"output_name", o.outputName},        {"input_variable", o.inputVariable},
-          {"output_variable", o.outputVariable}, {"max_sample_jitter", o.maxSampleJitter}};
+          {"output_variable", o.outputVariable}, {"max_sample_jitter", o.maxSampleJitter},
+          {"keep_irregular_time", o.keepIrregularTime}};
 }
 
 bool readOptionsFromJson(const json& j, const std::string& where, LogReadOptions& o,
@@ -122,15 +124,38 @@ bool readOptionsFromJson(const json& j, const std::string& where, LogReadOptions
   f.string(j, "input_variable", where, o.inputVariable, false);
   f.string(j, "output_variable", where, o.outputVariable, false);
   f.number(j, "max_sample_jitter", where, o.maxSampleJitter, false);
+  f.boolean(j, "keep_irregular_time", where, o.keepIrregularTime, false);
   if (f.failed()) return false;
   std::string why;
   if (!o.isValid(&why)) return f.fail(where, why);
   return true;
 }
 
+json resampleToJson(const std::optional<UniformGridOptions>& r) {
+  if (!r) return nullptr;
+  return {{"rate_hz", r->rateHz},           {"method", toString(r->method)},
+          {"max_gap_s", r->maxGapSeconds},  {"jitter_tolerance", r->jitterTolerance},
+          {"stopband_db", r->stopbandDb}};
+}
+
+bool resampleFromJson(const json& j, const std::string& where, UniformGridOptions& r, FieldReader& f) {
+  f.number(j, "rate_hz", where, r.rateHz);
+  std::string method;
+  if (f.string(j, "method", where, method)) {
+    auto m = interpolationMethodFromString(method);
+    if (!m) return f.fail(where + ".method", "unknown method '" + method + "'");
+    r.method = *m;
+  }
+  f.number(j, "max_gap_s", where, r.maxGapSeconds, false);
+  f.number(j, "jitter_tolerance", where, r.jitterTolerance, false);
+  f.number(j, "stopband_db", where, r.stopbandDb, false);
+  return !f.failed();
+}
+
 json preprocessToJson(const Session& s) {
   const PreprocessOptions& p = s.preprocess;
   json j = {{"applied", s.preprocessed},
+            {"resample", resampleToJson(p.resample)},
             {"differentiate_angle", p.differentiateAngle},
             {"range_samples", p.range ? json::array({p.range->begin, p.range->end}) : json(nullptr)},
             {"decimation",
@@ -145,6 +170,11 @@ bool preprocessFromJson(const json& j, Session& s, FieldReader& f) {
   const std::string where = "preprocessing";
   PreprocessOptions& p = s.preprocess;
   f.boolean(j, "applied", where, s.preprocessed);
+  if (const json* r = f.member(j, "resample", where, false); r && !r->is_null()) {
+    UniformGridOptions u;
+    if (!resampleFromJson(*r, where + ".resample", u, f)) return false;
+    p.resample = u;
+  }
   f.boolean(j, "differentiate_angle", where, p.differentiateAngle);
   if (const json* r = f.member(j, "range_samples", where, false); r && !r->is_null()) {
     if (!r->is_array() || r->size() != 2 || !(*r)[0].is_number_unsigned() ||
@@ -328,6 +358,18 @@ std::string storedLogPath(const std::string& sessionPath, const std::string& log
 
 std::vector<std::string> describePreprocessing(const PreprocessOptions& p) {
   std::vector<std::string> steps;
+  if (p.resample) {
+    char buf[160];
+    std::snprintf(buf, sizeof buf, "resampling onto a uniform %.6g Hz grid (%s for irregular time stamps, ",
+                  p.resample->rateHz, toString(p.resample->method));
+    std::string text = buf;
+    if (p.resample->maxGapSeconds > 0.0)
+      text += "gaps up to " + durationText(p.resample->maxGapSeconds);
+    else
+      text += "gaps up to ten sample intervals";
+    std::snprintf(buf, sizeof buf, "; anti-alias FIR, %.0f dB)", p.resample->stopbandDb);
+    steps.push_back(text + buf);
+  }
   if (p.differentiateAngle)
     steps.push_back("motor velocity from the motor angle by central differences (the output)");
   if (p.range)

@@ -36,7 +36,7 @@ struct Session {
   // data of another experiment).
   std::vector<LogReference> logs;
   bool preprocessed = false;     // preprocessing applied (the options below are used)
-  PreprocessOptions preprocess;  // differentiate, range, decimate, detrend (Section 5.2)
+  PreprocessOptions preprocess;  // resample, differentiate, range, decimate, detrend (5.2)
   std::optional<SecondsRange> estimation, validation;
   // Sections of the registered parts by key (session_part.h); each is validated on load.
   nlohmann::json parts = nlohmann::json::object();

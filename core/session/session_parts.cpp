@@ -15,6 +15,7 @@
 #include "core/session/fit_request.h"
 #include "core/session/lqg_part.h"
 #include "core/session/model_json.h"
+#include "core/session/recursive_part.h"
 #include "core/session/session_part.h"
 #include "core/signal/preprocess.h"
 
@@ -194,6 +195,7 @@ const std::vector<std::shared_ptr<const SessionPart>>& sessionParts() {
       makeFitsPart(),
       makeDiscoveryPart(),
       makeLqgPart(),
+      makeRecursivePart(),
       std::make_shared<ViewPart>(),
   };
   return kParts;

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <cstring>
 #include <stdexcept>
 
 namespace flexarm {
@@ -115,6 +117,20 @@ SampleRange IdData::rangeForTimes(double t0, double t1) const {
   return {b, e};
 }
 
+std::size_t IdData::indexNear(double t) const {
+  const std::size_t n = samples();
+  if (n == 0) return 0;
+  if (timeStamps.empty()) {
+    const double pos = std::round((t - startTime) / sampleTime);
+    return pos <= 0.0 ? 0 : std::min(n - 1, static_cast<std::size_t>(pos));
+  }
+  const auto it = std::lower_bound(timeStamps.begin(), timeStamps.end(), t);
+  std::size_t i = static_cast<std::size_t>(it - timeStamps.begin());
+  if (i >= n) return n - 1;
+  if (i > 0 && std::abs(timeStamps[i - 1] - t) < std::abs(timeStamps[i] - t)) --i;
+  return i;
+}
+
 IdData IdData::select(SampleRange r) const {
   r.end = std::min(r.end, samples());
   r.begin = std::min(r.begin, r.end);
@@ -137,6 +153,12 @@ IdData IdData::select(SampleRange r) const {
   };
   out.estimationRange = shift(estimationRange);
   out.validationRange = shift(validationRange);
+  auto slice = [&](const auto& v, auto& into) {
+    if (v.size() == samples())
+      into.assign(v.begin() + static_cast<std::ptrdiff_t>(r.begin), v.begin() + static_cast<std::ptrdiff_t>(r.end));
+  };
+  slice(timeStamps, out.timeStamps);
+  slice(sourceLines, out.sourceLines);
   return out;
 }
 
@@ -148,12 +170,34 @@ bool IdData::isValid(std::string* why) const {
   if (!(sampleTime > 0.0) || !std::isfinite(sampleTime))
     return fail("the sample time must be positive and finite");
   const std::size_t n = samples();
+  if (!timeStamps.empty()) {
+    if (timeStamps.size() != n)
+      return fail("there are " + std::to_string(timeStamps.size()) + " time stamps for " +
+                  std::to_string(n) + " samples");
+    for (std::size_t i = 0; i < n; ++i)
+      if (!std::isfinite(timeStamps[i]))
+        return fail("the time stamp of sample " + std::to_string(i) + " is not finite");
+  }
+  if (!sourceLines.empty() && sourceLines.size() != n)
+    return fail("there are " + std::to_string(sourceLines.size()) + " source lines for " +
+                std::to_string(n) + " samples");
   for (const auto& c : channels) {
     if (c.values.size() != n)
       return fail("channel '" + c.name + "' has " + std::to_string(c.values.size()) +
                   " samples, expected " + std::to_string(n));
+    // A quick pass for long logs: a value is not finite when its exponent bits are all set,
+    // and then (and only then) adding 1 to the exponent field carries into the top bit.
+    // Integer adds and ors, which the compiler vectorises.
+    constexpr std::uint64_t kExponent = 0x7ff0000000000000ull, kExponentOne = 1ull << 52;
+    std::uint64_t carries = 0;
+    for (double v : c.values) {
+      std::uint64_t bits;
+      std::memcpy(&bits, &v, sizeof bits);
+      carries |= (bits & kExponent) + kExponentOne;
+    }
+    if (!(carries >> 63)) continue;
     for (std::size_t i = 0; i < n; ++i)
-      if (!std::isfinite(c.values[i]))
+      if (!std::isfinite(c.values[i]) && !(std::isnan(c.values[i]) && !timeStamps.empty()))
         return fail("channel '" + c.name + "' has a non-finite value at sample " +
                     std::to_string(i));
   }

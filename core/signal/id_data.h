@@ -52,11 +52,23 @@ class IdData {
   std::vector<std::pair<std::string, std::string>> metadata;  // in file order
   std::optional<SampleRange> estimationRange;
   std::optional<SampleRange> validationRange;
+  // Sampling instants of data that are not uniformly sampled (as SITB's SamplingInstants), one
+  // per sample in file order, with the file line of each (when read from a file); empty for
+  // uniform data, whose sample i lies at startTime + i sampleTime. Only reading with
+  // LogReadOptions::keepIrregularTime makes such data, and resampleToUniform
+  // (uniform_grid.h) is the step that turns them into uniform data; sampleTime is then the
+  // nominal interval. A NaN value marks a channel that was not sampled at that instant
+  // (channels logged at different rates).
+  std::vector<double> timeStamps;
+  std::vector<int> sourceLines;
 
   std::size_t samples() const { return channels.empty() ? 0 : channels.front().values.size(); }
   double sampleRateHz() const { return 1.0 / sampleTime; }
   double duration() const { return samples() == 0 ? 0.0 : (samples() - 1) * sampleTime; }
-  double timeAt(std::size_t i) const { return startTime + static_cast<double>(i) * sampleTime; }
+  double timeAt(std::size_t i) const {
+    return timeStamps.empty() ? startTime + static_cast<double>(i) * sampleTime : timeStamps[i];
+  }
+  bool isUniform() const { return timeStamps.empty(); }
 
   int indexOf(std::string_view name) const;
   const Channel* channel(std::string_view name) const;
@@ -78,11 +90,15 @@ class IdData {
 
   // The samples whose time lies in [t0, t1], clipped to the data.
   SampleRange rangeForTimes(double t0, double t1) const;
+  // The sample nearest to time t (the first at or after t among time stamps, which are
+  // searched as if sorted); 0 for empty data.
+  std::size_t indexNear(double t) const;
   // A copy holding only the samples in r; ranges are shifted and clipped to it.
   IdData select(SampleRange r) const;
 
-  // True when every channel has the same length, every value is finite and the sample time
-  // is positive; otherwise says why.
+  // True when every channel has the same length, every value is finite (or, for data with
+  // time stamps, NaN where a channel was not sampled), the time stamps are finite and the
+  // sample time is positive; otherwise says why.
   bool isValid(std::string* why = nullptr) const;
 };
 

@@ -1,6 +1,7 @@
 #include "core/signal/preprocess.h"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <complex>
 #include <stdexcept>
@@ -12,85 +13,13 @@ namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 
-double besselI0(double x) {
-  double sum = 1.0, term = 1.0;
-  const double q = x * x / 4.0;
-  for (int k = 1; k < 200; ++k) {
-    term *= q / (static_cast<double>(k) * k);
-    sum += term;
-    if (term < 1e-17 * sum) break;
-  }
-  return sum;
-}
-
-// Value of x extended beyond its ends by odd reflection: x(-i) = 2 x(0) - x(i).
-inline double extended(const std::vector<double>& x, long i) {
-  const long n = static_cast<long>(x.size());
-  if (i < 0) {
-    long j = std::min(-i, n - 1);
-    return 2.0 * x[0] - x[static_cast<std::size_t>(j)];
-  }
-  if (i >= n) {
-    long j = std::max(2 * (n - 1) - i, 0L);
-    return 2.0 * x[static_cast<std::size_t>(n - 1)] - x[static_cast<std::size_t>(j)];
-  }
-  return x[static_cast<std::size_t>(i)];
-}
-
-// Second-order section b0 + b1 z^-1 + b2 z^-2 over 1 + a1 z^-1 + a2 z^-2.
-struct Biquad {
-  double b0, b1, b2, a1, a2;
-};
-
-// Order-8 Chebyshev type I low-pass with the given ripple, cutoff in cycles per sample, by the
-// bilinear transform of the analog prototype (pole pairs -> biquads).
-std::vector<Biquad> chebyshevLowpass(int order, double rippleDb, double cutoff) {
-  const double eps = std::sqrt(std::pow(10.0, rippleDb / 10.0) - 1.0);
-  const double mu = std::asinh(1.0 / eps) / order;
-  const double wc = 2.0 * std::tan(kPi * cutoff);  // prewarped, T = 1
-  std::vector<Biquad> sections;
-  for (int k = 0; k < order / 2; ++k) {
-    const double theta = kPi * (2.0 * k + 1.0) / (2.0 * order);
-    const std::complex<double> p(-std::sinh(mu) * std::sin(theta), std::cosh(mu) * std::cos(theta));
-    const std::complex<double> pa = p * wc;  // analog pole, its conjugate is the pair
-    // H(s) = |pa|^2 / (s^2 - 2 Re(pa) s + |pa|^2), s = 2 (z - 1) / (z + 1).
-    const double w2 = std::norm(pa), c = -2.0 * pa.real();
-    const double a0 = 4.0 + 2.0 * c + w2;
-    Biquad b;
-    b.b0 = w2 / a0;
-    b.b1 = 2.0 * w2 / a0;
-    b.b2 = w2 / a0;
-    b.a1 = (2.0 * w2 - 8.0) / a0;
-    b.a2 = (4.0 - 2.0 * c + w2) / a0;
-    sections.push_back(b);
-  }
-  // Even-order Chebyshev I has DC gain 1/sqrt(1+eps^2); scale the first section so the DC gain
-  // is exactly 1 (the top of the ripple band, as MATLAB's cheby1 does not, but as the data's
-  // means should be kept).
-  double dc = 1.0;
-  for (const auto& s : sections) dc *= (s.b0 + s.b1 + s.b2) / (1.0 + s.a1 + s.a2);
-  sections[0].b0 /= dc;
-  sections[0].b1 /= dc;
-  sections[0].b2 /= dc;
-  return sections;
-}
-
-void runBiquads(const std::vector<Biquad>& sections, std::vector<double>& x) {
-  for (const auto& s : sections) {
-    double z1 = 0.0, z2 = 0.0;  // transposed direct form II
-    // Start in the steady state for the first value, so a constant passes untouched.
-    const double x0 = x.empty() ? 0.0 : x[0];
-    const double y0 = x0 * (s.b0 + s.b1 + s.b2) / (1.0 + s.a1 + s.a2);
-    z1 = y0 - s.b0 * x0;
-    z2 = s.b2 * x0 - s.a2 * y0;
-    for (double& v : x) {
-      const double in = v;
-      const double out = s.b0 * in + z1;
-      z1 = s.b1 * in - s.a1 * out + z2;
-      z2 = s.b2 * in - s.a2 * out;
-      v = out;
-    }
-  }
+// Decimation is the up = 1 case of the rational resampler.
+ResampleOptions resampleOptions(const DecimateOptions& d) {
+  ResampleOptions r;
+  r.down = d.factor;
+  r.filter = d.filter;
+  r.stopbandDb = d.stopbandDb;
+  return r;
 }
 
 }  // namespace
@@ -126,21 +55,6 @@ IdData addDerivative(const IdData& data, const std::string& from, const std::str
   return out;
 }
 
-const char* toString(AntiAliasFilter f) {
-  switch (f) {
-    case AntiAliasFilter::Fir: return "fir";
-    case AntiAliasFilter::Chebyshev: return "chebyshev";
-    case AntiAliasFilter::None: return "none";
-  }
-  return "fir";
-}
-
-std::optional<AntiAliasFilter> antiAliasFilterFromString(std::string_view s) {
-  for (AntiAliasFilter f : {AntiAliasFilter::Fir, AntiAliasFilter::Chebyshev, AntiAliasFilter::None})
-    if (s == toString(f)) return f;
-  return std::nullopt;
-}
-
 bool DecimateOptions::isValid(std::string* why) const {
   if (factor < 1) {
     if (why) *why = "the decimation factor must be 1 or more";
@@ -157,90 +71,29 @@ bool DecimateOptions::isValid(std::string* why) const {
   return true;
 }
 
-std::vector<double> designLowpassFir(double passEdge, double stopEdge, double attenuationDb) {
-  if (!(passEdge > 0.0 && stopEdge > passEdge && stopEdge <= 0.5))
-    throw std::invalid_argument("designLowpassFir: need 0 < passEdge < stopEdge <= 0.5");
-  const double width = 2.0 * kPi * (stopEdge - passEdge);
-  int taps = static_cast<int>(std::ceil((attenuationDb - 8.0) / (2.285 * width))) + 1;
-  if (taps % 2 == 0) ++taps;
-  const double beta = attenuationDb > 50.0   ? 0.1102 * (attenuationDb - 8.7)
-                      : attenuationDb >= 21.0 ? 0.5842 * std::pow(attenuationDb - 21.0, 0.4) +
-                                                    0.07886 * (attenuationDb - 21.0)
-                                              : 0.0;
-  const double fc = 0.5 * (passEdge + stopEdge);
-  const int m = taps / 2;
-  std::vector<double> h(static_cast<std::size_t>(taps));
-  const double i0beta = besselI0(beta);
-  double sum = 0.0;
-  for (int n = 0; n < taps; ++n) {
-    const double k = n - m;
-    const double ideal = k == 0 ? 2.0 * fc : std::sin(2.0 * kPi * fc * k) / (kPi * k);
-    const double r = static_cast<double>(k) / m;
-    const double w = besselI0(beta * std::sqrt(std::max(0.0, 1.0 - r * r))) / i0beta;
-    h[static_cast<std::size_t>(n)] = ideal * w;
-    sum += ideal * w;
-  }
-  for (double& v : h) v /= sum;
-  return h;
-}
-
 std::vector<double> decimate(const std::vector<double>& x, const DecimateOptions& options) {
   std::string why;
   if (!options.isValid(&why)) throw std::invalid_argument("decimate: " + why);
-  const int r = options.factor;
-  if (r == 1 || x.empty()) return x;
-  const std::size_t nOut = (x.size() + static_cast<std::size_t>(r) - 1) / static_cast<std::size_t>(r);
-  std::vector<double> y(nOut);
-  switch (options.filter) {
-    case AntiAliasFilter::None:
-      for (std::size_t k = 0; k < nOut; ++k) y[k] = x[k * static_cast<std::size_t>(r)];
-      return y;
-    case AntiAliasFilter::Fir: {
-      const double newNyquist = 0.5 / r;
-      const auto h = designLowpassFir(0.8 * newNyquist, newNyquist, options.stopbandDb);
-      const long m = static_cast<long>(h.size() / 2);
-      const long n = static_cast<long>(x.size());
-      for (std::size_t k = 0; k < nOut; ++k) {
-        const long c = static_cast<long>(k) * r;
-        double acc = 0.0;
-        if (c - m >= 0 && c + m < n) {
-          const double* p = x.data() + (c - m);
-          for (std::size_t j = 0; j < h.size(); ++j) acc += h[j] * p[j];
-        } else {
-          for (long j = -m; j <= m; ++j) acc += h[static_cast<std::size_t>(j + m)] * extended(x, c + j);
-        }
-        y[k] = acc;
-      }
-      return y;
-    }
-    case AntiAliasFilter::Chebyshev: {
-      const auto sections = chebyshevLowpass(8, 0.05, 0.8 * 0.5 / r);
-      // Pad both ends by odd reflection, filter forward and backward, cut the padding.
-      const long n = static_cast<long>(x.size());
-      const long pad = std::min<long>(n - 1, 24L * r);
-      std::vector<double> w;
-      w.reserve(static_cast<std::size_t>(n + 2 * pad));
-      for (long i = -pad; i < n + pad; ++i) w.push_back(extended(x, i));
-      runBiquads(sections, w);
-      std::reverse(w.begin(), w.end());
-      runBiquads(sections, w);
-      std::reverse(w.begin(), w.end());
-      for (std::size_t k = 0; k < nOut; ++k) y[k] = w[static_cast<std::size_t>(pad) + k * static_cast<std::size_t>(r)];
-      return y;
-    }
-  }
-  return y;
+  return resample(x, resampleOptions(options));
 }
 
 IdData decimate(const IdData& data, const DecimateOptions& options) {
   std::string why;
   if (!options.isValid(&why)) throw std::invalid_argument("decimate: " + why);
+  if (!data.isUniform())
+    throw std::invalid_argument("decimate: the data have irregular time stamps; resample them first");
   if (options.factor == 1) return data;
   IdData out;
   out.sampleTime = data.sampleTime * options.factor;
   out.startTime = data.startTime;
   out.metadata = data.metadata;
-  for (const auto& c : data.channels) out.channels.push_back({c.name, c.unit, c.role, decimate(c.values, options)});
+  std::vector<const std::vector<double>*> inputs;
+  for (const auto& c : data.channels) inputs.push_back(&c.values);
+  auto outputs = resample(inputs, resampleOptions(options));
+  for (std::size_t i = 0; i < data.channels.size(); ++i) {
+    const Channel& c = data.channels[i];
+    out.channels.push_back({c.name, c.unit, c.role, std::move(outputs[i])});
+  }
   const std::size_t r = static_cast<std::size_t>(options.factor);
   auto scale = [&](const std::optional<SampleRange>& in) -> std::optional<SampleRange> {
     if (!in) return std::nullopt;
@@ -353,6 +206,7 @@ AmplitudeSpectrum amplitudeSpectrum(const std::vector<double>& x, double sampleT
 }
 
 bool PreprocessOptions::isValid(std::string* why) const {
+  if (resample && !resample->isValid(why)) return false;
   if (!decimation.isValid(why)) return false;
   if (range && range->empty()) {
     if (why) *why = "the selected range is empty";
@@ -361,14 +215,63 @@ bool PreprocessOptions::isValid(std::string* why) const {
   return true;
 }
 
-IdData preprocess(const IdData& data, const PreprocessOptions& options) {
+PreprocessResult runPreprocess(const IdData& data, const PreprocessOptions& options,
+                               const ProgressCallback& progress,
+                               const std::vector<const IdData*>& otherLogs) {
+  const auto t0 = std::chrono::steady_clock::now();
   std::string why;
   if (!options.isValid(&why)) throw std::invalid_argument("preprocess: " + why);
-  IdData d = options.differentiateAngle ? addDerivative(data) : data;
-  if (options.range) d = d.select(*options.range);
+  if (!otherLogs.empty() && !options.resample)
+    throw std::invalid_argument("preprocess: further logs join only through the resampling step");
+  PreprocessResult r;
+  auto finish = [&](Termination t, std::string message) {
+    r.termination = t;
+    r.message = std::move(message);
+    r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    return std::move(r);
+  };
+  IdData d;
+  if (options.resample) {
+    std::vector<const IdData*> logs{&data};
+    logs.insert(logs.end(), otherLogs.begin(), otherLogs.end());
+    UniformGridResult u = resampleToUniform(logs, *options.resample, progress);
+    if (u.termination != Termination::Converged) {
+      std::string message = u.message;
+      r.resampling = std::move(u);  // its time-stamp report shows where the problem is
+      return finish(r.resampling->termination, message);
+    }
+    d = std::move(u.data);
+    u.data = IdData{};
+    r.resampling = std::move(u);
+  } else if (!data.isUniform()) {
+    TimingOptions to;
+    const TimingReport timing = analyzeTiming(data.timeStamps, data.sourceLines, to);
+    return finish(Termination::Failed, "the time stamps are irregular (" + timing.summary() +
+                                           "): resample the log onto a uniform grid first");
+  } else {
+    d = data;
+  }
+  if (options.differentiateAngle) {
+    if (!d.channel(columns::kMotorAngle))
+      return finish(Termination::Failed, "differentiation needs a motor_angle_rad channel");
+    d = addDerivative(d);
+  }
+  if (options.range) {
+    if (options.range->end > d.samples())
+      return finish(Termination::Failed, "the range ends at sample " + std::to_string(options.range->end) +
+                                             " but the data have " + std::to_string(d.samples()));
+    d = d.select(*options.range);
+  }
   d = decimate(d, options.decimation);
   if (options.detrend != Detrend::None) d = detrend(d, options.detrend);
-  return d;
+  r.data = std::move(d);
+  return finish(Termination::Converged, r.resampling ? r.resampling->message : std::string());
+}
+
+IdData preprocess(const IdData& data, const PreprocessOptions& options) {
+  PreprocessResult r = runPreprocess(data, options);
+  if (r.termination != Termination::Converged) throw std::invalid_argument(r.message);
+  return std::move(r.data);
 }
 
 }  // namespace flexarm

@@ -5,6 +5,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <string>
+#include <utility>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -23,6 +24,21 @@ inline std::string readAll(const std::string& path) {
     while ((n = std::fread(buf.data(), 1, buf.size(), f)) > 0) text.append(buf.data(), n);
     std::fclose(f);
   }
+  return text;
+}
+
+// The text of a rendered PDF (pdftotext -layout, written beside it); empty when pdftotext
+// failed. The PDF's font sets "ff", "fi", "fl", "ffi" and "ffl" as ligatures: they are read
+// back as letters.
+inline std::string pdfText(const std::string& pdf) {
+  const std::string txt = pdf + ".txt";
+  const std::string cmd = "pdftotext -layout '" + pdf + "' '" + txt + "'";
+  if (std::system(cmd.c_str()) != 0) return {};
+  std::string text = readAll(txt);
+  for (const auto& [lig, letters] :
+       {std::pair<std::string, std::string>{"\xef\xac\x80", "ff"}, {"\xef\xac\x81", "fi"},
+        {"\xef\xac\x82", "fl"}, {"\xef\xac\x83", "ffi"}, {"\xef\xac\x84", "ffl"}})
+    for (std::size_t at; (at = text.find(lig)) != std::string::npos;) text.replace(at, lig.size(), letters);
   return text;
 }
 

@@ -9,6 +9,7 @@
 
 #include "cli_test_support.h"
 
+using flexarm::test::pdfText;
 using flexarm::test::readAll;
 using flexarm::test::runFlexarm;
 using flexarm::test::scratchDir;
@@ -20,20 +21,6 @@ const std::string kMultisine =
     std::string(FLEXARM_SAMPLE_DIR) + "/three_mass_validation_multisine.csv";
 
 // This build renders reports (the GUI build); a build without Qt refuses --report clearly.
-
-// The text of a rendered PDF (used where the build renders reports).
-[[maybe_unused]] std::string pdfText(const std::string& pdf) {
-  const std::string txt = pdf + ".txt";
-  const std::string cmd = "pdftotext -layout '" + pdf + "' '" + txt + "'";
-  EXPECT_EQ(std::system(cmd.c_str()), 0) << cmd;
-  // The PDF's font sets "ff", "fi", "fl", "ffi" and "ffl" as ligatures; read them as letters.
-  std::string text = readAll(txt);
-  for (const auto& [lig, letters] :
-       {std::pair<std::string, std::string>{"\xef\xac\x80", "ff"}, {"\xef\xac\x81", "fi"},
-        {"\xef\xac\x82", "fl"}, {"\xef\xac\x83", "ffi"}, {"\xef\xac\x84", "ffl"}})
-    for (std::size_t at; (at = text.find(lig)) != std::string::npos;) text.replace(at, lig.size(), letters);
-  return text;
-}
 
 }  // namespace
 

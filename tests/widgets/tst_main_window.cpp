@@ -2,7 +2,9 @@
 // checks what the panels show, with screenshots of the window and the Arm dock.
 #include <QApplication>
 #include <QDir>
+#include <QMessageBox>
 #include <QMimeData>
+#include <QPushButton>
 #include <QSignalSpy>
 #include <QStandardPaths>
 #include <QTableWidget>
@@ -140,7 +142,7 @@ class MainWindowTest : public QObject {
     QVERIFY(view->isVisible());
     const QImage before = view->grabFramebuffer();
     test::saveShot(before, "arm_view");
-    QVERIFY2(test::orangeFraction(before) > 0.01,
+    QVERIFY2(test::orangeFraction(before) > 0.005,  // the camera keeps the whole sweep of the tool in view
              qPrintable(QString("orange fraction %1").arg(test::orangeFraction(before))));
     // Dragging with the mouse rotates the camera: the picture changes.
     QTest::mousePress(view, Qt::LeftButton, Qt::NoModifier, QPoint(60, 60));
@@ -149,7 +151,7 @@ class MainWindowTest : public QObject {
     const QImage after = view->grabFramebuffer();
     test::saveShot(after, "arm_view_rotated");
     QVERIFY(test::differingPixels(before, after) > before.width() * before.height() / 50);
-    QVERIFY(test::orangeFraction(after) > 0.01);
+    QVERIFY(test::orangeFraction(after) > 0.005);
   }
 
   void preprocessingDecimates() {
@@ -196,6 +198,15 @@ class MainWindowTest : public QObject {
     for (const QString& name : logs) {
       QSignalSpy opened(window_, &MainWindow::logOpened);
       window_->openFile(QString(FLEXARM_SAMPLE_DIR) + "/" + name);
+      if (name.contains("irregular_timing")) {
+        // Refused as read; opened as recorded when the engineer accepts, awaiting resampling.
+        QTRY_VERIFY_WITH_TIMEOUT(test::findBox("irregularTimeBox") != nullptr, 20000);
+        test::findBox("irregularTimeBox")->button(QMessageBox::Open)->click();
+        QVERIFY2(opened.wait(20000), qPrintable(name));
+        QVERIFY(window_->workspace()->needsResampling());
+        QVERIFY(window_->workspace()->raw()->input() != nullptr);
+        continue;
+      }
       QVERIFY2(opened.wait(20000), qPrintable(name));
       QVERIFY2(window_->logPanel()->channelCount() >= 3, qPrintable(name));
       QVERIFY(window_->workspace()->current()->input() != nullptr);

@@ -161,22 +161,32 @@ class PlayheadTest : public QObject {
     Playhead* p = window_->playhead();
     ArmScene* scene = window_->armPanel()->scene();
     p->setTime(12.0);
-    const double axisBefore = scene->axisOne();
+    const double axisBefore = scene->drawnAngle(ArmPart::Arm);
     p->setTime(14.5);
     QCOMPARE(window_->logPanel()->playheadCursor()->shownTime(), 14.5);
     QVERIFY(window_->logPanel()->playheadCursor()->isInView());
     QCOMPARE(window_->comparePanel()->playheadCursor()->shownTime(), 14.5);
     QVERIFY(window_->comparePanel()->playheadCursor()->isInView());
-    QVERIFY2(window_->armPanel()->labelText().startsWith("t = 14.500 s"),
-             qPrintable(window_->armPanel()->labelText()));
-    QVERIFY(scene->axisOne() != axisBefore);
+    // Every time plot of the window (Log, Compare, the Model panel's simulation, Discovery's
+    // residuals and overlay) holds its cursor at the playhead.
+    const auto cursors = window_->findChildren<PlayheadCursor*>();
+    QVERIFY2(cursors.size() >= 5, qPrintable(QString::number(cursors.size())));
+    for (const PlayheadCursor* c : cursors) {
+      QCOMPARE(c->playhead(), p);
+      QCOMPARE(c->shownTime(), 14.5);
+    }
+    QVERIFY2(window_->armPanel()->statusText().startsWith("t = 14.500 s"),
+             qPrintable(window_->armPanel()->statusText()));
+    QVERIFY(scene->drawnAngle(ArmPart::Arm) != axisBefore);
     // The arm shows the log's motor angle at that time, through the gear.
     const IdData* d = window_->workspace()->raw();
     const std::size_t i = static_cast<std::size_t>(std::llround((14.5 - d->startTime) / d->sampleTime));
     const double motor = d->channel(columns::kMotorAngle)->values[i];
     const std::string r = d->meta("gear_ratio");
     const double gear = r.empty() ? 1.0 / 118.0 : std::stod(r);
-    QVERIFY(std::abs(scene->axisOne() - 100.0 * gear * motor) < 1e-12);
+    QCOMPARE(scene->pose().motor, motor);
+    const double drawn = window_->armPanel()->magnification() * gear * motor;
+    QVERIFY(std::abs(scene->drawnAngle(ArmPart::Arm) - drawn) < 1e-12);
     QCOMPARE(window_->transportBar()->slider()->value(),
              static_cast<int>(std::lround((14.5 - p->start()) / (p->end() - p->start()) * 100000)));
   }

@@ -61,13 +61,6 @@ bool clickEstimate(FitPanel* fit) {
   return done.takeFirst().at(0).toBool();
 }
 
-QMessageBox* findBox(const char* name) {
-  for (QWidget* w : QApplication::topLevelWidgets())
-    if (auto* box = qobject_cast<QMessageBox*>(w); box && box->objectName() == name && box->isVisible())
-      return box;
-  return nullptr;
-}
-
 }  // namespace
 
 class SessionTest : public QObject {
@@ -255,7 +248,7 @@ class SessionTest : public QObject {
       QVERIFY(failed.wait(30000));
       const QString message = failed.first().first().toString();
       QVERIFY2(message.contains(words), qPrintable(message));
-      QMessageBox* box = findBox("sessionErrorBox");
+      QMessageBox* box = test::findBox("sessionErrorBox");
       QVERIFY(box != nullptr);
       QVERIFY(box->text().contains(words));
       if (path == newer) test::saveShot(box->grab().toImage(), "session-newer-refused");
@@ -302,7 +295,7 @@ class SessionTest : public QObject {
     std::unique_ptr<MainWindow> next(newWindow());
     QSignalSpy offered(next->sessionController(), &SessionController::recoveryOffered);
     QVERIFY(offered.wait(5000));
-    QMessageBox* box = findBox("recoverBox");
+    QMessageBox* box = test::findBox("recoverBox");
     QVERIFY(box != nullptr);
     test::saveShot(box->grab().toImage(), "session-recover");
     QSignalSpy opened(next->sessionController(), &SessionController::sessionOpened);

@@ -3,6 +3,7 @@
 #include <QApplication>
 #include <QDir>
 #include <QImage>
+#include <QMessageBox>
 #include <QMouseEvent>
 #include <QString>
 #include <QWidget>
@@ -17,6 +18,14 @@ inline QString saveShot(const QImage& image, const QString& name) {
   const QString path = QString(FLEXARM_SCREENSHOT_DIR) + "/" + name + ".png";
   image.save(path);
   return path;
+}
+
+// The visible message box with this object name, or null.
+inline QMessageBox* findBox(const char* name) {
+  for (QWidget* w : QApplication::topLevelWidgets())
+    if (auto* box = qobject_cast<QMessageBox*>(w); box && box->objectName() == name && box->isVisible())
+      return box;
+  return nullptr;
 }
 
 // A mouse move delivered straight to the widget (with the buttons held), so no other window

@@ -284,3 +284,51 @@ TEST(Replay, SubstitutedAndChangedLogsAreNamed) {
   EXPECT_EQ(missing.termination, Termination::Failed);
   EXPECT_NE(missing.message.find("no_such_log.csv"), std::string::npos) << missing.message;
 }
+
+TEST(Session, ResamplingStepRoundTripsAndReplaysTheIrregularLog) {
+  // The irregular sample log, read as recorded and put on a 2 kHz grid by the session.
+  const fs::path dir = scratch() / "resampled";
+  fs::create_directories(dir);
+  fs::copy_file(std::string(FLEXARM_SAMPLE_DIR) + "/three_mass_irregular_timing.csv", dir / "log.csv",
+                fs::copy_options::overwrite_existing);
+  Session s;
+  LogReference ref;
+  ref.name = "estimation";
+  ref.path = "log.csv";
+  ref.sha256 = sha256OfFile((dir / "log.csv").string(), nullptr).value_or("");
+  ref.read.keepIrregularTime = true;
+  s.logs.push_back(ref);
+  s.preprocessed = true;
+  UniformGridOptions u;
+  u.rateHz = 2000;
+  u.method = InterpolationMethod::Pchip;
+  u.maxGapSeconds = 0.004;
+  s.preprocess.resample = u;
+  s.preprocess.decimation.factor = 10;
+  const std::string text = toJsonText(s);
+  auto back = parseSession(text);
+  ASSERT_TRUE(back.ok) << back.message;
+  EXPECT_EQ(toJsonText(back.session), text);
+  ASSERT_TRUE(back.session.preprocess.resample);
+  EXPECT_EQ(*back.session.preprocess.resample, u);
+  EXPECT_TRUE(back.session.logs[0].read.keepIrregularTime);
+  const auto steps = describePreprocessing(back.session.preprocess);
+  ASSERT_EQ(steps.size(), 2u);
+  EXPECT_EQ(steps[0], "resampling onto a uniform 2000 Hz grid (pchip for irregular time stamps, gaps up to 4 ms; "
+                      "anti-alias FIR, 80 dB)");
+  // Replayed, the log is read as recorded, resampled and decimated: 12000 -> 1200 samples.
+  const std::string path = (dir / "session.json").string();
+  std::string why;
+  ASSERT_TRUE(saveSession(back.session, path, &why)) << why;
+  const ReplayResult r = replaySession(back.session, path);
+  ASSERT_EQ(r.termination, Termination::Converged) << r.message;
+  const nlohmann::json report = r.report.toJson();
+  const auto* data = sectionValues(report, "Data");
+  ASSERT_NE(data, nullptr);
+  EXPECT_EQ((*data)["samples"].get<std::size_t>(), 1200u);
+  // Without keeping the irregular stamps, the log is refused as when opened.
+  back.session.logs[0].read.keepIrregularTime = false;
+  const ReplayResult refused = replaySession(back.session, path);
+  EXPECT_EQ(refused.termination, Termination::Failed);
+  EXPECT_NE(refused.message.find("does not increase"), std::string::npos) << refused.message;
+}

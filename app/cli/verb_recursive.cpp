@@ -1,0 +1,265 @@
+// flexarm recursive LOG --model three-mass [--param NAME=V ...] --estimate k_T,J_a,f_m
+//                   [--algorithm forgetting|kalman] [--lambda 0.995] [--r1 a,b,c] [--r2 v]
+//                   [--start-scale 1.2] [--gradient sensitivity|difference]
+//                   [--decimate N] [--out trajectory.csv] [--json]
+#include <charconv>
+#include <cmath>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <ostream>
+
+#include "app/cli/cli.h"
+#include "app/cli/log_args.h"
+#include "app/cli/model_args.h"
+#include "core/recursive/recursive_log.h"
+
+namespace flexarm::cli {
+namespace {
+
+const char* kRecursiveHelp =
+    "Usage: flexarm recursive LOG --model three-mass [--param NAME=V ...] --estimate k_T,J_a,f_m\n"
+    "                         [--algorithm forgetting|kalman] [--lambda 0.995] [--r1 a,b,c]\n"
+    "                         [--r2 v] [--start-scale 1.2] [--gradient sensitivity|difference]\n"
+    "                         [--decimate N] [--out trajectory.csv] [--json]\n\n"
+    "Estimates physical parameters recursively, sample by sample, as the seed's chapter 6 does:\n"
+    "the recursive prediction-error method on the continuous-time model sampled with a\n"
+    "zero-order hold at the current estimate every sample, its gradient from the sensitivity\n"
+    "system (6.27). The log is prepared as for a fit: the motor velocity from the motor angle\n"
+    "(central differences at the log's rate), decimated to 200 Hz (the seed's rate) behind the\n"
+    "anti-alias filter, means removed. P(0) is chosen as the seed does (Section 6.6.2): the P\n"
+    "update run at the nominal parameters, its diagonal averaged.\n\n"
+    "  --model NAME          the structure (default three-mass); nominal values are its\n"
+    "                        defaults (three-mass: Table 5.7 p6) or a fit's (--nominal)\n"
+    "  --param NAME=VALUE    set a nominal parameter (repeatable)\n"
+    "  --nominal FILE.json   the nominal model from `flexarm fit --json` (or a session's\n"
+    "                        model): its structure and parameter values\n"
+    "  --estimate A,B,...    parameters to estimate (default k_T,J_a,f_m, the seed's); the\n"
+    "                        others stay at their nominal values. theta holds J_a as J_a^-1\n"
+    "                        as the seed does (see --invert); results use the model's names\n"
+    "  --invert A,B|none     parameters theta holds as inverses (default J_a); NAME^-1 in\n"
+    "                        --estimate does the same\n"
+    "  --algorithm NAME      forgetting (Algorithm 6.1, default) or kalman (Algorithm 6.2)\n"
+    "  --lambda L            forgetting factor (default 0.995)\n"
+    "  --r1 a,b,c            diag R1 of Algorithm 6.2, one per estimated parameter (default\n"
+    "                        (6.54): 5e-8, 5e-7, 5e-6 for k_T, J_a^-1, f_m)\n"
+    "  --r2 V                R2 of Algorithm 6.2 (default 1)\n"
+    "  --mu M                regularisation (6.9) (default 0)\n"
+    "  --start-scale S       theta(0) = S * nominal (the seed starts 20 % above: 1.2; default 1)\n"
+    "  --p0 a,b,c            diag P(0) (default: the seed's pre-run)\n"
+    "  --gradient KIND       sensitivity ((6.27), default) or difference ((6.33); can diverge\n"
+    "                        for an output-error model, Example 6.1)\n"
+    "  --decimate N          decimation factor (default: to 200 Hz, 10 on a 2 kHz log)\n"
+    "  --range A:B           use the log from A to B seconds (default: all of it)\n"
+    "  --out FILE.csv        write the trajectory: time_s, theta, sigma per parameter, y, yhat,\n"
+    "                        epsilon\n"
+    "  --json                print the result as JSON\n\n"
+    "JSON fields: final and std (the model's names: J_a even when theta holds J_a^-1), theta\n"
+    "{name: {nominal, start, final, std}} (theta's names), nominal, start, termination, message,\n"
+    "caveat, samples, sample_time_s, decimation, preparation, algorithm, gradient, p0,\n"
+    "psi_variance (diag Q (6.53)), rms_prediction_error, seconds, out.\n"
+    "Exit status: 0 the estimates stayed within their bounds, 2 usage, 3 bad log, 4 the\n"
+    "estimate left its bounds or P blew up (the message says when; the trajectory up to there\n"
+    "is written).\n";
+
+// A comma-separated list of numbers; false with a sentence for anything else.
+bool parseNumbers(const std::string& option, const std::string& text, std::vector<double>& out,
+                  std::string* why) {
+  out.clear();
+  for (const auto& item : splitList(text)) {
+    double v = 0.0;
+    const auto r = std::from_chars(item.data(), item.data() + item.size(), v);
+    if (r.ec != std::errc() || r.ptr != item.data() + item.size() || !std::isfinite(v)) {
+      *why = "--" + option + " expects numbers separated by commas, not '" + text + "'";
+      return false;
+    }
+    out.push_back(v);
+  }
+  if (out.empty()) {
+    *why = "--" + option + " expects numbers separated by commas";
+    return false;
+  }
+  return true;
+}
+
+nlohmann::json byName(const RecursiveResult& r, double RecursiveEstimate::*field) {
+  nlohmann::json j = nlohmann::json::object();
+  for (const auto& e : r.estimates) j[e.parameter.modelName] = e.*field;
+  return j;
+}
+
+}  // namespace
+
+int runRecursive(const std::vector<std::string>& argv, std::ostream& out, std::ostream& err) {
+  std::vector<std::string> valued = logReadOptionNames();
+  for (const char* n : {"model", "param", "nominal", "estimate", "invert", "algorithm", "lambda",
+                        "r1", "r2", "mu", "start-scale", "p0", "gradient", "decimate", "range",
+                        "out"})
+    valued.push_back(n);
+  ArgParser args({"json", "help"}, valued);
+  const std::string pre = "flexarm recursive: ";
+  if (!args.parse(argv)) {
+    err << pre << args.error() << "\n" << kRecursiveHelp;
+    return kExitUsage;
+  }
+  if (args.flag("help")) {
+    out << kRecursiveHelp << "\n" << logReadOptionsHelp();
+    return kExitOk;
+  }
+  if (args.positional().size() != 1) {
+    err << pre << "expected exactly one LOG\n";
+    return kExitUsage;
+  }
+
+  // The nominal model: a fit's JSON or the structure's defaults, then --param.
+  std::unique_ptr<PhysicalModel> model;
+  if (auto file = args.value("nominal")) {
+    std::string why;
+    model = modelFromFile(*file, &why);
+    if (!model) {
+      err << "flexarm: " << *file << ": " << why << "\n";
+      return kExitBadInput;
+    }
+    if (auto m = args.value("model"); m && *m != model->structureName()) {
+      err << pre << "--model " << *m << " differs from the " << model->structureName()
+          << " model of " << *file << "\n";
+      return kExitUsage;
+    }
+    if (!applyParams(args, *model, "recursive", err)) return kExitUsage;
+  } else {
+    model = modelFromArgs(args, "recursive", err);
+    if (!model) return kExitUsage;
+  }
+
+  RecursiveOptions o;
+  std::string why;
+  if (auto e = args.value("estimate")) o.estimate = splitList(*e);
+  if (auto inv = args.value("invert")) o.inverted = *inv == "none" ? std::vector<std::string>{} : splitList(*inv);
+  if (auto a = args.value("algorithm")) {
+    const auto parsed = recursiveAlgorithmFromString(*a);
+    if (!parsed) {
+      err << pre << "--algorithm must be forgetting or kalman, not '" << *a << "'\n";
+      return kExitUsage;
+    }
+    o.algorithm = *parsed;
+  }
+  if (auto g = args.value("gradient")) {
+    const auto parsed = recursiveGradientFromString(*g);
+    if (!parsed) {
+      err << pre << "--gradient must be sensitivity or difference, not '" << *g << "'\n";
+      return kExitUsage;
+    }
+    o.gradient = *parsed;
+  }
+  if (!args.number("lambda", o.lambda) || !args.number("r2", o.r2) || !args.number("mu", o.mu) ||
+      !args.number("start-scale", o.startScale)) {
+    err << pre << args.error() << "\n";
+    return kExitUsage;
+  }
+  if (auto v = args.value("r1"); v && !parseNumbers("r1", *v, o.r1, &why)) {
+    err << pre << why << "\n";
+    return kExitUsage;
+  }
+  if (auto v = args.value("p0"); v && !parseNumbers("p0", *v, o.p0, &why)) {
+    err << pre << why << "\n";
+    return kExitUsage;
+  }
+  if (!o.isValid(&why)) {
+    err << pre << why << "\n";
+    return kExitUsage;
+  }
+  RecursiveDataOptions d;
+  long decimation = 0;
+  if (!args.integer("decimate", decimation)) {
+    err << pre << args.error() << "\n";
+    return kExitUsage;
+  }
+  if (args.value("decimate") && decimation < 1) {
+    err << pre << "--decimate must be at least 1\n";
+    return kExitUsage;
+  }
+  d.decimation = static_cast<int>(decimation);
+  if (auto r = args.value("range")) {
+    d.range = secondsRangeFromText(*r, &why);
+    if (!d.range) {
+      err << pre << "--range: " << why << "\n";
+      return kExitUsage;
+    }
+  }
+
+  auto readOptions = logReadOptions(args, err);
+  if (!readOptions) return kExitUsage;
+  const std::string& path = args.positional()[0];
+  LogReadResult log = readLog(path, *readOptions);
+  if (!log.ok) {
+    err << "flexarm: " << log.error.toString() << "\n";
+    return kExitBadInput;
+  }
+  const RecursiveLogResult run = recursiveIdentification(log.data, *model, d, o);
+  const RecursiveResult& r = run.result;
+  if (r.termination == Termination::Failed) {
+    err << "flexarm: " << path << ": " << r.message << "\n";
+    return kExitBadInput;
+  }
+  const auto outPath = args.value("out");
+  if (outPath && !writeTrajectoryCsv(r, *outPath, &why)) {
+    err << "flexarm: " << *outPath << ": " << why << "\n";
+    return kExitBadInput;
+  }
+  const int status = r.termination == Termination::Diverged ? kExitNumerical : kExitOk;
+
+  if (!args.flag("json")) {
+    out << model->structureName() << ", " << toString(o.algorithm) << ", "
+        << toString(o.gradient) << " gradient: " << toString(r.termination) << "\n"
+        << r.message << "\n";
+    for (const auto& e : r.estimates) {
+      char line[200];
+      std::snprintf(line, sizeof line, "  %-6s = %-12.6g +- %-10.3g (start %.6g, nominal %.6g)\n",
+                    e.parameter.modelName.c_str(), e.modelFinal, e.modelSigma, e.modelStart,
+                    e.modelNominal);
+      out << line;
+    }
+    out << "samples " << r.samples << " at " << 1.0 / run.sampleTime << " Hz (" << run.preparation
+        << "), " << r.seconds << " s\n";
+    if (!r.caveat.empty()) out << "note: " << r.caveat << "\n";
+    return status;
+  }
+  nlohmann::json theta = nlohmann::json::object();
+  for (const auto& e : r.estimates)
+    theta[e.parameter.name] = {{"nominal", e.parameter.nominal}, {"start", e.start},
+                               {"final", e.final},               {"std", e.sigma},
+                               {"unit", e.parameter.unit},       {"spread", e.spread}};
+  nlohmann::json p0 = nlohmann::json::object(), psi = nlohmann::json::object();
+  for (std::size_t i = 0; i < r.estimates.size(); ++i) {
+    const auto k = static_cast<Eigen::Index>(i);
+    p0[r.estimates[i].parameter.name] = r.p0[k];
+    psi[r.estimates[i].parameter.name] = r.Q.size() ? nlohmann::json(r.Q(k, k)) : nlohmann::json();
+  }
+  nlohmann::json j = {{"model", model->structureName()},
+                      {"final", byName(r, &RecursiveEstimate::modelFinal)},
+                      {"std", byName(r, &RecursiveEstimate::modelSigma)},
+                      {"nominal", byName(r, &RecursiveEstimate::modelNominal)},
+                      {"start", byName(r, &RecursiveEstimate::modelStart)},
+                      {"theta", theta},
+                      {"termination", toString(r.termination)},
+                      {"message", r.message},
+                      {"caveat", r.caveat.empty() ? nlohmann::json() : nlohmann::json(r.caveat)},
+                      {"samples", r.samples},
+                      {"sample_time_s", run.sampleTime},
+                      {"decimation", run.decimation},
+                      {"preparation", run.preparation},
+                      {"algorithm", toString(o.algorithm)},
+                      {"gradient", toString(o.gradient)},
+                      {"lambda", o.lambda},
+                      {"r2", o.r2},
+                      {"mu", o.mu},
+                      {"p0", p0},
+                      {"psi_variance", psi},
+                      {"rms_prediction_error", r.rmsEpsilon},
+                      {"prediction_error_lag1", r.epsilonLag1},
+                      {"seconds", r.seconds},
+                      {"out", outPath ? nlohmann::json(*outPath) : nlohmann::json()}};
+  out << j.dump(2) << "\n";
+  return status;
+}
+
+}  // namespace flexarm::cli

@@ -1,0 +1,91 @@
+// Names, option checks and the trajectory container of the recursive estimator.
+#include <cmath>
+
+#include "core/recursive/rpem.h"
+
+namespace flexarm {
+
+const char* toString(RecursiveAlgorithm a) {
+  return a == RecursiveAlgorithm::Kalman ? "kalman" : "forgetting";
+}
+std::optional<RecursiveAlgorithm> recursiveAlgorithmFromString(std::string_view s) {
+  for (auto a : {RecursiveAlgorithm::ForgettingFactor, RecursiveAlgorithm::Kalman})
+    if (s == toString(a)) return a;
+  return std::nullopt;
+}
+
+const char* toString(RecursiveGradient g) {
+  return g == RecursiveGradient::Difference ? "difference" : "sensitivity";
+}
+std::optional<RecursiveGradient> recursiveGradientFromString(std::string_view s) {
+  for (auto g : {RecursiveGradient::Sensitivity, RecursiveGradient::Difference})
+    if (s == toString(g)) return g;
+  return std::nullopt;
+}
+
+bool RecursiveOptions::isValid(std::string* why) const {
+  auto fail = [&](const std::string& text) {
+    if (why) *why = text;
+    return false;
+  };
+  if (why) why->clear();
+  for (std::size_t i = 0; i < estimate.size(); ++i)
+    for (std::size_t j = 0; j < i; ++j)
+      if (estimate[i] == estimate[j]) return fail("'" + estimate[i] + "' is listed twice");
+  if (!(lambda > 0.0 && lambda <= 1.0)) return fail("the forgetting factor must lie in (0, 1]");
+  if (!(r2 > 0.0) || !std::isfinite(r2)) return fail("R2 must be a positive number");
+  for (double v : r1)
+    if (!(v >= 0.0) || !std::isfinite(v)) return fail("R1's diagonal must not be negative");
+  if (!r1.empty() && r1.size() != estimate.size())
+    return fail("R1 needs one value per estimated parameter");
+  if (!(mu >= 0.0) || !std::isfinite(mu)) return fail("the regularisation mu must not be negative");
+  if (!(differenceStep > 0.0) || !std::isfinite(differenceStep))
+    return fail("the difference step must be positive");
+  if (!(startScale > 0.0) || !std::isfinite(startScale))
+    return fail("the start scale must be a positive number");
+  if (!thetaStart.empty() && thetaStart.size() != estimate.size())
+    return fail("theta(0) needs one value per estimated parameter");
+  for (double v : thetaStart)
+    if (!std::isfinite(v)) return fail("theta(0) must be finite");
+  if (!p0.empty() && p0.size() != estimate.size())
+    return fail("P(0) needs one value per estimated parameter");
+  for (double v : p0)
+    if (!(v > 0.0) || !std::isfinite(v)) return fail("P(0)'s diagonal must be positive");
+  if (!(noiseVariance >= 0.0) || !std::isfinite(noiseVariance))
+    return fail("the noise variance must not be negative");
+  if (!(covarianceLimit > 1.0)) return fail("the covariance limit must exceed 1");
+  if (!(maxHeldSeconds >= 0.0)) return fail("the time held at the bounds must not be negative");
+  return true;
+}
+
+void RecursiveTrajectory::reserve(std::size_t samples, std::size_t parameters) {
+  for (auto* v : {&time, &y, &yhat, &epsilon, &noiseVariance}) v->reserve(samples);
+  for (auto* m : {&theta, &pDiagonal, &sigma}) {
+    m->resize(parameters);
+    for (auto& v : *m) v.reserve(samples);
+  }
+}
+
+void RecursiveTrajectory::append(const RecursiveStep& s) {
+  const auto p = static_cast<std::size_t>(s.theta.size());
+  for (auto* m : {&theta, &pDiagonal, &sigma})
+    if (m->size() != p) m->resize(p);
+  time.push_back(s.time);
+  y.push_back(s.y);
+  yhat.push_back(s.yhat);
+  epsilon.push_back(s.epsilon);
+  noiseVariance.push_back(s.noiseVariance);
+  for (std::size_t i = 0; i < p; ++i) {
+    const auto k = static_cast<Eigen::Index>(i);
+    theta[i].push_back(s.theta[k]);
+    pDiagonal[i].push_back(s.pDiagonal[k]);
+    sigma[i].push_back(s.sigma[k]);
+  }
+}
+
+void RecursiveTrajectory::clear() {
+  for (auto* v : {&time, &y, &yhat, &epsilon, &noiseVariance}) v->clear();
+  for (auto* m : {&theta, &pDiagonal, &sigma}) m->clear();
+}
+
+}  // namespace flexarm
