@@ -7,6 +7,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -103,6 +104,32 @@ TEST(CsvRows, TheFirstBadRowIsNamedAtItsLineWhateverTheThreads) {
     const std::string text = logText(3000, badRow);
     const auto at = text.find(",x" + std::to_string(badRow) + ",");
     EXPECT_EQ(one.errorLine, 1 + std::count(text.begin(), text.begin() + static_cast<long>(at), '\n'));
+  }
+  fs::remove_all(tempDir());
+}
+
+TEST(CsvRows, EmptyFieldsAreHolesOnlyWhenAskedAndNeverInTheTime) {
+  const fs::path file = tempDir() / "holes.csv";
+  std::string text = logText(400);
+  const std::string row200 = "100,28.571428571428573,-200\n";
+  const auto at = text.find(row200);
+  ASSERT_NE(at, std::string::npos);
+  text.replace(at, row200.size(), "100,,-200\n");  // no torque at row 200
+  std::ofstream(file, std::ios::binary) << text;
+  for (unsigned threads : {1u, 3u}) {
+    textio::LineReader reader;
+    ASSERT_TRUE(reader.open(file.string()));
+    std::string_view line;
+    for (int i = 0; i < 3; ++i) reader.next(line);
+    const auto holes = textio::readCsvRows(file.string(), reader, 3, threads, 0);
+    ASSERT_TRUE(holes.ok) << holes.problem;
+    EXPECT_TRUE(holes.holes);
+    EXPECT_TRUE(std::isnan(holes.columns[1][200]));
+    EXPECT_EQ(holes.columns[2][200], -200.0);
+    const auto refused = readRows(file, threads);  // holes not asked for
+    ASSERT_FALSE(refused.ok);
+    EXPECT_EQ(refused.errorColumn, 2);
+    EXPECT_EQ(refused.problem, "the field is empty");
   }
   fs::remove_all(tempDir());
 }
