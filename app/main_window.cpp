@@ -36,6 +36,7 @@
 #include "widgets/bode_panel.h"
 #include "widgets/compare_panel.h"
 #include "widgets/fit_panel.h"
+#include "widgets/diagnosis_panel.h"
 #include "widgets/discovery_panel.h"
 #include "widgets/log_panel.h"
 #include "widgets/lqg_panel.h"
@@ -134,6 +135,8 @@ MainWindow::MainWindow(QWidget* parent)
   lqgDock_ = addPanel(lqgPanel_ = new LqgPanel(workspace_, this), tr("LQG"), "lqgDock",
                       "Ctrl+Shift+L", preprocessDock_);
   discoveryDock_ = addPanel(discoveryPanel_ = new DiscoveryPanel(workspace_, this), tr("Discovery"), "discoveryDock", "Ctrl+Shift+D", preprocessDock_);
+  diagnosisDock_ = addPanel(diagnosisPanel_ = new DiagnosisPanel(workspace_, this), tr("Diagnosis"),
+                            "diagnosisDock", "Ctrl+Shift+G", preprocessDock_);
   recursiveDock_ = addPanel(recursivePanel_ = new RecursivePanel(workspace_, this), tr("Recursive"),
                             "recursiveDock", "Ctrl+Shift+I", preprocessDock_);
   preprocessDock_->raise();
@@ -153,7 +156,15 @@ MainWindow::MainWindow(QWidget* parent)
   comparePanel_->setPlayhead(playhead_);
   modelPanel_->setPlayhead(playhead_);
   discoveryPanel_->setPlayhead(playhead_);
+  diagnosisPanel_->setPlayhead(playhead_);
   recursivePanel_->setPlayhead(playhead_);
+  // The Arm view highlights the part whose parameter the diagnosis names at the playhead.
+  connect(diagnosisPanel_, &DiagnosisPanel::verdictShown, this, [this](const QString& parameter) {
+    if (parameter.isEmpty())
+      armPanel_->clearFault();
+    else
+      armPanel_->showParameterFault(parameter, tr("diagnosis: %1 changed").arg(parameter));
+  });
   transportBar_ = new TransportBar(playhead_, this);
   auto* transport = new QToolBar(tr("Playhead"), this);
   transport->setObjectName("transportToolBar");

@@ -29,6 +29,7 @@ class PreprocessPanel;
 class RecursivePanel;
 class TransportBar;
 class ResidualsPanel;
+class DiagnosisPanel;
 class SessionController;
 class Workspace;
 
@@ -56,6 +57,7 @@ class MainWindow : public QMainWindow {
   LqgPanel* lqgPanel() const { return lqgPanel_; }
   SessionController* sessionController() const { return session_; }
   DiscoveryPanel* discoveryPanel() const { return discoveryPanel_; }
+  DiagnosisPanel* diagnosisPanel() const { return diagnosisPanel_; }
   RecursivePanel* recursivePanel() const { return recursivePanel_; }
   QDockWidget* recursiveDock() const { return recursiveDock_; }
   QStringList recentFiles() const;
@@ -110,6 +112,8 @@ class MainWindow : public QMainWindow {
   QDockWidget* lqgDock_ = nullptr;
   SessionController* session_ = nullptr;
   QDockWidget* discoveryDock_ = nullptr;
+  DiagnosisPanel* diagnosisPanel_ = nullptr;
+  QDockWidget* diagnosisDock_ = nullptr;
   RecursivePanel* recursivePanel_ = nullptr;
   QDockWidget* recursiveDock_ = nullptr;
   QMenu* recentMenu_ = nullptr;

@@ -1,5 +1,7 @@
 #include "app/session_controller.h"
 
+#include <algorithm>
+
 #include "app/recent_files.h"
 
 #include <QAction>
@@ -102,6 +104,18 @@ Session SessionController::capture(const QString& sessionPath) const {
     LogReference extra = loaded_.logs[i];
     extra.path = stored(resolveLogPath(path_.toStdString(), extra.path));
     s.logs.push_back(extra);
+  }
+  // Logs a part names (a panel's reference log), replacing one of the same name.
+  for (const auto& part : windowSessionParts()) {
+    if (!part.logs) continue;
+    for (LogReference extra : part.logs(*window_)) {
+      extra.sha256 = sha256OfFile(extra.path, nullptr).value_or("");
+      extra.path = stored(extra.path);
+      auto same = std::find_if(s.logs.begin() + 1, s.logs.end(),
+                               [&](const LogReference& l) { return l.name == extra.name; });
+      if (same != s.logs.end()) *same = extra;
+      else s.logs.push_back(extra);
+    }
   }
   s.preprocessed = workspace_->isPreprocessed();
   if (s.preprocessed) s.preprocess = workspace_->preprocessOptions();
@@ -235,6 +249,7 @@ void SessionController::onOpened() {
   };
   workspace_->setRangeDirect(RangeKind::Estimation, toTime(s.estimation));
   workspace_->setRangeDirect(RangeKind::Validation, toTime(s.validation));
+  opened_ = s;  // sessionLogPath() answers the parts' restore from it
   for (const auto& part : windowSessionParts()) {
     if (s.parts.contains(part.key)) part.restore(s.parts[part.key], *window_);
     else if (part.reset) part.reset(*window_);
@@ -257,6 +272,14 @@ void SessionController::onOpened() {
   for (const auto& w : o.prepared.warnings) status += " - " + QString::fromStdString(w);
   window_->statusBar()->showMessage(status, 15000);
   emit sessionOpened(openingPath_);
+}
+
+QString SessionController::sessionLogPath(const std::string& name) const {
+  const Session& s = restoring_ ? opened_ : loaded_;
+  const std::string base = restoring_ ? openingPath_.toStdString() : path_.toStdString();
+  for (const auto& l : s.logs)
+    if (l.name == name) return QString::fromStdString(resolveLogPath(base, l.path));
+  return {};
 }
 
 void SessionController::exportDialog() {

@@ -41,6 +41,9 @@ class SessionController : public QObject {
   void exportReport(const QString& path);
 
   QString sessionPath() const { return path_; }
+  // The file of the session's log `name` (paths resolved against the session); empty when the
+  // session has no such log. Parts restoring a session use it for the logs they name.
+  QString sessionLogPath(const std::string& name) const;
   bool isDirty() const { return dirty_; }
   QStringList recentSessions() const;
   QString autosavePath() const;
@@ -85,6 +88,7 @@ class SessionController : public QObject {
   bool dirty_ = false;
   std::string logSha256_;    // of the log when it was opened
   Session loaded_;           // the last opened session (its extra logs and parts are kept)
+  Session opened_;           // the session being restored (its parts read its logs)
   QMenu* recentMenu_ = nullptr;
   QTimer* autosaveTimer_;
   QProgressDialog* progress_ = nullptr;

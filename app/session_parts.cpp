@@ -4,10 +4,14 @@
 #include <QVariant>
 
 #include "app/main_window.h"
+#include "core/diagnosis/diagnosis_json.h"
+#include "core/session/diagnosis_part.h"
 #include "core/session/discovery_part.h"
 #include "core/session/fit_request.h"
 #include "core/session/lqg_part.h"
 #include "core/session/model_json.h"
+#include "app/session_controller.h"
+#include "widgets/diagnosis_panel.h"
 #include "core/session/recursive_part.h"
 #include "widgets/discovery_panel.h"
 #include "widgets/lqg_panel.h"
@@ -156,6 +160,45 @@ void resetLqg(MainWindow& w) {
   if (w.lqgPanel()) w.lqgPanel()->setDesign(LqgOptions::seedCaseI(), 0.0, w.lqgPanel()->tableSourceText());
 }
 
+// The Diagnosis panel's request (its reference log joins the session's logs under this name)
+// and the summary of its result; restoring takes the request over without running it.
+constexpr const char* kDiagnosisReference = "diagnosis_reference";
+
+json captureDiagnosis(const MainWindow& w) {
+  const DiagnosisPanel* panel = w.diagnosisPanel();
+  if (!panel) return nullptr;
+  const auto request = panel->sessionRequest(kDiagnosisReference);
+  if (!request) return nullptr;
+  json section = {{"request", diagnosisRequestToJson(*request)}};
+  if (const DiagnosisRun* run = panel->lastRun(); run && run->ok())
+    section["result"] = diagnosisResultJson(run->result);
+  return section;
+}
+
+std::vector<LogReference> diagnosisLogs(const MainWindow& w) {
+  const DiagnosisPanel* panel = w.diagnosisPanel();
+  if (!panel || panel->referenceLogPath().isEmpty() || !panel->sessionRequest(kDiagnosisReference))
+    return {};
+  LogReference l;
+  l.name = kDiagnosisReference;
+  l.path = panel->referenceLogPath().toStdString();
+  return {l};
+}
+
+void restoreDiagnosis(const json& section, MainWindow& w) {
+  std::string why;
+  const auto request = diagnosisRequestFromJson(section["request"], &why);
+  if (!request || !w.diagnosisPanel()) return;
+  const QString path = request->referenceLog.empty() || !w.sessionController()
+                           ? QString()
+                           : w.sessionController()->sessionLogPath(request->referenceLog);
+  w.diagnosisPanel()->setRequest(*request, path);
+}
+
+void resetDiagnosis(MainWindow& w) {
+  if (w.diagnosisPanel()) w.diagnosisPanel()->clearResult();
+}
+
 // The Recursive panel's runs (the overlaid previous one and the current one): each request
 // with the summary of its result when it ran to the end. Opening a session sets the panel's
 // controls from the last request and runs nothing; the runs are kept as read until the panel
@@ -211,6 +254,7 @@ const std::vector<WindowSessionPart>& windowSessionParts() {
       {"fits", &captureFits, &restoreFits},
       {"discovery", &captureDiscovery, &restoreDiscovery, &resetDiscovery},
       {"lqg", &captureLqg, &restoreLqg, &resetLqg},
+      {"diagnosis", &captureDiagnosis, &restoreDiagnosis, &resetDiagnosis, &diagnosisLogs},
       {"recursive", &captureRecursive, &restoreRecursive, &resetRecursive},
       {"view", &captureView, &restoreView},
   };

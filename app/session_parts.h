@@ -6,6 +6,8 @@
 #include <string>
 #include <vector>
 
+#include "core/session/session.h"
+
 namespace flexarm {
 
 class MainWindow;
@@ -19,6 +21,10 @@ struct WindowSessionPart {
   // Returns the window's side to its state without the section, when an opened session has
   // none (so nothing of the previous session is shown or saved again); null: nothing to do.
   void (*reset)(MainWindow& window) = nullptr;
+  // Logs the section names besides the window's own (e.g. a fault-free reference), added to
+  // the session's log list when it is saved (name, path, read options; the checksum is formed
+  // on saving); null: none.
+  std::vector<LogReference> (*logs)(const MainWindow& window) = nullptr;
 };
 
 const std::vector<WindowSessionPart>& windowSessionParts();

@@ -11,8 +11,12 @@ PACKAGES=(
   libmatio-dev libfftw3-dev nlohmann-json3-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   xvfb xauth libgl1-mesa-dri
-  poppler-utils python3-scipy
+  poppler-utils python3-scipy zlib1g-dev libfast-float-dev
+  clang libclang-rt-14-dev
 )
+# clang and libclang-rt-14-dev (its sanitizer and libFuzzer runtimes, only recommended by
+# clang-14) build the AddressSanitizer/UBSan tests and the fuzz targets (scripts/sanitize.sh,
+# scripts/fuzz.sh).
 
 if [ "${1:-}" = "--bench" ]; then
   PACKAGES=(python3-numpy python3-scipy python3-pandas python3-matplotlib

@@ -50,6 +50,16 @@ sim diagnosis_fault_k_T "${diag[@]}" --param k_T=1.2              # k_T up 20 %
 sim diagnosis_fault_J_a_inv "${diag[@]}" --param J_a=1.4333333333333333  # 1/J_a up 20 %
 sim diagnosis_fault_f_m "${diag[@]}" --param f_m=0.0426           # f_m up 20 %
 
+# Chapter 7 beyond the seed: the fault steps in at 12 s, in the middle of the log (the seed
+# starts the estimator off the nominal value instead); the same experiment design as above,
+# another seed, so that the healthy reference (diagnosis_no_fault) and the monitored logs are
+# different experiments.
+step=(--model three-mass --excitation multisine --amplitude 0.2 --duration 24 --seed 8)
+sim diagnosis_step_none "${step[@]}"                                   # healthy throughout
+sim diagnosis_step_k_T "${step[@]}" --step k_T=1.2@12                  # k_T up 20 % at 12 s
+sim diagnosis_step_J_a_inv "${step[@]}" --step J_a=1.4333333333333333@12  # 1/J_a up 20 %
+sim diagnosis_step_f_m "${step[@]}" --step f_m=0.0426@12               # f_m up 20 % at 12 s
+
 # One log per effect (default effect parameters), three-mass arm, chirp, 1 kHz, 10 s. The
 # ripple log adds a constant motor speed of 5 rad/s so that the motor turns several
 # revolutions and the ripple is periodic in time.

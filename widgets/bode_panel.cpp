@@ -137,7 +137,7 @@ void BodePanel::refresh() {
   bands_.clear();
   QStringList notes;
   QString why;
-  const auto data = identSignals(*workspace_, 1, true, &why);
+  const auto data = workspaceData(*workspace_, 1, true, &why);
   double wmin = 1.0, wmax = 2000.0;
   if (data) {
     wmin = std::max(2.0 * M_PI / (static_cast<double>(data->estimation.size()) * data->sampleTime), 0.5);

@@ -84,24 +84,25 @@ void ComparePanel::refresh() {
   plot_->clearGraphs();
   fits_.clear();
   const auto& list = workspace_->models();
-  // Physical models want the motor velocity; black-box ones the data as they are.
+  // Models give the motor velocity (the fit pipeline's black-box estimates too, Section 5.2),
+  // unless a physical model's output is the motor angle.
   bool velocity = false;
   for (std::size_t i = 0; i < list.size(); ++i)
-    if (isModelChecked(models_, i) && list[i].model) velocity = velocity || wantsVelocity(list[i]);
+    if (isModelChecked(models_, i)) velocity = velocity || wantsVelocity(list[i]);
   // The data at each rate a model needs (black-box models at the rate they were estimated at).
-  std::map<int, std::optional<IdentSignals>> rates;
+  std::map<int, std::optional<PreparedData>> rates;
   QString why;
-  auto at = [&](int factor) -> const std::optional<IdentSignals>& {
+  auto at = [&](int factor) -> const std::optional<PreparedData>& {
     auto it = rates.find(factor);
-    if (it == rates.end()) it = rates.emplace(factor, identSignals(*workspace_, factor, velocity, &why)).first;
+    if (it == rates.end()) it = rates.emplace(factor, workspaceData(*workspace_, factor, velocity, &why)).first;
     return it->second;
   };
   const auto kind = static_cast<RangeKind>(range_->currentData().toInt());
-  auto rangeOf = [kind](const IdentSignals& d) {
+  auto rangeOf = [kind](const PreparedData& d) {
     const SampleRange r = kind == RangeKind::Validation ? d.validation : d.estimation;
     return r.empty() ? d.estimation : r;
   };
-  auto addGraph = [&](const IdentSignals& d, const Eigen::VectorXd& v, const QString& name,
+  auto addGraph = [&](const PreparedData& d, const Eigen::VectorXd& v, const QString& name,
                       const QPen& pen) {
     const SampleRange r = rangeOf(d);
     const std::size_t step = std::max<std::size_t>(1, r.size() / kMaxPoints);
@@ -156,7 +157,7 @@ void ComparePanel::refresh() {
   lines.prepend(tr("Fit (5.2) of the simulated output on the %1 data (%2):")
                     .arg(noValidation ? tr("estimation (no validation range set)")
                                       : kind == RangeKind::Validation ? tr("validation") : tr("estimation"),
-                         base->note));
+                         QString::fromStdString(base->note())));
   fit_->setText(lines.join("\n"));
   plot_->rescaleAxes();
   plot_->replot();

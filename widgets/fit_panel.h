@@ -12,14 +12,14 @@
 #include <atomic>
 #include <memory>
 
-#include "core/ident/closed_loop_pem.h"
-#include "core/ident/pem.h"
+#include "core/ident/fit.h"
 #include "core/ident/sensitivity.h"
 #include "widgets/workspace.h"
 
 class QComboBox;
 class QLabel;
 class QListWidget;
+class QPlainTextEdit;
 class QProgressBar;
 class QPushButton;
 class QSpinBox;
@@ -43,8 +43,9 @@ class FitPanel : public QWidget {
   QStringList freeParameters() const;
   void setDecimation(int factor);
   void setNoiseModel(NoiseModel m);
-  // Output-error fits of closed-loop logs (with a reference channel): two-stage or direct.
-  void setClosedLoopMethod(ClosedLoopMethod m);
+  // Output-error fits of closed-loop logs (with a reference channel): auto, two-stage, direct
+  // or indirect.
+  void setClosedLoopMethod(ClosedLoopChoice m);
   void setStarts(int randomStarts);
 
   bool isBusy() const { return watcher_.isRunning() || study_.isRunning(); }
@@ -66,21 +67,13 @@ class FitPanel : public QWidget {
   void studyFinished(bool ok);
 
  private:
-  struct Row {
-    QString name, unit;
-    double value = 0, std = 0, lower = 0, upper = 0;
-    bool free = false;
-  };
   struct Outcome {
-    QString error, note;
-    ModelEntry entry;
-    std::vector<Row> rows;
-    EstimateSummary summary;
-    double fitEstimation = 0, fitValidation = 0;
-    bool hasValidation = false;
-    std::vector<double> notches, peaks;
+    QString error, name;
+    FitResult result;
     std::shared_ptr<FitRequest> request;  // what was asked, kept with the estimate
-    // What the sensitivity study needs (physical estimates only).
+  };
+  // What the sensitivity study works on: the latest physical estimate and its estimation data.
+  struct StudyInput {
     std::shared_ptr<const ParametricModel> estimate;
     Eigen::VectorXd u, y;
     double sampleTime = 0;
@@ -90,6 +83,7 @@ class FitPanel : public QWidget {
     MonteCarloResult monteCarlo;
     QString error;
   };
+  std::optional<FitOptions> options(QString* name);
   void refillModels();
   void refillParameters();
   void updateControls();
@@ -118,7 +112,7 @@ class FitPanel : public QWidget {
   QPushButton* cancel_;
   QProgressBar* progress_;
   QTableWidget* table_;
-  QLabel* summary_;
+  QPlainTextEdit* summary_;
   QSpinBox* studyRuns_;
   QPushButton* study_button_;
   QTableWidget* studyTable_;
@@ -128,9 +122,8 @@ class FitPanel : public QWidget {
   QFutureWatcher<StudyOutcome> study_;
   std::shared_ptr<std::atomic<int>> permille_;
   std::shared_ptr<std::atomic<bool>> abort_;
-  Outcome last_;  // the latest physical estimate (for the study)
+  StudyInput last_;  // the latest physical estimate (for the study)
   int lastIndex_ = -1;
-  int fits_ = 0;
 };
 
 }  // namespace flexarm

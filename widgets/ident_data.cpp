@@ -5,7 +5,6 @@
 
 #include "core/ident/nonparametric.h"
 #include "core/ident/pem.h"
-#include "core/signal/preprocess.h"
 
 namespace flexarm {
 
@@ -32,57 +31,43 @@ bool isModelChecked(const QListWidget* list, std::size_t index) {
          list->item(static_cast<int>(index))->checkState() == Qt::Checked;
 }
 
-std::optional<IdentSignals> identSignals(const Workspace& workspace, int decimation,
-                                         bool velocityOutput, QString* why) {
+void useWorkspaceData(const Workspace& workspace, FitOptions& options) {
+  options.estimation.clear();
+  options.validation.clear();
+  if (!workspace.current()) return;
+  auto data = std::make_shared<const IdData>(*workspace.current());
+  auto seconds = [&workspace](RangeKind kind) -> std::optional<SecondsRange> {
+    const auto r = workspace.range(kind);
+    if (!r) return std::nullopt;
+    return SecondsRange{r->start, r->end};
+  };
+  options.estimation.push_back({data, seconds(RangeKind::Estimation)});
+  if (auto v = seconds(RangeKind::Validation)) options.validation.push_back({data, v});
+}
+
+std::optional<PreparedData> workspaceData(const Workspace& workspace, int decimation, bool velocityOutput,
+                                          QString* why) {
   const IdData* current = workspace.current();
   if (!current || !current->input() || !current->output()) {
     if (why) *why = QObject::tr("Open a log with an input and an output channel first.");
     return std::nullopt;
   }
-  IdData data = *current;
-  QStringList notes;
-  if (velocityOutput && data.output()->name == columns::kMotorAngle) {
-    data = addDerivative(data);
-    notes << QObject::tr("motor velocity from the angle (central differences)");
-  }
-  if (decimation > 1) {
-    DecimateOptions d;
-    d.factor = decimation;
-    std::string reason;
-    if (!d.isValid(&reason)) {
-      if (why) *why = QString::fromStdString(reason);
-      return std::nullopt;
-    }
-    data = decimate(data, d);
-    notes << QObject::tr("decimated by %1").arg(decimation);
-  }
-  IdentSignals s;
-  s.sampleTime = data.sampleTime;
-  s.startTime = data.startTime;
-  s.closedLoop = data.isClosedLoop();
-  inputOutput(data, s.u, s.y);
-  auto rangeOf = [&](RangeKind kind) {
-    const auto r = workspace.range(kind);
-    return r ? data.rangeForTimes(r->start, r->end) : SampleRange{};
-  };
-  s.estimation = rangeOf(RangeKind::Estimation);
-  if (s.estimation.empty()) s.estimation = {0, data.samples()};
-  s.validation = rangeOf(RangeKind::Validation);
-  const auto n = static_cast<Eigen::Index>(s.estimation.size());
-  if (n < 20) {
-    if (why) *why = QObject::tr("The estimation range holds only %1 samples.").arg(n);
+  FitDataOptions o;
+  o.decimation = decimation;
+  o.velocityOutput = velocityOutput;
+  if (const auto r = workspace.range(RangeKind::Estimation)) o.estimation = SecondsRange{r->start, r->end};
+  if (const auto r = workspace.range(RangeKind::Validation)) o.validation = SecondsRange{r->start, r->end};
+  std::string reason;
+  if (!o.isValid(&reason)) {
+    if (why) *why = QString::fromStdString(reason);
     return std::nullopt;
   }
-  const auto b = static_cast<Eigen::Index>(s.estimation.begin);
-  s.u.array() -= s.u.segment(b, n).mean();
-  s.y.array() -= s.y.segment(b, n).mean();
-  if (const Channel* ref = data.withRole(ChannelRole::Reference)) {
-    s.r = Eigen::Map<const Eigen::VectorXd>(ref->values.data(), static_cast<Eigen::Index>(ref->values.size()));
-    s.r.array() -= s.r.segment(b, n).mean();
+  PreparedData d = prepareFitData(*current, o);
+  if (!d.ok()) {
+    if (why) *why = QString::fromStdString(d.message);
+    return std::nullopt;
   }
-  notes << QObject::tr("estimation means removed");
-  s.note = notes.join(", ");
-  return s;
+  return d;
 }
 
 int decimationFor(const ModelEntry& entry, double dataSampleTime) {
@@ -124,17 +109,8 @@ std::optional<Eigen::VectorXd> residualsOf(const ModelEntry& entry, const Eigen:
 
 FrequencyResponse responseOf(const ModelEntry& entry, const std::vector<double>& omega,
                              double level) {
-  if (entry.model)
-    return frequencyResponse(*entry.model, omega, entry.covariance, entry.covarianceIndices,
-                             level);
-  std::vector<double> w;
-  if (entry.polynomial) {
-    const double nyquist = M_PI / entry.polynomial->sampleTime;
-    for (double x : omega)
-      if (x < nyquist) w.push_back(x);
-  }
-  if (w.empty()) return FrequencyResponse{};
-  return frequencyResponse(*entry.polynomial, w, level);
+  return estimateResponse(entry.model.get(), entry.covariance, entry.covarianceIndices, entry.polynomial.get(),
+                          omega, level);
 }
 
 }  // namespace flexarm

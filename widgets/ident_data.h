@@ -9,6 +9,7 @@
 #include <Eigen/Dense>
 
 #include "core/ident/evaluation.h"
+#include "core/ident/fit.h"
 #include "widgets/workspace.h"
 
 class QListWidget;
@@ -23,25 +24,17 @@ std::shared_ptr<PhysicalModel> clonePhysical(const ParametricModel& model);
 void fillModelChecklist(QListWidget* list, const std::vector<ModelEntry>& models);
 bool isModelChecked(const QListWidget* list, std::size_t index);
 
-// Input u and output y of the whole log with the estimation data's means removed (as the seed
-// does, Section 5.2), and the sample ranges the workspace's ranges cover.
-struct IdentSignals {
-  Eigen::VectorXd u, y;
-  Eigen::VectorXd r;  // the reference channel (empty when the log has none)
-  SampleRange estimation;  // the estimation range, or every sample when none is set
-  SampleRange validation;  // empty when no validation range is set
-  double sampleTime = 1.0;
-  double startTime = 0.0;
-  bool closedLoop = false;
-  QString note;  // how the data were prepared, for the user
-};
+// The workspace's current data prepared as the fit pipeline prepares them (prepareFitData,
+// core/ident/fit_data.h): the workspace's estimation and validation ranges, decimation behind
+// the anti-alias FIR when decimation > 1, the motor velocity from the motor angle when
+// velocityOutput (the physical models' output), the estimation data's means removed (Section
+// 5.2). nullopt with a sentence in why when there are no usable data.
+std::optional<PreparedData> workspaceData(const Workspace& workspace, int decimation, bool velocityOutput,
+                                          QString* why);
 
-// Builds the signals from the workspace's current data. decimation > 1 decimates behind the
-// anti-alias FIR; velocityOutput forms the motor velocity from the motor angle (central
-// differences) when the output is the angle, because the physical models' output is the
-// motor velocity. Returns nullopt with a sentence in why when there are no usable data.
-std::optional<IdentSignals> identSignals(const Workspace& workspace, int decimation,
-                                         bool velocityOutput, QString* why);
+// The workspace's current data and ranges as the experiments of a fit: the estimation range
+// (the whole log without one) and, when one is set, the validation range of the same log.
+void useWorkspaceData(const Workspace& workspace, FitOptions& options);
 
 // The decimation that brings data sampled at dataSampleTime to the rate the entry works at:
 // 1 for physical (continuous-time) models, T_model / T_data for black-box estimates, 0 when
@@ -64,8 +57,8 @@ std::optional<Eigen::VectorXd> residualsOf(const ModelEntry& entry, const Eigen:
                                            const Eigen::VectorXd& y, double sampleTime,
                                            QString* why);
 
-// Frequency response at omega (rad/s) with bands at `level` where the entry has a covariance.
-// Black-box responses stop at their Nyquist frequency.
+// Frequency response at omega (rad/s) with bands at `level` where the entry has a covariance
+// (estimateResponse of the fit pipeline). Black-box responses stop at their Nyquist frequency.
 FrequencyResponse responseOf(const ModelEntry& entry, const std::vector<double>& omega,
                              double level);
 

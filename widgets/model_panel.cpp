@@ -11,6 +11,7 @@
 #include <QTableWidget>
 #include <QVBoxLayout>
 #include <QtConcurrent>
+#include <cctype>
 #include <cmath>
 #include <qcustomplot.h>
 
@@ -18,6 +19,7 @@
 #include "core/models/analysis.h"
 #include "core/models/nonlinear_plant.h"
 #include "core/signal/preprocess.h"
+#include "core/sim/log_simulation.h"
 #include "widgets/ident_data.h"
 #include "widgets/plots/bode_plot.h"
 #include "widgets/plots/playhead_cursor.h"
@@ -353,36 +355,26 @@ void ModelPanel::simulateAgainstLog() {
   const IdData* data = workspace_->current();
   if (current_ < 0 || !data || isSimulating()) return;
   if (!workspace_->models()[static_cast<std::size_t>(current_)].model) return;
-  const Channel* torque = data->channel(columns::kTorqueRef);
-  if (!torque && data->input()) torque = data->input();
-  const Channel* velocity = data->channel(columns::kMotorVelocity);
-  const Channel* angle = data->channel(columns::kMotorAngle);
-  if (!torque || (!velocity && !angle)) {
-    fit_->setText(tr("The log needs a torque reference and a motor angle or velocity."));
-    return;
-  }
   const ModelEntry entry = workspace_->models()[static_cast<std::size_t>(current_)];
-  auto u = std::make_shared<std::vector<double>>(torque->values);
-  auto y = std::make_shared<std::vector<double>>(velocity ? velocity->values : differentiate(angle->values, data->sampleTime));
-  const double ts = data->sampleTime, t0 = data->startTime;
+  auto log = std::make_shared<const IdData>(*data);
   simulate_->setEnabled(false);
   fit_->setText(tr("Simulating..."));
-  simulation_.setFuture(QtConcurrent::run([entry, u, y, ts, t0]() {
+  simulation_.setFuture(QtConcurrent::run([entry, log]() {
     SimOutcome out;
     try {
-      NonlinearPlant plant(*entry.model, entry.effects);
-      TorqueResponseOptions o;
-      o.substeps = std::max(2, static_cast<int>(std::ceil(ts / 2.5e-4)));
-      TorqueResponse r = simulateTorque(plant, *u, ts, o);
-      out.simulated = r.motorVelocity;
-      out.measured = *y;
-      out.time.resize(u->size());
-      for (std::size_t i = 0; i < u->size(); ++i) out.time[i] = t0 + i * ts;
-      const Eigen::VectorXd ym = Eigen::Map<const Eigen::VectorXd>(y->data(), static_cast<Eigen::Index>(y->size()));
-      const Eigen::VectorXd ys = Eigen::Map<const Eigen::VectorXd>(out.simulated.data(), static_cast<Eigen::Index>(out.simulated.size()));
-      out.fit = fitPercent(ym, ys);
+      LogSimulationResult r = flexarm::simulateAgainstLog(*entry.model, entry.effects, *log);
+      if (!r.ok()) {
+        std::string text = r.message + ".";
+        text[0] = static_cast<char>(std::toupper(static_cast<unsigned char>(text[0])));
+        out.error = QString::fromStdString(text);
+        return out;
+      }
+      out.simulated = std::move(r.simulated);
+      out.measured = std::move(r.measured);
+      out.time = std::move(r.time);
+      out.fit = r.fitPercent;
     } catch (const std::exception& e) {
-      out.error = QString::fromStdString(e.what());
+      out.error = QObject::tr("Simulation failed: %1").arg(QString::fromStdString(e.what()));
     }
     return out;
   }));
@@ -392,7 +384,7 @@ void ModelPanel::onSimulated() {
   simulate_->setEnabled(true);
   SimOutcome out = simulation_.result();
   if (!out.error.isEmpty()) {
-    fit_->setText(tr("Simulation failed: %1").arg(out.error));
+    fit_->setText(out.error);
     return;
   }
   auto qv = [](const std::vector<double>& v) { return QVector<double>(v.begin(), v.end()); };

@@ -133,7 +133,7 @@ void ResidualsPanel::refresh() {
     verdict_->setText(tr("%1: its sample time is no multiple of the data's.").arg(entry.name));
     return;
   }
-  const auto data = identSignals(*workspace_, factor, wantsVelocity(entry), &why);
+  const auto data = workspaceData(*workspace_, factor, wantsVelocity(entry), &why);
   if (!data) {
     verdict_->setText(why);
     return;

@@ -13,6 +13,7 @@
 #include "core/models/physical_models.h"
 #include "core/signal/id_data.h"
 #include "core/signal/preprocess.h"
+#include "core/signal/seconds_range.h"
 
 class QUndoStack;
 
@@ -22,10 +23,8 @@ struct FitRequest;  // core/session/fit_request.h
 
 enum class RangeKind { Estimation, Validation };
 
-struct TimeRange {
-  double start = 0.0;
-  double end = 0.0;
-};
+// A range in seconds (core/signal/seconds_range.h).
+using TimeRange = SecondsRange;
 
 // A model in the shared model list: a physical model (its parameters, free/fixed flags and
 // output options) and the nonlinear effects switched on for it, or a black-box estimate.

@@ -2,6 +2,7 @@
 #include <charconv>
 #include <cmath>
 #include <sstream>
+#include <string>
 
 #include "app/cli/cli.h"
 
@@ -103,6 +104,23 @@ std::vector<std::string> splitList(const std::string& text) {
   while (std::getline(ss, item, ','))
     if (!item.empty()) out.push_back(item);
   return out;
+}
+
+bool ArgParser::integer(const std::string& name, int& out, int min, int max) {
+  auto v = value(name);
+  if (!v) return true;
+  long long x = 0;
+  const char* b = v->data();
+  const char* e = v->data() + v->size();
+  if (b != e && *b == '+') ++b;
+  const auto res = std::from_chars(b, e, x);
+  if (res.ec != std::errc() || res.ptr != e || x < min || x > max) {
+    error_ = "--" + name + " expects a whole number from " + std::to_string(min) + " to " +
+             std::to_string(max) + ", got '" + *v + "'";
+    return false;
+  }
+  out = static_cast<int>(x);
+  return true;
 }
 
 }  // namespace flexarm::cli

@@ -23,6 +23,8 @@ const std::vector<Verb>& verbs() {
        runDiscover},
       {"recursive", "estimate physical parameters sample by sample (chapter 6's RPEM)",
        runRecursive},
+      {"diagnose", "detect and isolate a fault in k_T, J_a or f_m from recursive estimates",
+       runDiagnose},
   };
   return kVerbs;
 }

@@ -53,6 +53,9 @@ class ArgParser {
   // Typed access; on a malformed value return false and set error().
   bool number(const std::string& name, double& out);
   bool integer(const std::string& name, long& out);
+  // An integer in [min, max]: anything else (a fraction, 1e12, a value that overflows) is
+  // refused with a sentence naming the allowed range, never wrapped.
+  bool integer(const std::string& name, int& out, int min, int max);
 
  private:
   std::vector<std::string> flags_, valued_;
@@ -75,5 +78,6 @@ int runLqg(const std::vector<std::string>& args, std::ostream& out, std::ostream
 int runRun(const std::vector<std::string>& args, std::ostream& out, std::ostream& err);
 int runDiscover(const std::vector<std::string>& args, std::ostream& out, std::ostream& err);
 int runRecursive(const std::vector<std::string>& args, std::ostream& out, std::ostream& err);
+int runDiagnose(const std::vector<std::string>& args, std::ostream& out, std::ostream& err);
 
 }  // namespace flexarm::cli

@@ -38,15 +38,13 @@ std::optional<LogReadOptions> logReadOptions(ArgParser& args, std::ostream& err)
       return std::nullopt;
     }
   }
-  long in = o.inputColumn, outc = o.outputColumn, tc = o.timeColumn;
-  if (!args.integer("input-column", in) || !args.integer("output-column", outc) ||
-      !args.integer("time-column", tc) || !args.number("sample-time", o.sampleTime)) {
+  if (!args.integer("input-column", o.inputColumn, 1, LogReadOptions::kMaxColumns) ||
+      !args.integer("output-column", o.outputColumn, 1, LogReadOptions::kMaxColumns) ||
+      !args.integer("time-column", o.timeColumn, 0, LogReadOptions::kMaxColumns) ||
+      !args.number("sample-time", o.sampleTime)) {
     err << "flexarm: " << args.error() << "\n";
     return std::nullopt;
   }
-  o.inputColumn = static_cast<int>(in);
-  o.outputColumn = static_cast<int>(outc);
-  o.timeColumn = static_cast<int>(tc);
   if (auto v = args.value("input-name")) o.inputName = *v;
   if (auto v = args.value("output-name")) o.outputName = *v;
   if (auto v = args.value("input-var")) o.inputVariable = *v;

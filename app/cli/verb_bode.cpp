@@ -48,8 +48,8 @@ int runBode(const std::vector<std::string>& argv, std::ostream& out, std::ostrea
     return kExitUsage;
   }
   double level = 0.99, wmin = 0.0, wmax = 0.0;
-  long points = 500;
-  if (!args.number("level", level) || !args.integer("points", points) ||
+  int points = 500;
+  if (!args.number("level", level) || !args.integer("points", points, 2, 1000000) ||
       !args.number("wmin", wmin) || !args.number("wmax", wmax)) {
     err << "flexarm bode: " << args.error() << "\n";
     return kExitUsage;
@@ -58,16 +58,16 @@ int runBode(const std::vector<std::string>& argv, std::ostream& out, std::ostrea
     err << "flexarm bode: --level must lie strictly between 0 and 1 and --points be at least 2\n";
     return kExitUsage;
   }
-  FitOutcome fit;
-  if (const int rc = prepareAndFit(args, "bode", fit, err, true); rc != kExitOk) return rc;
-  const double T = fit.sampleTime;
-  if (!args.value("wmin")) wmin = 2.0 * M_PI / (static_cast<double>(fit.yEst.size()) * T);
+  FitResult fit;
+  if (const int rc = runFitPipeline(args, "bode", fit, err, true); rc != kExitOk) return rc;
+  const double T = fit.data.sampleTime;
+  if (!args.value("wmin")) wmin = 2.0 * M_PI / (static_cast<double>(fit.data.estimation.size()) * T);
   if (!args.value("wmax")) wmax = M_PI / T;
   if (!(wmin > 0.0) || !(wmax > wmin)) {
     err << "flexarm bode: need 0 < --wmin < --wmax\n";
     return kExitUsage;
   }
-  const auto fr = fit.response(logGrid(wmin, wmax, static_cast<int>(points)), level);
+  const auto fr = fitResponse(fit, logGrid(wmin, wmax, static_cast<int>(points)), level);
   // SPA leaves out frequencies where the input has no power.
   const long omitted = points - static_cast<long>(fr.omega.size());
   std::ostringstream csv;
@@ -89,10 +89,10 @@ int runBode(const std::vector<std::string>& argv, std::ostream& out, std::ostrea
     err << "flexarm bode: " << why << "\n";
     return kExitBadInput;
   }
-  const std::string name = fit.spec.nonparametric ? (fit.spec.spa ? "spa" : "etfe")
-                                                  : fit.modelName();
+  const bool nonparametric = fit.model.kind == FitModelKind::Spa || fit.model.kind == FitModelKind::Etfe;
+  const std::string name = fit.modelName();
   // Non-parametric curves ripple: only extrema 3 dB deep count there.
-  const auto np = notchesAndPeaks(fr, fit.spec.nonparametric ? 3.0 : 1.0);
+  const auto np = notchesAndPeaks(fr, nonparametric ? 3.0 : 1.0);
   if (args.flag("json")) {
     nlohmann::json j = {{"model", name},
                         {"output", *outPath},
@@ -101,13 +101,13 @@ int runBode(const std::vector<std::string>& argv, std::ostream& out, std::ostrea
                         {"bands", fr.hasBands()},
                         {"notches_rad_s", np.notches},
                         {"peaks_rad_s", np.peaks},
-                        {"warning", fit.spec.nonparametric ? fit.nonparametric.warning : ""},
+                        {"warning", fit.nonparametric.warning},
                         {"omitted_frequencies", omitted}};
     out << j.dump(2) << "\n";
   } else {
     out << "wrote " << *outPath << ": " << fr.omega.size() << " frequencies of " << name
         << (fr.hasBands() ? " with bands" : "") << "\n";
-    if (fit.spec.nonparametric && !fit.nonparametric.warning.empty())
+    if (!fit.nonparametric.warning.empty())
       out << "warning: " << fit.nonparametric.warning << "\n";
     if (omitted > 0)
       out << "note: left out " << omitted << " of " << points

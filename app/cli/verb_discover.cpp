@@ -104,12 +104,10 @@ int runDiscover(const std::vector<std::string>& argv, std::ostream& out, std::os
       pos = comma + 1;
     }
   }
-  long threads = 2;
-  if (!args.integer("threads", threads)) {
+  if (!args.integer("threads", options.threads, 1, 64)) {
     err << pre << args.error() << "\n";
     return kExitUsage;
   }
-  options.threads = static_cast<int>(threads);
   std::string why;
   if (!options.isValid(&why)) {
     err << pre << why << "\n";

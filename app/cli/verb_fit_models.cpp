@@ -11,7 +11,7 @@ bool isPhysicalModelName(const std::string& name) {
   return false;
 }
 
-std::unique_ptr<ParametricModel> makePhysicalModel(const std::string& name) {
+std::unique_ptr<PhysicalModel> makePhysicalModel(const std::string& name) {
   if (!isPhysicalModelName(name)) return nullptr;
   return makeModel(name);  // nominal values: Table 5.2 (two-mass), Table 5.7 p6 (three-mass)
 }

@@ -121,9 +121,7 @@ int runPreprocess(const std::vector<std::string>& argv, std::ostream& out, std::
     return kExitUsage;
   };
   PreprocessOptions p;
-  long factor = 1;
-  if (!args.integer("decimate", factor)) return usage(args.error());
-  p.decimation.factor = static_cast<int>(factor);
+  if (!args.integer("decimate", p.decimation.factor, 1, 1000000)) return usage(args.error());
   if (auto f = args.value("filter")) {
     auto parsed = antiAliasFilterFromString(*f);
     if (!parsed) return usage("--filter must be fir, chebyshev or none, not '" + *f + "'");

@@ -1,6 +1,9 @@
 // flexarm simulate --model ... [--effect NAME[:VALUE] ...] --excitation KIND --duration S
 //                  --seed N [--rate HZ] --out LOG.csv
+#include <algorithm>
 #include <cstdio>
+#include <map>
+#include <utility>
 #include <nlohmann/json.hpp>
 #include <ostream>
 
@@ -15,7 +18,8 @@ namespace {
 const char* kSimulateHelp =
     "Usage: flexarm simulate [--model STRUCTURE] [--param NAME=VALUE ...]\n"
     "                        [--effect NAME[:V1[,V2]] ...] --excitation chirp|multisine|prbs|none\n"
-    "                        --duration S --seed N [--rate HZ] --out LOG.csv [--json]\n\n"
+    "                        [--step NAME=VALUE@S ...] --duration S --seed N [--rate HZ]\n"
+    "                        --out LOG.csv [--json]\n\n"
     "Simulates the model with the effects under the cascaded position (P) / velocity (PI)\n"
     "controller of the seed's Figure 5.1 and writes a FlexArm CSV log (time_s,\n"
     "motor_angle_rad, torque_ref_nm, angle_ref_rad) plus LOG.truth.json with everything that\n"
@@ -39,6 +43,10 @@ const char* kSimulateHelpTail =
     "  --multisine-lines K0:K1, --multisine-period S\n"
     "  --prbs-clock S        PRBS bit length (default 0.01 s)\n"
     "  --reference-velocity RAD_S  constant motor speed added to the reference (default 0)\n\n"
+    "Faults (repeatable):\n"
+    "  --step NAME=VALUE@S   the model parameter NAME steps to VALUE at S seconds, e.g.\n"
+    "                        k_T=1.2@20 (a 20 % torque-constant fault at 20 s); the state is\n"
+    "                        continuous, the log's metadata and truth name the step\n\n"
     "Simulation:\n"
     "  --duration S          length of the log (default 20 s)\n"
     "  --seed N              random seed for noise, multisine phases, PRBS (default 1)\n"
@@ -81,7 +89,7 @@ nlohmann::json truthJson(const PhysicalModel& model, const std::vector<Effect>& 
   const auto& c = o.controller;
   const auto& d = o.disturbance;
   const auto& x = o.excitation;
-  return {{"generator", "FlexArm simulator (flexarm simulate)"},
+  nlohmann::json truth = {{"generator", "FlexArm simulator (flexarm simulate)"},
           {"model", modelJson(model)},
           {"effects", fx},
           {"controller",
@@ -110,13 +118,29 @@ nlohmann::json truthJson(const PhysicalModel& model, const std::vector<Effect>& 
           {"duration_s", o.durationS},
           {"log_rate_hz", o.logRateHz},
           {"substeps", o.substeps}};
+  if (!o.parameterSteps.empty()) {
+    // Only logs with a fault carry the key, so that the others keep their bytes.
+    nlohmann::json steps = nlohmann::json::array();
+    std::map<std::string, double> current;
+    for (const auto& p : model.parameters()) current[p.name] = p.value;
+    auto ordered = o.parameterSteps;
+    std::stable_sort(ordered.begin(), ordered.end(),
+                     [](const ParameterStep& a, const ParameterStep& b) { return a.timeS < b.timeS; });
+    for (const auto& s : ordered)
+      steps.push_back({{"name", s.name},
+                       {"value_before", std::exchange(current[s.name], s.value)},
+                       {"value", s.value},
+                       {"time_s", s.timeS}});
+    truth["parameter_steps"] = steps;
+  }
+  return truth;
 }
 
 }  // namespace
 
 int runSimulate(const std::vector<std::string>& argv, std::ostream& out, std::ostream& err) {
   auto valued = modelValuedOptions();
-  for (const char* v : {"effect", "excitation", "amplitude", "chirp", "multisine-lines",
+  for (const char* v : {"effect", "step", "excitation", "amplitude", "chirp", "multisine-lines",
                         "multisine-period", "prbs-clock", "reference-velocity", "duration", "seed",
                         "rate", "controller-rate", "kp", "kv", "ti", "torque-noise", "load-noise",
                         "encoder-counts", "substeps", "out"})
@@ -143,7 +167,8 @@ int runSimulate(const std::vector<std::string>& argv, std::ostream& out, std::os
     if (!kind) return usage("--excitation must be chirp, multisine, prbs or none, not '" + *e + "'");
     o.excitation.kind = *kind;
   }
-  long seed = 1, counts = o.disturbance.encoderCountsPerRev, substeps = o.substeps;
+  long seed = 1;
+  int counts = static_cast<int>(o.disturbance.encoderCountsPerRev);
   double prbsClock = o.excitation.prbsClockS;
   if (!args.number("amplitude", o.excitation.amplitude) ||
       !args.number("multisine-period", o.excitation.multisinePeriodS) ||
@@ -154,13 +179,13 @@ int runSimulate(const std::vector<std::string>& argv, std::ostream& out, std::os
       !args.number("ti", o.controller.ti) ||
       !args.number("torque-noise", o.disturbance.torqueNoiseStd) ||
       !args.number("load-noise", o.disturbance.loadTorqueStd) || !args.integer("seed", seed) ||
-      !args.integer("encoder-counts", counts) || !args.integer("substeps", substeps))
+      !args.integer("encoder-counts", counts, 0, 1 << 30) ||
+      !args.integer("substeps", o.substeps, 1, 10000))
     return usage(args.error());
   o.excitation.prbsClockS = prbsClock;
+  o.disturbance.encoderCountsPerRev = counts;
   if (seed < 0) return usage("--seed must be >= 0");
   o.seed = static_cast<std::uint64_t>(seed);
-  o.disturbance.encoderCountsPerRev = counts;
-  o.substeps = static_cast<int>(substeps);
   o.logRateHz = o.controller.rateHz;
   if (!args.number("rate", o.logRateHz)) return usage(args.error());
   if (auto c = args.value("chirp");
@@ -188,8 +213,21 @@ int runSimulate(const std::vector<std::string>& argv, std::ostream& out, std::os
     if (!e) return usage("--effect " + spec + ": " + why);
     effects.push_back(*e);
   }
+  for (const auto& spec : args.values("step")) {
+    auto step = parseParameterStep(spec, &why);
+    if (!step) return usage("--step: " + why);
+    o.parameterSteps.push_back(*step);
+  }
   auto model = modelFromArgs(args, "simulate", err);
   if (!model) return kExitUsage;
+  for (const auto& s : o.parameterSteps) {
+    const int i = model->indexOf(s.name);
+    if (i < 0) return usage("--step: the " + model->structureName() + " model has no parameter '" + s.name + "'");
+    const auto& p = model->parameters()[static_cast<std::size_t>(i)];
+    if (s.value < p.lower || s.value > p.upper)
+      return usage("--step " + toString(s) + ": the value is outside " + s.name + "'s bounds");
+    if (s.timeS > o.durationS) return usage("--step " + toString(s) + ": the time is after the log's end");
+  }
 
   SimulationResult r;
   try {

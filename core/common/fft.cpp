@@ -16,6 +16,7 @@ namespace flexarm {
 
 namespace {
 
+// The one lock around FFTW's planner: fftw_plan_* and fftw_destroy_plan.
 std::mutex& plannerMutex() {
   static std::mutex m;
   return m;
@@ -43,7 +44,9 @@ Plan makePlan(int n, int inAlign, int outAlign) {
   fftw_plan p = fftw_plan_dft_r2c_1d(n, inAt, outAt, FFTW_ESTIMATE | FFTW_PRESERVE_INPUT);
   fftw_free(in);
   fftw_free(out);
-  if (!p) throw std::runtime_error("FFTW could not plan a transform of " + std::to_string(n));
+  if (!p)
+    throw std::runtime_error("FFTW could not plan a Fourier transform of " + std::to_string(n) +
+                             " points (out of memory?)");
   return Plan(p, [](fftw_plan q) {
     std::lock_guard<std::mutex> lock(plannerMutex());
     fftw_destroy_plan(q);
@@ -76,7 +79,7 @@ Plan cachedPlan(int n, int inAlign, int outAlign) {
 }  // namespace
 
 void realDft(const double* x, int n, std::complex<double>* X) {
-  if (n < 1) throw std::invalid_argument("realDft: the length must be positive");
+  if (n < 1) throw std::invalid_argument("a Fourier transform needs at least one point");
   auto* in = const_cast<double*>(x);  // FFTW_PRESERVE_INPUT: x is only read
   auto* out = reinterpret_cast<fftw_complex*>(X);  // double[2], as std::complex (FFTW 4.1.1)
   const Plan plan =

@@ -6,6 +6,8 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
+#include <limits>
 #include <sstream>
 #include <stdexcept>
 
@@ -27,15 +29,69 @@ std::optional<PolyStructure> polyStructureFromString(std::string_view s) {
   return std::nullopt;
 }
 
+int PolyOrders::parameters() const {
+  const long long sum = static_cast<long long>(na) + nb + nc + nd + nf;
+  return static_cast<int>(std::min<long long>(sum, std::numeric_limits<int>::max()));
+}
+
 bool PolyOrders::isValid(std::string* why) const {
-  auto fail = [&](const char* text) {
+  auto fail = [&](const std::string& text) {
     if (why) *why = text;
     return false;
   };
   if (na < 0 || nb < 0 || nc < 0 || nd < 0 || nf < 0) return fail("orders must not be negative");
   if (nb < 1) return fail("nb must be at least 1");
   if (nk < 0) return fail("the delay nk must not be negative");
-  if (parameters() > 2000) return fail("more than 2000 parameters");
+  if (std::max({na, nb, nc, nd, nf}) > kMaxOrder || parameters() > kMaxOrder)
+    return fail("more than " + std::to_string(kMaxOrder) + " parameters");
+  if (nk > kMaxDelay) return fail("the delay nk is more than " + std::to_string(kMaxDelay) + " samples");
+  return true;
+}
+
+namespace {
+// Least-squares work (rows x parameters^2) allowed: ARX solves once, the iterative structures
+// once per iteration (up to 100 by default). Both are a few seconds to a minute here.
+constexpr double kMaxArxWork = 2e10;
+constexpr double kMaxIterativeWork = 2e9;
+
+// First sample at which every regressor holds data: the prediction-error criterion starts here.
+int criterionStart(const PolyOrders& o) {
+  return static_cast<int>(
+      PolyPredictor::criterionStart(o, std::numeric_limits<Eigen::Index>::max()));
+}
+}  // namespace
+
+bool PolyOrders::fitsData(PolyStructure s, long long samples, std::string* why) const {
+  std::string bad;
+  if (!isValid(&bad)) {
+    if (why) *why = bad;
+    return false;
+  }
+  const long long p = parameters();
+  const long long rows = samples - criterionStart(*this);
+  const bool iterative = s != PolyStructure::Arx;
+  const long long needed = iterative ? 2 * p + 21 : p + 1;
+  if (rows < needed) {
+    if (why)
+      *why = "too few samples (" + std::to_string(samples) + ") for " + std::to_string(p) +
+             " parameters with the delay nk = " + std::to_string(nk) + ": the estimate needs at least " +
+             std::to_string(needed + samples - rows) + "; lower the orders or the delay";
+    return false;
+  }
+  const double work = static_cast<double>(rows) * static_cast<double>(p) * static_cast<double>(p);
+  const double limit = iterative ? kMaxIterativeWork : kMaxArxWork;
+  if (work > limit) {
+    if (why) {
+      char buf[320];
+      std::snprintf(buf, sizeof buf,
+                    "%s with %lld parameters on %lld samples is a least-squares problem of "
+                    "%.2g operations%s, more than the %.0e FlexArm allows (minutes of work); "
+                    "lower the orders or decimate the data",
+                    toString(s), p, samples, work, iterative ? " per iteration" : "", limit);
+      *why = buf;
+    }
+    return false;
+  }
   return true;
 }
 
@@ -306,11 +362,7 @@ PolyEstimate arx(const Eigen::VectorXd& u, const Eigen::VectorXd& y, int na, int
   const Eigen::Index n = y.size();
   const int first = std::max(na, nb + nk - 1);
   const int p = o.parameters();
-  if (n - first <= p) {
-    r.summary.message = "too few samples (" + std::to_string(n) + ") for " +
-                        std::to_string(p) + " parameters";
-    return r;
-  }
+  if (!o.fitsData(PolyStructure::Arx, n, &r.summary.message)) return r;
   if (!u.allFinite() || !y.allFinite()) {
     r.summary.message = "the data contain NaN or infinite values";
     return r;
@@ -356,9 +408,9 @@ PolyEstimate refinePolynomial(const Eigen::VectorXd& u, const Eigen::VectorXd& y
   auto& s = r.summary;
   const Eigen::Index n = y.size();
   const int p = initial.orders.parameters();
-  if (n <= 2 * p) {
+  if (n - criterionStart(initial.orders) <= 2 * p) {
     s.message = "too few samples (" + std::to_string(n) + ") for " + std::to_string(p) +
-                " parameters";
+                " parameters with the delay nk = " + std::to_string(initial.orders.nk);
     return r;
   }
   if (!u.allFinite() || !y.allFinite()) {
@@ -411,11 +463,10 @@ PolyEstimate estimatePolynomial(const Eigen::VectorXd& u, const Eigen::VectorXd&
   if (!o.isValid(&why)) throw std::invalid_argument(std::string(toString(structure)) + ": " + why);
   const auto t0 = Clock::now();
   if (structure == PolyStructure::Arx) return arx(u, y, o.na, o.nb, o.nk, sampleTime);
-  if (y.size() <= 2 * o.parameters() + 20) {
+  if (std::string tooBig; !o.fitsData(structure, y.size(), &tooBig)) {
     PolyEstimate r;
     r.model = PolynomialModel::zero(structure, o, sampleTime);
-    r.summary.message = "too few samples (" + std::to_string(y.size()) + ") for " +
-                        std::to_string(o.parameters()) + " parameters";
+    r.summary.message = tooBig;
     return r;
   }
   if (!u.allFinite() || !y.allFinite()) {

@@ -20,9 +20,17 @@ std::optional<PolyStructure> polyStructureFromString(std::string_view s);
 
 // Orders of (4.8): na, nb, nc, nd, nf and the delay nk (B = b1 q^{-nk} + ... (4.10)).
 struct PolyOrders {
+  static constexpr int kMaxOrder = 2000;    // of each polynomial, and of all together
+  static constexpr int kMaxDelay = 1000000;  // nk, samples
   int na = 0, nb = 1, nc = 0, nd = 0, nf = 0, nk = 1;
-  int parameters() const { return na + nb + nc + nd + nf; }
+  // na + nb + nc + nd + nf, computed without overflow (saturates at INT_MAX).
+  int parameters() const;
   bool isValid(std::string* why) const;
+  // Whether a structure of these orders can be estimated from `samples` samples in bounded
+  // time: enough samples after the delay and the longest regressor, and a least-squares
+  // problem (samples x parameters^2) of at most a few 1e9 operations per iteration. False
+  // with a sentence naming the limit otherwise.
+  bool fitsData(PolyStructure s, long long samples, std::string* why) const;
 };
 
 // One estimated polynomial model (4.8) with its parameter covariance. The parameter vector is

@@ -94,16 +94,21 @@ ReferenceProjection projectOnReference(const Eigen::VectorXd& u, const Eigen::Ve
     throw std::invalid_argument("projectOnReference: input and reference differ in length");
   if (!(T > 0.0)) throw std::invalid_argument("projectOnReference: the sample time must be positive");
   ReferenceProjection out;
-  out.pastTaps = static_cast<int>(std::lround(options.pastS / T));
-  out.futureTaps = static_cast<int>(std::lround(options.futureS / T));
   const Eigen::Index n = u.size();
-  const int lo = -out.futureTaps, hi = out.pastTaps;  // lags k: u(t) ~ r(t - k)
-  const int m = hi - lo + 1;
-  if (n < 4 * m) {
-    out.message = "too few samples (" + std::to_string(n) + ") for an FIR of " +
-                  std::to_string(m) + " taps of the reference";
+  // The FIR length is checked against the data in floating point first: a tiny sample time
+  // would overflow an int (e.g. "-1806140927 taps").
+  const double pastTaps = std::round(options.pastS / T), futureTaps = std::round(options.futureS / T);
+  if (!(pastTaps + futureTaps + 1.0 <= static_cast<double>(n) / 4.0)) {
+    char buf[64];
+    std::snprintf(buf, sizeof buf, "%.0f", pastTaps + futureTaps + 1.0);
+    out.message = "too few samples (" + std::to_string(n) + ") for an FIR of " + buf +
+                  " taps of the reference";
     return out;
   }
+  out.pastTaps = static_cast<int>(pastTaps);
+  out.futureTaps = static_cast<int>(futureTaps);
+  const int lo = -out.futureTaps, hi = out.pastTaps;  // lags k: u(t) ~ r(t - k)
+  const int m = hi - lo + 1;
   if (!u.allFinite() || !r.allFinite()) {
     out.message = "the input or the reference contains NaN or infinite values";
     return out;
@@ -291,6 +296,8 @@ ClosedLoopPemResult indirect(const ParametricModel& model, const Eigen::VectorXd
                              const ProgressCallback& progress) {
   if (r.size() != y.size())
     throw std::invalid_argument("pemClosedLoop: the indirect method needs a reference as long as the output");
+  if (options.loopWarmup < 0 || options.loopWarmup >= y.size())
+    throw std::invalid_argument("pemClosedLoop: the loop's warm-up must leave samples to compare");
   ClosedLoopPemResult out;
   out.method = ClosedLoopMethod::Indirect;
   const std::string head = "indirect closed-loop fit";
@@ -314,10 +321,17 @@ ClosedLoopPemResult indirect(const ParametricModel& model, const Eigen::VectorXd
   po.covariance = CovarianceKind::Sandwich;
   const ControllerOptions ctl = options.controller;
   const LoopOutput output = options.loopOutput;
-  po.predictor = [ctl, output](const ParametricModel& m, const Eigen::VectorXd& ref,
-                               const Eigen::VectorXd& angle, double Ts,
-                               const std::vector<int>& free, bool withGradient) {
-    return evaluateLoop(m, ctl, ref, angle, Ts, free, withGradient, output);
+  const Eigen::Index skip = options.loopWarmup;
+  po.predictor = [ctl, output, skip](const ParametricModel& m, const Eigen::VectorXd& ref,
+                                     const Eigen::VectorXd& angle, double Ts,
+                                     const std::vector<int>& free, bool withGradient) {
+    PemEvaluation ev = evaluateLoop(m, ctl, ref, angle, Ts, free, withGradient, output);
+    if (skip > 0) {
+      const Eigen::Index n = ev.eps.size() - skip;
+      ev.eps = Eigen::VectorXd(ev.eps.tail(n));
+      if (withGradient) ev.psi = Eigen::MatrixXd(ev.psi.bottomRows(n));
+    }
+    return ev;
   };
   out.pem = pem(*work, rRel, yRel, T, po, progress);
   // Back to the caller's output (e.g. the motor velocity) for Bode plots and simulation.

@@ -103,6 +103,9 @@ struct ClosedLoopPemOptions {
   // Indirect: the controller the log was recorded with, and the output compared.
   ControllerOptions controller;
   LoopOutput loopOutput = LoopOutput::MotorAngle;
+  // Indirect: the first samples of (r, y) that the loop runs through from rest but the loss
+  // leaves out, for an estimation range that starts after the log's first sample.
+  Eigen::Index loopWarmup = 0;
   // Options of the pem run; with TwoStage the noise model is output error and the covariance
   // the sandwich (these two fields are overridden).
   PemOptions pem;
@@ -121,7 +124,7 @@ struct ClosedLoopPemResult {
 // by the chosen method. Direct ignores r (it may be empty) and runs pem(options.pem) on
 // (u, y). Indirect ignores u: y is the measured motor angle and r the position reference as
 // logged (means kept, from the start of the log, where the loop is at rest), at the
-// controller's rate; a physical model whose output is the motor velocity is fitted with the
+// controller's rate, its loss over the samples after loopWarmup; a physical model whose output is the motor velocity is fitted with the
 // motor angle as output and returned with its own output. Its covariance is the sandwich.
 // Throws std::invalid_argument on misuse; data failures end in pem.summary.
 ClosedLoopPemResult pemClosedLoop(const ParametricModel& model, const Eigen::VectorXd& u,

@@ -1,5 +1,6 @@
 #include "core/ident/fit_data.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <stdexcept>
@@ -116,9 +117,21 @@ PreparedData prepareFitData(const IdData& data, const FitDataOptions& options) {
     if (d.samples() < static_cast<std::size_t>(4 * options.decimation))
       return fail("the log holds too few samples (" + std::to_string(d.samples()) +
                   ") to decimate by " + std::to_string(options.decimation));
+    const std::vector<double> fine = d.input()->values;
     d = decimate(d, dec);
     out.decimation = options.decimation;
     out.steps.push_back("decimated by " + std::to_string(options.decimation) + " (anti-alias FIR)");
+    if (options.decimatedInput == FitDataOptions::DecimatedInput::HeldMean) {
+      std::vector<double>& held = d.channel(in->name)->values;
+      const std::size_t r = static_cast<std::size_t>(options.decimation);
+      for (std::size_t k = 0; k < held.size(); ++k) {
+        const std::size_t b = k * r, e = std::min(fine.size(), b + r);
+        double sum = 0.0;
+        for (std::size_t j = b; j < e; ++j) sum += fine[j];
+        held[k] = sum / static_cast<double>(e - b);
+      }
+      out.steps.push_back("input as its mean over each held period");
+    }
   }
   out.sampleTime = d.sampleTime;
   out.startTime = d.startTime;

@@ -33,6 +33,14 @@ struct FitDataOptions {
   // Decimation factor (1: none) and the anti-alias filter's stopband attenuation.
   int decimation = 1;
   double stopbandDb = 80.0;
+  // What a decimated input sample is. Filtered: the anti-alias FIR's output at the sample, as
+  // for every other channel (zero phase: centred on the sample). HeldMean: the mean of the
+  // input over the new sample period that starts at the sample, which is what a zero-order
+  // hold of that period (5.3) must hold to give the same impulse as the torque the controller
+  // held at the log's rate; the filtered input lags it by half a period, a phase error of
+  // w T / 2 at every frequency w for a continuous-time model sampled with a zero-order hold.
+  enum class DecimatedInput { Filtered, HeldMean };
+  DecimatedInput decimatedInput = DecimatedInput::Filtered;
   // Estimation range; unset: every sample. (The ranges a log stores, IdData::estimationRange
   // and validationRange, are not used: a front end passes them here when it means them.)
   std::optional<SecondsRange> estimation;

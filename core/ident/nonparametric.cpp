@@ -138,6 +138,7 @@ NonparametricEstimate etfe(const Eigen::VectorXd& u, const Eigen::VectorXd& y, d
   const int nb = n / 2;
   const double dw = 2.0 * M_PI / (n * ts);
   const int width = std::max(1, options.smoothingWidth);
+  r.window = width;
   // The cross spectrum Y conj(U) and |U|^2 per bin (written out: std::complex's product
   // checks for infinities on every call), with `pad` zeros at both ends.
   const int pad = width - 1;
@@ -222,6 +223,7 @@ NonparametricEstimate spa(const Eigen::VectorXd& u, const Eigen::VectorXd& y, do
   int M = options.windowWidth > 0 ? options.windowWidth
                                   : static_cast<int>(std::min<Eigen::Index>(n / 10, 30));
   M = static_cast<int>(std::max<Eigen::Index>(1, std::min<Eigen::Index>(M, n - 1)));
+  r.window = M;
   // Covariances R_yu(tau) = 1/N sum y(t + tau) u(t), tau = -M..M, and R_u, R_y for tau >= 0.
   auto cov = [&](const Eigen::VectorXd& a, const Eigen::VectorXd& b, int tau) {
     double s = 0.0;

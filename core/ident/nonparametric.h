@@ -27,6 +27,7 @@ struct NonparametricEstimate {
   bool closedLoopBias = false; // true when the data carry a reference channel (4.30)
   std::string warning;         // kClosedLoopBiasWarning when closedLoopBias
   int omittedFrequencies = 0;  // SPA: requested frequencies left out (no input power there)
+  int window = 0;              // SPA: the lag window M used; ETFE: the smoothing width
   Termination termination = Termination::Failed;
   std::string message;
   double seconds = 0.0;

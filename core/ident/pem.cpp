@@ -392,9 +392,12 @@ PemResult pem(const ParametricModel& model0, const Eigen::VectorXd& u, const Eig
   }
 
   std::unique_ptr<ParametricModel> work = model0.clone();
+  // The bounds are applied again after the transform: exp(log(b)) or (b / s) * s may round
+  // one ulp past a bound b (e.g. exp(log(1e4)) > 1e4), which setParameter would refuse.
   auto setPhi = [&](const Eigen::VectorXd& phi, Eigen::VectorXd& K) {
     for (int j = 0; j < pf; ++j)
-      work->setParameter(params0[tr.free[j]].name, tr.toTheta(j, phi[j]));
+      work->setParameter(params0[tr.free[j]].name,
+                         std::clamp(tr.toTheta(j, phi[j]), tr.lower[j], tr.upper[j]));
     K = innovations ? Eigen::VectorXd(phi.tail(tr.nK)) : Eigen::VectorXd();
   };
   LeastSquaresProblem problem;
@@ -512,7 +515,9 @@ PemResult pem(const ParametricModel& model0, const Eigen::VectorXd& u, const Eig
     totalIterations += sol.summary.iterations;
     cancelled = sol.summary.termination == Termination::Cancelled;
     const bool ok = sol.summary.termination != Termination::Failed;
-    result.startLosses.push_back(ok ? sol.sumSquares / y.size() : INFINITY);
+    // Per error the predictor compares (a custom one may compare fewer samples than y holds).
+    result.startLosses.push_back(ok ? sol.sumSquares / static_cast<double>(std::max<Eigen::Index>(1, sol.eps.size()))
+                                    : INFINITY);
     if (!ok && firstFailure.empty()) firstFailure = sol.summary.message;
     if (ok && (!best.ok || sol.sumSquares < best.sol.sumSquares)) {
       best.sol = std::move(sol);
@@ -542,7 +547,7 @@ PemResult pem(const ParametricModel& model0, const Eigen::VectorXd& u, const Eig
   if (result.starts > 1)
     sum.message += "; best of " + std::to_string(result.starts) + " starts (start " +
                    std::to_string(result.bestStart) + ")";
-  fillStatistics(sum, best.sol.sumSquares, y.size(), p);
+  fillStatistics(sum, best.sol.sumSquares, best.sol.eps.size(), p);
   // Covariance in phi, mapped to theta with the Jacobian of the transform.
   result.covarianceKind = options.covariance;
   Eigen::MatrixXd covPhi;

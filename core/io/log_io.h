@@ -4,7 +4,9 @@
 // Bad input never throws and never yields partial data: the result carries a ReadError
 // naming the file, the line and column (or variable) and the problem.
 #include <cstdint>
+#include <functional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "core/signal/id_data.h"
@@ -34,6 +36,8 @@ enum class LogFormat { Auto, FlexArmCsv, Table, Mat };
 const char* toString(LogFormat f);
 
 struct LogReadOptions {
+  static constexpr int kMaxColumns = 65536;    // columns of a CSV log or table
+  static constexpr int kMaxMetadata = 1000;    // "# key: value" lines of a CSV log
   LogFormat format = LogFormat::Auto;  // Auto: .mat by extension or magic, CSV with header
                                        // when the first data line is not numeric, else Table
   std::uint64_t maxFileBytes = 2ull << 30;  // larger files are refused with a clear message
@@ -58,18 +62,33 @@ struct LogReadOptions {
   bool isValid(std::string* why) const;
 };
 
-// Reads any supported log; see LogReadOptions::format.
+// Reads any supported log; see LogReadOptions::format. Only regular files are read (a device
+// or pipe is refused before reading), never more than options.maxFileBytes, and memory stays
+// within a few times the file's size.
 LogReadResult readLog(const std::string& path, const LogReadOptions& options = {});
 LogReadResult readFlexArmCsv(const std::string& path, const LogReadOptions& options = {});
 LogReadResult readTable(const std::string& path, const LogReadOptions& options = {});
 LogReadResult readMat(const std::string& path, const LogReadOptions& options = {});
+// The same readers on text already in memory; `name` is what messages call the file.
+LogReadResult readFlexArmCsvText(std::string_view text, const std::string& name,
+                                 const LogReadOptions& options = {});
+LogReadResult readTableText(std::string_view text, const std::string& name,
+                            const LogReadOptions& options = {});
 
 // Writes data in the FlexArm CSV format (metadata, header, time column, every channel).
 // The file is written to a temporary sibling and renamed, so a failure leaves any previous
 // file untouched. Returns false and fills error on failure.
 bool writeFlexArmCsv(const IdData& data, const std::string& path, ReadError* error = nullptr);
 
-// Writes text to path atomically (temporary sibling, flush, rename).
+// Writes text to path atomically: a temporary sibling, written, flushed to the disk and then
+// renamed over path. Refuses to replace anything but a regular file (a device such as
+// /dev/full, a pipe, a directory), and reports every write error (disk full, quota) with the
+// previous file left as it was.
 bool writeFileAtomically(const std::string& path, const std::string& text, std::string* why);
+// The same with the text produced piecewise: produce(sink) calls sink(bytes) any number of
+// times, so a large file never has to be held in memory whole.
+bool writeFileAtomically(const std::string& path,
+                         const std::function<void(const std::function<void(std::string_view)>&)>& produce,
+                         std::string* why);
 
 }  // namespace flexarm

@@ -1,9 +1,9 @@
 #include "core/session/discovery_part.h"
 
 #include <cmath>
-#include <limits>
 
 #include "core/session/fit_request.h"
+#include "core/session/json_fields.h"
 #include "core/session/model_json.h"
 
 namespace flexarm {
@@ -14,35 +14,7 @@ namespace {
 
 const char* kStructures[] = {"two-mass", "three-mass", "four-mass"};
 
-// JSON has no NaN: non-finite numbers are stored as null and read back as NaN.
-json number(double v) { return std::isfinite(v) ? json(v) : json(nullptr); }
-
-// Looks key up: Absent (an error only when required), Bad (missing though required, or of
-// another kind than `kind` names) or Present; an error leaves a sentence in why.
-enum class Field { Absent, Present, Bad };
-template <class IsKind>
-Field field(const json& j, const char* key, bool required, IsKind isKind, const char* kind,
-            std::string* why, const std::string& where) {
-  if (!j.contains(key)) {
-    if (!required) return Field::Absent;
-    if (why) *why = where + key + " is missing";
-    return Field::Bad;
-  }
-  if (!isKind(j[key])) {
-    if (why) *why = where + key + " must be " + kind;
-    return Field::Bad;
-  }
-  return Field::Present;
-}
-
-bool readNumber(const json& j, const char* key, double& out, bool required, std::string* why,
-                const std::string& where) {
-  const Field f = field(j, key, required, [](const json& v) { return v.is_number() || v.is_null(); },
-                        "a number", why, where);
-  if (f == Field::Present)
-    out = j[key].is_null() ? std::numeric_limits<double>::quiet_NaN() : j[key].get<double>();
-  return f != Field::Bad;
-}
+json number(double v) { return jsonNumber(v); }
 
 // The effect names listed under key, if the key is there (else out is left as it is); false
 // with a sentence when the value is not a list or names an unknown effect.
@@ -63,27 +35,6 @@ bool readEffectList(const json& j, const char* key, const char* notList, const c
     out.push_back(*k);
   }
   return true;
-}
-
-bool readText(const json& j, const char* key, std::string& out, bool required, std::string* why,
-              const std::string& where) {
-  const Field f = field(j, key, required, [](const json& v) { return v.is_string(); }, "text", why, where);
-  if (f == Field::Present) out = j[key].get<std::string>();
-  return f != Field::Bad;
-}
-
-bool readFlag(const json& j, const char* key, bool& out, std::string* why, const std::string& where) {
-  const Field f = field(j, key, false, [](const json& v) { return v.is_boolean(); }, "true or false",
-                        why, where);
-  if (f == Field::Present) out = j[key].get<bool>();
-  return f != Field::Bad;
-}
-
-bool readWhole(const json& j, const char* key, int& out, std::string* why, const std::string& where) {
-  const Field f = field(j, key, false, [](const json& v) { return v.is_number_integer(); },
-                        "a whole number", why, where);
-  if (f == Field::Present) out = j[key].get<int>();
-  return f != Field::Bad;
 }
 
 json dataRefToJson(const DiscoveryDataRef& d) {
@@ -166,18 +117,8 @@ std::string describeData(const DiscoveryDataRef& d, const std::string& firstLog)
 // The chosen data set, or a sentence why there is none.
 std::optional<IdData> pickData(const DiscoveryDataRef& ref, bool raw, const ReplayContext& context,
                                std::string* why) {
-  const auto* logs = raw ? context.rawLogs : &context.logs;
-  if (!logs || logs->empty()) {
-    *why = raw ? "the logs as read are not available" : "the session has no log";
-    return std::nullopt;
-  }
-  const IdData* d = nullptr;
-  for (const auto& [name, data] : *logs)
-    if (ref.log.empty() ? d == nullptr : name == ref.log) d = data;
-  if (!d) {
-    *why = "the session has no log named '" + ref.log + "'";
-    return std::nullopt;
-  }
+  const IdData* d = findLog(context, ref.log, raw, why);
+  if (!d) return std::nullopt;
   if (!ref.range) return *d;
   const SampleRange r = d->rangeForTimes(ref.range->start, ref.range->end);
   if (r.size() < 10) {
@@ -191,19 +132,14 @@ std::optional<IdData> pickData(const DiscoveryDataRef& ref, bool raw, const Repl
 std::unique_ptr<PhysicalModel> pickBase(const DiscoveryRequest& q, const Session& session,
                                         std::string* why) {
   if (q.baseModel.empty()) return makeModel(q.baseStructure);
-  if (session.parts.contains("models"))
-    for (const auto& m : session.parts["models"]) {
-      auto spec = modelFromJson(m, why);
-      if (!spec || spec->name != q.baseModel) continue;
-      if (!spec->effects.empty()) {
-        *why = "the base model '" + q.baseModel + "' has effects; discovery starts from a model without";
-        return nullptr;
-      }
-      auto c = spec->model->clone();
-      return std::unique_ptr<PhysicalModel>(static_cast<PhysicalModel*>(c.release()));
-    }
-  *why = "the model list has no model named '" + q.baseModel + "'";
-  return nullptr;
+  const auto spec = findListModel(session.parts.value("models", json::array()), q.baseModel, why);
+  if (!spec) return nullptr;
+  if (!spec->effects.empty()) {
+    *why = "the base model '" + q.baseModel + "' has effects; discovery starts from a model without";
+    return nullptr;
+  }
+  auto c = spec->model->clone();
+  return std::unique_ptr<PhysicalModel>(static_cast<PhysicalModel*>(c.release()));
 }
 
 ReportSeries series(const std::string& name, const std::vector<double>& t, std::vector<double> y,

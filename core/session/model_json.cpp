@@ -1,6 +1,7 @@
 #include "core/session/model_json.h"
 
 #include <cmath>
+#include <set>
 #include <stdexcept>
 
 namespace flexarm {
@@ -54,11 +55,18 @@ std::optional<ModelSpec> modelFromJson(const json& j, std::string* why) {
   }
   if (j.contains("parameters")) {
     if (!j["parameters"].is_array()) return fail("model '" + name + "': parameters must be a list");
+    if (j["parameters"].size() > spec.model->parameters().size())
+      return fail("model '" + name + "': " + std::to_string(j["parameters"].size()) +
+                  " parameters listed, but the " + j["structure"].get<std::string>() +
+                  " model has " + std::to_string(spec.model->parameters().size()));
+    std::set<std::string> seen;
     for (const auto& p : j["parameters"]) {
       if (!p.is_object() || !p.contains("name") || !p["name"].is_string() ||
           !p.contains("value") || !p["value"].is_number())
         return fail("model '" + name + "': each parameter needs a name and a numeric value");
       const std::string pn = p["name"].get<std::string>();
+      if (!seen.insert(pn).second)
+        return fail("model '" + name + "': parameter " + pn + " is listed twice");
       try {
         spec.model->setParameter(pn, p["value"].get<double>());
         if (p.contains("free")) {
@@ -73,6 +81,8 @@ std::optional<ModelSpec> modelFromJson(const json& j, std::string* why) {
   }
   if (j.contains("effects")) {
     if (!j["effects"].is_array()) return fail("model '" + name + "': effects must be a list");
+    if (j["effects"].size() > kMaxEffects)
+      return fail("model '" + name + "': more than " + std::to_string(kMaxEffects) + " effects");
     for (const auto& e : j["effects"]) {
       std::string effectWhy;
       auto effect = e.is_string() ? parseEffect(e.get<std::string>(), &effectWhy) : std::nullopt;
@@ -83,6 +93,17 @@ std::optional<ModelSpec> modelFromJson(const json& j, std::string* why) {
     }
   }
   return spec;
+}
+
+std::optional<ModelSpec> findListModel(const nlohmann::json& models, const std::string& name,
+                                       std::string* why) {
+  if (models.is_array())
+    for (const auto& m : models) {
+      auto spec = modelFromJson(m, why);
+      if (spec && spec->name == name) return spec;
+    }
+  if (why) *why = "the model list has no model named '" + name + "'";
+  return std::nullopt;
 }
 
 }  // namespace flexarm

@@ -22,8 +22,17 @@ struct ModelSpec {
 nlohmann::json modelToJson(const std::string& name, const PhysicalModel& model,
                            const std::vector<Effect>& effects);
 
+// Effects one model may carry (there are six kinds).
+inline constexpr std::size_t kMaxEffects = 16;
+
 // The model described by j; nullopt with a sentence for an unknown structure or parameter, a
-// value outside its bounds, or a malformed effect.
+// value outside its bounds, a parameter listed twice or more often than the structure has
+// parameters, or a malformed effect.
 std::optional<ModelSpec> modelFromJson(const nlohmann::json& j, std::string* why);
+
+// The model named `name` in a session's "models" part (a list of modelToJson objects);
+// nullopt with a sentence when there is none by that name.
+std::optional<ModelSpec> findListModel(const nlohmann::json& models, const std::string& name,
+                                       std::string* why);
 
 }  // namespace flexarm

@@ -6,6 +6,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "core/io/input_file.h"
 #include "core/session/session_part.h"
 
 namespace flexarm {
@@ -75,10 +76,6 @@ class FieldReader {
   std::string* why_;
   bool failed_ = false;
 };
-
-json rangeToJson(const std::optional<SecondsRange>& r) {
-  return r ? json::array({r->start, r->end}) : json(nullptr);
-}
 
 bool rangeFromJson(const json& v, const std::string& where, std::optional<SecondsRange>& out,
                    FieldReader& f) {
@@ -204,6 +201,63 @@ bool preprocessFromJson(const json& j, Session& s, FieldReader& f) {
   return true;
 }
 
+// Limits checked on the text before a document is built: a 40 MB file of one list of a
+// million items, or brackets nested a million deep (whose document is destroyed
+// recursively, overflowing the stack), is refused at the cost of one pass.
+constexpr std::size_t kMaxJsonDepth = 64;
+constexpr std::size_t kMaxJsonItems = 100000;  // in one list or object
+
+class ShapeCheck : public nlohmann::json_sax<json> {
+ public:
+  std::string problem;
+  bool null() override { return item(); }
+  bool boolean(bool) override { return item(); }
+  bool number_integer(number_integer_t) override { return item(); }
+  bool number_unsigned(number_unsigned_t) override { return item(); }
+  bool number_float(number_float_t, const string_t&) override { return item(); }
+  bool string(string_t&) override { return item(); }
+  bool binary(binary_t&) override { return item(); }
+  bool start_object(std::size_t) override { return open(); }
+  bool key(string_t&) override { return true; }
+  bool end_object() override { return close(); }
+  bool start_array(std::size_t) override { return open(); }
+  bool end_array() override { return close(); }
+  bool parse_error(std::size_t, const std::string&, const nlohmann::detail::exception&) override {
+    return false;  // the document parse that follows names the place
+  }
+
+ private:
+  bool item() {
+    if (!counts_.empty() && ++counts_.back() > kMaxJsonItems) {
+      problem = "a list or object holds more than " + std::to_string(kMaxJsonItems) + " items";
+      return false;
+    }
+    return true;
+  }
+  bool open() {
+    if (!item()) return false;
+    if (counts_.size() >= kMaxJsonDepth) {
+      problem = "lists and objects are nested more than " + std::to_string(kMaxJsonDepth) + " deep";
+      return false;
+    }
+    counts_.push_back(0);
+    return true;
+  }
+  bool close() {
+    counts_.pop_back();
+    return true;
+  }
+  std::vector<std::size_t> counts_;
+};
+
+bool jsonShapeIsBounded(const std::string& text, std::string* why) {
+  ShapeCheck check;
+  json::sax_parse(text, &check);
+  if (check.problem.empty()) return true;
+  if (why) *why = check.problem;
+  return false;
+}
+
 // Line and column of a byte offset, for parse errors.
 std::string placeOf(const std::string& text, std::size_t byte) {
   int line = 1, column = 1;
@@ -220,6 +274,23 @@ std::string placeOf(const std::string& text, std::size_t byte) {
 
 }  // namespace
 
+json secondsRangeToJson(const std::optional<SecondsRange>& r) {
+  return r ? json::array({r->start, r->end}) : json(nullptr);
+}
+
+bool readSecondsRange(const json& j, const char* key, std::optional<SecondsRange>& out, std::string* why) {
+  out.reset();
+  if (!j.contains(key) || j[key].is_null()) return true;
+  const json& r = j[key];
+  if (!r.is_array() || r.size() != 2 || !r[0].is_number() || !r[1].is_number() ||
+      !(r[0].get<double>() < r[1].get<double>())) {
+    if (why) *why = std::string(key) + " must be [start, end] in seconds with start < end";
+    return false;
+  }
+  out = SecondsRange{r[0].get<double>(), r[1].get<double>()};
+  return true;
+}
+
 std::string toJsonText(const Session& s) {
   json logs = json::array();
   for (const auto& l : s.logs)
@@ -231,14 +302,18 @@ std::string toJsonText(const Session& s) {
             {"logs", logs},
             {"preprocessing", preprocessToJson(s)},
             {"ranges",
-             {{"estimation_s", rangeToJson(s.estimation)},
-              {"validation_s", rangeToJson(s.validation)}}},
+             {{"estimation_s", secondsRangeToJson(s.estimation)},
+              {"validation_s", secondsRangeToJson(s.validation)}}},
             {"parts", s.parts.is_object() ? s.parts : json::object()}};
   return j.dump(2) + "\n";
 }
 
 SessionParseResult parseSession(const std::string& text) {
   SessionParseResult r;
+  if (std::string why; !jsonShapeIsBounded(text, &why)) {
+    r.message = "not a readable session: " + why;
+    return r;
+  }
   json j;
   try {
     j = json::parse(text);
@@ -325,14 +400,17 @@ SessionParseResult parseSession(const std::string& text) {
 
 SessionParseResult loadSession(const std::string& path) {
   SessionParseResult r;
-  std::ifstream in(path, std::ios::binary);
-  if (!in) {
-    r.message = path + ": cannot be read";
+  FileBytes bytes;
+  std::string problem;
+  if (!readInputFile(path, kMaxSessionBytes, bytes, &problem)) {
+    r.message = path + ": " + problem;
     return r;
   }
-  std::ostringstream text;
-  text << in.rdbuf();
-  r = parseSession(text.str());
+  if (std::string enc = textEncodingProblem(bytes.view()); !enc.empty()) {
+    r.message = path + ": " + enc;
+    return r;
+  }
+  r = parseSession(std::string(bytes.view()));
   if (!r.ok) r.message = path + ": " + r.message;
   return r;
 }

@@ -4,6 +4,7 @@
 // validation ranges, and one section per capability ("parts": the model list, view state,
 // and what later capabilities add; see session_part.h). Stored as readable JSON with a format
 // version; a damaged or newer file is refused as a whole with a sentence naming the problem.
+#include <cstdint>
 #include <map>
 #include <optional>
 #include <string>
@@ -43,6 +44,13 @@ struct Session {
   std::string writtenBy;  // "FlexArm 0.1.0" of the program that saved the file
 };
 
+// A range in seconds as session JSON, [start, end] or null.
+nlohmann::json secondsRangeToJson(const std::optional<SecondsRange>& r);
+// Reads j[key] (absent or null: no range); false with a sentence unless [start, end] with
+// start < end.
+bool readSecondsRange(const nlohmann::json& j, const char* key, std::optional<SecondsRange>& out,
+                      std::string* why);
+
 // The session as JSON text (pretty-printed, keys in a stable order).
 std::string toJsonText(const Session& session);
 
@@ -55,7 +63,9 @@ struct SessionParseResult {
 // a version newer than kSessionVersion, missing or mistyped fields and unknown parts.
 SessionParseResult parseSession(const std::string& text);
 
-// Reads and parses a session file; the message names the file.
+// Reads and parses a session file; the message names the file. Only regular files of at most
+// kMaxSessionBytes are read.
+inline constexpr std::uint64_t kMaxSessionBytes = 64ull << 20;
 SessionParseResult loadSession(const std::string& path);
 
 // Writes the session atomically (temporary sibling, then rename): a failure or a crash while

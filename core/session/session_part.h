@@ -17,6 +17,10 @@
 
 namespace flexarm {
 
+// Items (models, fits, ...) one list of a part may hold: replaying each costs seconds, so a
+// file listing thousands would make opening it take hours. Parts refuse longer lists.
+inline constexpr std::size_t kMaxPartItems = 100;
+
 // What a part sees when it is replayed: the session, the data the analysis uses
 // (preprocessed, ranges set) and every log the session names, read and preprocessed alike.
 struct ReplayContext {
@@ -28,6 +32,10 @@ struct ReplayContext {
   // caller has none.
   const std::vector<std::pair<std::string, const IdData*>>* rawLogs = nullptr;
 };
+
+// The log a part names (empty: the session's first) among the context's logs as read (raw) or
+// as preprocessed; nullptr with a sentence when there is none.
+const IdData* findLog(const ReplayContext& context, const std::string& name, bool raw, std::string* why);
 
 class SessionPart {
  public:

@@ -4,20 +4,18 @@
 #include <algorithm>
 #include <cmath>
 #include <complex>
+#include <set>
 
-
-#include <Eigen/Dense>
-
-#include "core/ident/evaluation.h"
 #include "core/models/analysis.h"
 #include "core/models/nonlinear_plant.h"
+#include "core/session/diagnosis_part.h"
 #include "core/session/discovery_part.h"
 #include "core/session/fit_request.h"
 #include "core/session/lqg_part.h"
 #include "core/session/model_json.h"
 #include "core/session/recursive_part.h"
 #include "core/session/session_part.h"
-#include "core/signal/preprocess.h"
+#include "core/sim/log_simulation.h"
 
 namespace flexarm {
 
@@ -39,8 +37,19 @@ class ModelsPart : public SessionPart {
       if (why) *why = "must be a list of models";
       return false;
     }
-    for (const auto& m : section)
-      if (!modelFromJson(m, why)) return false;
+    if (section.size() > kMaxPartItems) {
+      if (why) *why = "more than " + std::to_string(kMaxPartItems) + " models";
+      return false;
+    }
+    std::set<std::string> names;
+    for (const auto& m : section) {
+      auto spec = modelFromJson(m, why);
+      if (!spec) return false;
+      if (!names.insert(spec->name).second) {
+        if (why) *why = "the model name '" + spec->name + "' is used twice";
+        return false;
+      }
+    }
     return true;
   }
 
@@ -118,44 +127,28 @@ class ModelsPart : public SessionPart {
 
   // Simulation fit % (5.2) on the ranges, as the Model panel computes it for the whole log.
   static void addFit(const ModelSpec& spec, const IdData& data, ReportSection& s) {
-    const Channel* torque = data.channel(columns::kTorqueRef);
-    if (!torque) torque = data.input();
-    const Channel* velocity = data.channel(columns::kMotorVelocity);
-    const Channel* angle = data.channel(columns::kMotorAngle);
-    if (!torque || (!velocity && !angle) || data.samples() < 2) {
-      s.paragraphs.push_back("No fit: the log needs a torque reference and a motor angle or velocity.");
+    const LogSimulationResult run = simulateAgainstLog(*spec.model, spec.effects, data);
+    if (!run.ok()) {
+      s.paragraphs.push_back("No fit: " + run.message + ".");
       return;
     }
-    std::vector<double> simulated;
-    try {
-      NonlinearPlant plant(*spec.model, spec.effects);
-      TorqueResponseOptions o;
-      o.substeps = std::max(2, static_cast<int>(std::ceil(data.sampleTime / 2.5e-4)));
-      simulated = simulateTorque(plant, torque->values, data.sampleTime, o).motorVelocity;
-    } catch (const std::invalid_argument& e) {
-      s.paragraphs.push_back(std::string("No fit: the simulation failed: ") + e.what());
-      return;
-    }
-    const std::vector<double> measured =
-        velocity ? velocity->values : differentiate(angle->values, data.sampleTime);
-    const Eigen::Map<const Eigen::VectorXd> y(measured.data(), static_cast<Eigen::Index>(measured.size()));
-    const Eigen::Map<const Eigen::VectorXd> yhat(simulated.data(), static_cast<Eigen::Index>(simulated.size()));
+    const std::vector<double>& measured = run.measured;
+    const std::vector<double>& simulated = run.simulated;
     ReportTable fit{"Simulation fit % (5.2), open loop from the torque reference",
                     {"Range", "Samples", "Fit %"}, {}};
     std::optional<SampleRange> plotRange;
     for (const auto& [name, range] : {std::pair{"estimation", data.estimationRange},
                                       std::pair{"validation", data.validationRange}}) {
       if (!range) continue;
-      const double f = fitPercent(y, yhat, static_cast<Eigen::Index>(range->begin),
-                                  static_cast<Eigen::Index>(range->end));
-      fit.rows.push_back({name, std::to_string(range->size()), formatFixed(f, 2)});
-      s.values[std::string("fit_") + name + "_percent"] = f;
+      const auto f = run.fitPercentOver(*range);
+      if (!f) continue;
+      fit.rows.push_back({name, std::to_string(range->size()), formatFixed(*f, 2)});
+      s.values[std::string("fit_") + name + "_percent"] = *f;
       plotRange = range;  // the validation range when there is one
     }
     if (fit.rows.empty()) {
-      const double f = fitPercent(y, yhat);
-      fit.rows.push_back({"whole log", std::to_string(data.samples()), formatFixed(f, 2)});
-      s.values["fit_whole_log_percent"] = f;
+      fit.rows.push_back({"whole log", std::to_string(data.samples()), formatFixed(run.fitPercent, 2)});
+      s.values["fit_whole_log_percent"] = run.fitPercent;
       plotRange = SampleRange{0, data.samples()};
     }
     s.tables.push_back(fit);
@@ -196,9 +189,23 @@ const std::vector<std::shared_ptr<const SessionPart>>& sessionParts() {
       makeDiscoveryPart(),
       makeLqgPart(),
       makeRecursivePart(),
+      makeDiagnosisPart(),
       std::make_shared<ViewPart>(),
   };
   return kParts;
+}
+
+const IdData* findLog(const ReplayContext& context, const std::string& name, bool raw, std::string* why) {
+  const auto* logs = raw ? context.rawLogs : &context.logs;
+  if (!logs || logs->empty()) {
+    if (why) *why = raw ? "the logs as read are not available" : "the session has no log";
+    return nullptr;
+  }
+  const IdData* d = nullptr;
+  for (const auto& [logName, data] : *logs)
+    if (name.empty() ? d == nullptr : logName == name) d = data;
+  if (!d && why) *why = "the session has no log named '" + name + "'";
+  return d;
 }
 
 const SessionPart* findSessionPart(const std::string& key) {

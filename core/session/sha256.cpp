@@ -1,5 +1,7 @@
 #include "core/session/sha256.h"
 
+#include "core/io/input_file.h"
+
 #include <array>
 #include <cerrno>
 #include <cstdint>
@@ -102,6 +104,13 @@ std::string sha256Hex(std::string_view bytes) {
 }
 
 std::optional<std::string> sha256OfFile(const std::string& path, std::string* why) {
+  // Only a regular file has an end: /dev/zero or a pipe would be hashed forever.
+  std::uint64_t size = 0;
+  std::string problem;
+  if (!checkInputFile(path, ~std::uint64_t{0}, &size, &problem)) {
+    if (why) *why = path + ": " + problem;
+    return std::nullopt;
+  }
   std::ifstream in(path, std::ios::binary);
   if (!in) {
     if (why) *why = "cannot read " + path + ": " + std::strerror(errno);

@@ -167,8 +167,8 @@ bool IdData::isValid(std::string* why) const {
     if (why) *why = std::move(msg);
     return false;
   };
-  if (!(sampleTime > 0.0) || !std::isfinite(sampleTime))
-    return fail("the sample time must be positive and finite");
+  if (!(sampleTime >= kMinSampleTime) || !std::isfinite(sampleTime))
+    return fail("the sample time must be finite and at least 1e-06 s (1 MHz)");
   const std::size_t n = samples();
   if (!timeStamps.empty()) {
     if (timeStamps.size() != n)

@@ -46,6 +46,8 @@ struct SampleRange {
 
 class IdData {
  public:
+  // The finest sample time FlexArm handles (1 MHz): its logs hold time with 9 decimals.
+  static constexpr double kMinSampleTime = 1e-6;
   double sampleTime = 1.0;  // seconds between samples
   double startTime = 0.0;   // time of sample 0, seconds
   std::vector<Channel> channels;
@@ -98,7 +100,7 @@ class IdData {
 
   // True when every channel has the same length, every value is finite (or, for data with
   // time stamps, NaN where a channel was not sampled), the time stamps are finite and the
-  // sample time is positive; otherwise says why.
+  // sample time is finite and at least kMinSampleTime; otherwise says why.
   bool isValid(std::string* why = nullptr) const;
 };
 

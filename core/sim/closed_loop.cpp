@@ -3,7 +3,9 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <algorithm>
 #include <cstdlib>
+#include <memory>
 #include <stdexcept>
 #include <utility>
 
@@ -13,7 +15,7 @@
 namespace flexarm {
 
 namespace {
-bool failWith(std::string* why, const char* text) {
+bool failWith(std::string* why, const std::string& text) {
   if (why) *why = text;
   return false;
 }
@@ -49,17 +51,68 @@ bool SimulationOptions::isValid(std::string* why) const {
   if (ratio < 1.0 - 1e-9 || std::abs(ratio - std::round(ratio)) > 1e-9)
     return failWith(why, "the log rate must divide the controller rate");
   if (substeps < 1 || substeps > 10000) return failWith(why, "substeps must be in 1..10000");
+  // Memory and time grow with the samples and controller ticks: bounded before allocating.
+  if (durationS * logRateHz > kMaxSamples)
+    return failWith(why, "the log would have " + std::to_string(std::llround(durationS * logRateHz)) +
+                             " samples (duration x log rate), more than the " +
+                             std::to_string(static_cast<long long>(kMaxSamples)) +
+                             " one simulation writes; shorten the duration or lower the rate");
+  if (durationS * controller.rateHz > kMaxTicks)
+    return failWith(why, "the simulation would run " +
+                             std::to_string(std::llround(durationS * controller.rateHz)) +
+                             " controller ticks (duration x controller rate), more than " +
+                             std::to_string(static_cast<long long>(kMaxTicks)) +
+                             "; shorten the duration or lower the controller rate");
   if (!std::isfinite(referenceVelocity)) return failWith(why, "reference velocity must be finite");
+  if (!referenceSignal.empty() && !(referenceSampleTime > 0.0 && std::isfinite(referenceSampleTime)))
+    return failWith(why, "a given reference signal needs a sample time > 0");
+  for (double v : referenceSignal)
+    if (!std::isfinite(v)) return failWith(why, "the given reference signal holds a non-finite value");
+  for (const auto& s : parameterSteps)
+    if (s.name.empty() || !std::isfinite(s.value) || !(s.timeS >= 0.0) || !std::isfinite(s.timeS))
+      return failWith(why, "a parameter step needs a name, a finite value and a time >= 0");
   if (why) why->clear();
   return true;
 }
+
+namespace {
+
+// The plant before any step, then after each step in time order (the steps accumulate).
+struct PlantSchedule {
+  std::vector<std::unique_ptr<NonlinearPlant>> plants;
+  std::vector<double> startTimes;  // plants[i] runs from startTimes[i] on
+};
+
+PlantSchedule schedulePlants(const PhysicalModel& model, const std::vector<Effect>& effects,
+                             std::vector<ParameterStep> steps) {
+  PlantSchedule s;
+  s.plants.push_back(std::make_unique<NonlinearPlant>(model, effects));
+  s.startTimes.push_back(0.0);
+  std::stable_sort(steps.begin(), steps.end(),
+                   [](const ParameterStep& a, const ParameterStep& b) { return a.timeS < b.timeS; });
+  auto changed = model.clone();
+  for (const auto& step : steps) {
+    if (model.indexOf(step.name) < 0)
+      throw std::invalid_argument("parameter step: the " + model.structureName() +
+                                  " model has no parameter '" + step.name + "'");
+    changed->setParameter(step.name, step.value);  // throws outside the bounds
+    s.plants.push_back(
+        std::make_unique<NonlinearPlant>(dynamic_cast<const PhysicalModel&>(*changed), effects));
+    s.startTimes.push_back(step.timeS);
+  }
+  return s;
+}
+
+}  // namespace
 
 SimulationResult simulateClosedLoop(const PhysicalModel& model, const std::vector<Effect>& effects,
                                     const SimulationOptions& o, const ProgressCallback& progress) {
   std::string why;
   if (!o.isValid(&why)) throw std::invalid_argument("simulateClosedLoop: " + why);
   const auto start = std::chrono::steady_clock::now();
-  const NonlinearPlant plant(model, effects);
+  const PlantSchedule schedule = schedulePlants(model, effects, o.parameterSteps);
+  std::size_t segment = 0;
+  const NonlinearPlant* active = schedule.plants.front().get();
   const double Tc = 1.0 / o.controller.rateHz;
   const std::size_t decimation = static_cast<std::size_t>(std::llround(o.controller.rateHz / o.logRateHz));
   const std::size_t samples = static_cast<std::size_t>(std::llround(o.durationS * o.logRateHz));
@@ -67,11 +120,20 @@ SimulationResult simulateClosedLoop(const PhysicalModel& model, const std::vecto
   SimulationResult result;
 
   // Separate streams: the excitation must not change when the noise settings change.
-  const std::vector<double> excitation = makeExcitation(o.excitation, Tc, ticks, o.seed);
+  const bool given = !o.referenceSignal.empty();
+  const std::vector<double> excitation =
+      given ? std::vector<double>{} : makeExcitation(o.excitation, Tc, ticks, o.seed);
+  auto givenReference = [&o](double t) {
+    const double pos = t / o.referenceSampleTime;
+    const std::size_t i = static_cast<std::size_t>(pos);
+    if (i + 1 >= o.referenceSignal.size()) return o.referenceSignal.back();
+    const double f = pos - static_cast<double>(i);
+    return (1.0 - f) * o.referenceSignal[i] + f * o.referenceSignal[i + 1];
+  };
   Random noise(o.seed * 0x9E3779B97F4A7C15ull + 0x632BE59BD9B4E019ull);
 
   std::vector<double> applied(ticks, 0.0);  // torque reference + noise, per tick
-  const double delay = plant.inputDelay();
+  const double delay = active->inputDelay();
   auto torqueAt = [&applied, Tc, delay](double t) {
     const double tau = (t - delay) / Tc;
     return tau < 0.0 ? 0.0 : applied[static_cast<std::size_t>(tau)];
@@ -103,7 +165,10 @@ SimulationResult simulateClosedLoop(const PhysicalModel& model, const std::vecto
   const double bound = 1e6;  // rad or rad/s: the loop has run away
   for (std::size_t k = 0; k < ticks; ++k) {
     const double t = static_cast<double>(k) * Tc;
-    const double reference = o.referenceVelocity * t + excitation[k];
+    while (segment + 1 < schedule.plants.size() && t >= schedule.startTimes[segment + 1] - 1e-9 * Tc)
+      active = schedule.plants[++segment].get();
+    const NonlinearPlant& plant = *active;
+    const double reference = given ? givenReference(t) : o.referenceVelocity * t + excitation[k];
     const double angle = measure(plant.motorAngle(x));
     const double velocity = k == 0 ? 0.0 : (angle - previousAngle) / Tc;
     previousAngle = angle;
@@ -166,8 +231,13 @@ SimulationResult simulateClosedLoop(const PhysicalModel& model, const std::vecto
   d.setMeta("generator", "FlexArm simulator (closed loop, Figure 5.1)");
   d.setMeta("model", model.structureName());
   d.setMeta("effects", effectList.empty() ? "none" : effectList);
-  d.setMeta("excitation", toString(o.excitation.kind));
+  d.setMeta("excitation", given ? "given reference signal" : toString(o.excitation.kind));
   d.setMeta("seed", std::to_string(o.seed));
+  if (!o.parameterSteps.empty()) {
+    std::string steps;
+    for (const auto& s : o.parameterSteps) steps += (steps.empty() ? "" : " ") + toString(s);
+    d.setMeta("parameter_steps", steps);
+  }
   char buf[64];
   std::snprintf(buf, sizeof buf, "%.12g", model.value("r"));
   d.setMeta("gear_ratio", buf);
@@ -185,6 +255,31 @@ SimulationResult simulateClosedLoop(const PhysicalModel& model, const std::vecto
   result.controllerTicks = ticks;
   result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return result;
+}
+
+std::optional<ParameterStep> parseParameterStep(const std::string& text, std::string* why) {
+  const auto eq = text.find('=');
+  const auto at = text.find('@', eq == std::string::npos ? 0 : eq);
+  auto number = [](const std::string& t, double& v) {
+    char* end = nullptr;
+    v = std::strtod(t.c_str(), &end);
+    return !t.empty() && end == t.c_str() + t.size() && std::isfinite(v);
+  };
+  ParameterStep s;
+  if (eq == std::string::npos || eq == 0 || at == std::string::npos ||
+      !number(text.substr(eq + 1, at - eq - 1), s.value) || !number(text.substr(at + 1), s.timeS) ||
+      s.timeS < 0.0) {
+    if (why) *why = "a parameter step is NAME=VALUE@SECONDS (e.g. k_T=1.2@20), not '" + text + "'";
+    return std::nullopt;
+  }
+  s.name = text.substr(0, eq);
+  return s;
+}
+
+std::string toString(const ParameterStep& step) {
+  char buf[96];
+  std::snprintf(buf, sizeof buf, "=%.12g@%.12g", step.value, step.timeS);
+  return step.name + buf;
 }
 
 std::optional<ControllerOptions> controllerFromMetadata(const IdData& data, std::string* why) {

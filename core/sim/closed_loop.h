@@ -40,10 +40,21 @@ struct DisturbanceOptions {
   bool isValid(std::string* why) const;
 };
 
+// A parameter of the model that steps to a new value at a given time while the log runs: an
+// abrupt multiplicative fault (the seed's Section 7.1), e.g. k_T up 20 % at 20 s. The state
+// (angles and velocities) is continuous across the step.
+struct ParameterStep {
+  std::string name;    // a parameter of the model, e.g. "k_T", "J_a", "f_m"
+  double value = 0.0;  // its value from timeS on (within the parameter's bounds)
+  double timeS = 0.0;  // seconds from the start of the log, >= 0
+};
+
 struct SimulationOptions {
   ControllerOptions controller;
   DisturbanceOptions disturbance;
   ExcitationOptions excitation;
+  static constexpr double kMaxSamples = 4e6;   // of the log (33 min at 2 kHz)
+  static constexpr double kMaxTicks = 2e7;     // controller periods
   double durationS = 20.0;
   double logRateHz = 2000.0;        // must divide the controller rate
   double referenceVelocity = 0.0;   // rad/s of the motor: phi_ref = v t + excitation
@@ -52,6 +63,15 @@ struct SimulationOptions {
   bool logMotorVelocity = false;    // adds motor_velocity_rad_s (true velocity)
   bool logArmAcceleration = false;  // adds arm_accel_rad_s2 (true acceleration)
   bool logGear = false;             // adds gear_deflection_rad and gear_torque_nm
+  // A given position reference phi_ref (rad, motor side), sampled every referenceSampleTime s
+  // from t = 0 and interpolated linearly at the controller rate (held after its last sample),
+  // in place of the excitation and the reference velocity: to run the loop of a log again
+  // with the log's own reference. Empty: the excitation.
+  std::vector<double> referenceSignal;
+  double referenceSampleTime = 0.0;
+  // Parameters that change during the run, applied in time order at the first controller
+  // tick at or after their time. Empty: the model is the same throughout.
+  std::vector<ParameterStep> parameterSteps;
   bool isValid(std::string* why) const;
 };
 
@@ -64,8 +84,10 @@ struct SimulationResult {
 };
 
 // Simulates the closed loop from rest. Deterministic for a given seed. An unstable loop ends
-// with Termination::Diverged and a message; invalid options or effects throw
-// std::invalid_argument.
+// with Termination::Diverged and a message; invalid options or effects, or a parameter step
+// naming a parameter the model lacks or a value outside its bounds, throw
+// std::invalid_argument. A log with parameter steps says so in its metadata
+// (parameter_steps: NAME=VALUE@TIME ...).
 SimulationResult simulateClosedLoop(const PhysicalModel& model, const std::vector<Effect>& effects,
                                     const SimulationOptions& options,
                                     const ProgressCallback& progress = {});
@@ -74,6 +96,11 @@ SimulationResult simulateClosedLoop(const PhysicalModel& model, const std::vecto
 // controller_kp, controller_kv, controller_ti, as simulateClosedLoop writes them): what the
 // indirect closed-loop fit closes around the model. nullopt with a sentence naming the
 // missing or malformed key, or the invalid controller.
+// "k_T=1.2@20": a parameter step as the command line and the metadata write it; nullopt with
+// a sentence for malformed text.
+std::optional<ParameterStep> parseParameterStep(const std::string& text, std::string* why);
+std::string toString(const ParameterStep& step);
+
 std::optional<ControllerOptions> controllerFromMetadata(const IdData& data, std::string* why);
 
 }  // namespace flexarm

@@ -6,7 +6,10 @@
 #include <filesystem>
 #include <string>
 #include <utility>
+#include <csignal>
+#include <sys/resource.h>
 #include <sys/wait.h>
+#include <vector>
 #include <unistd.h>
 
 namespace flexarm::test {
@@ -60,6 +63,69 @@ inline RunResult runFlexarm(const std::vector<std::string>& args) {
   const int status = std::system(cmd.c_str());
   RunResult r;
   r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  r.out = readAll(out);
+  r.err = readAll(err);
+  return r;
+}
+
+// The sanitizers reserve terabytes of address space and keep freed memory in quarantine:
+// under them an address-space limit cannot be set and resident memory runs higher.
+#if defined(__SANITIZE_ADDRESS__)
+inline constexpr bool kUnderAddressSanitizer = true;
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer)
+inline constexpr bool kUnderAddressSanitizer = true;
+#else
+inline constexpr bool kUnderAddressSanitizer = false;
+#endif
+#else
+inline constexpr bool kUnderAddressSanitizer = false;
+#endif
+
+struct MeasuredRun : RunResult {
+  long maxRssMb = -1;  // peak resident memory of the flexarm process
+};
+
+struct RunLimits {
+  long addressSpaceMb = 4096;  // a runaway allocation fails here instead of eating the machine
+  long fileSizeBlocks = -1;    // RLIMIT_FSIZE in 512-byte blocks (simulates a full disk); -1: none
+};
+
+// Runs flexarm directly (no shell) with limits, and measures its peak resident memory.
+inline MeasuredRun runFlexarmMeasured(const std::vector<std::string>& args, RunLimits limits = {}) {
+  const auto dir = scratchDir();
+  static int counter = 0;
+  const std::string out = (dir / ("mout" + std::to_string(counter))).string();
+  const std::string err = (dir / ("merr" + std::to_string(counter++))).string();
+  MeasuredRun r;
+  const pid_t pid = ::fork();
+  if (pid == 0) {
+    std::freopen("/dev/null", "r", stdin);
+    std::freopen(out.c_str(), "w", stdout);
+    std::freopen(err.c_str(), "w", stderr);
+    if (!kUnderAddressSanitizer && limits.addressSpaceMb > 0) {
+      rlimit as{static_cast<rlim_t>(limits.addressSpaceMb) << 20, static_cast<rlim_t>(limits.addressSpaceMb) << 20};
+      ::setrlimit(RLIMIT_AS, &as);
+    }
+    if (limits.fileSizeBlocks >= 0) {
+      std::signal(SIGXFSZ, SIG_IGN);  // write() then fails with EFBIG, as on a full disk
+      rlimit fs{static_cast<rlim_t>(limits.fileSizeBlocks) * 512, static_cast<rlim_t>(limits.fileSizeBlocks) * 512};
+      ::setrlimit(RLIMIT_FSIZE, &fs);
+    }
+    std::vector<char*> argv;
+    std::string exe = FLEXARM_EXE;
+    argv.push_back(exe.data());
+    std::vector<std::string> copy = args;
+    for (auto& a : copy) argv.push_back(a.data());
+    argv.push_back(nullptr);
+    ::execv(exe.c_str(), argv.data());
+    std::_Exit(127);
+  }
+  int status = 0;
+  rusage usage{};
+  ::wait4(pid, &status, 0, &usage);
+  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  r.maxRssMb = usage.ru_maxrss / 1024;
   r.out = readAll(out);
   r.err = readAll(err);
   return r;

@@ -35,10 +35,10 @@ TEST(CliLog, UsageErrorsExitWithTwo) {
   EXPECT_EQ(runFlexarm({"info", kSample, "--no-such-option"}).code, 2);
   auto r = runFlexarm({"preprocess", kSample, "--decimate", "0", "--out", "/tmp/x.csv"});
   EXPECT_EQ(r.code, 2);
-  EXPECT_NE(r.err.find("decimation factor"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("--decimate expects a whole number from 1 to"), std::string::npos) << r.err;
   r = runFlexarm({"preprocess", kSample, "--decimate", "ten", "--out", "/tmp/x.csv"});
   EXPECT_EQ(r.code, 2);
-  EXPECT_NE(r.err.find("expects an integer"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("--decimate expects a whole number"), std::string::npos) << r.err;
   EXPECT_EQ(runFlexarm({"preprocess", kSample, "--decimate", "10"}).code, 2) << "--out missing";
 }
 

@@ -2,6 +2,7 @@
 // carries the section titles, parameter names, checksums and the same fit % as --json.
 #include <gtest/gtest.h>
 
+#include <cctype>
 #include <cstdio>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -37,7 +38,8 @@ TEST(CliRun, JsonNamesVersionLogChecksumAndEveryModel) {
                                               "Non-parametric estimate (SPA)",
                                               "Fit three-mass estimate",
                                               "Discovery: the missing effect",
-                                              "LQG design (chapter 8)"}));
+                                              "LQG design (chapter 8)",
+                                              "Diagnosis (chapter 7)"}));
   EXPECT_EQ(j["sections"][0]["values"]["rate_hz"].get<double>(), 200.0);
 }
 
@@ -94,9 +96,11 @@ TEST(CliRun, PdfTextHasTitlesParametersChecksumAndTheJsonFitPercent) {
   const std::string hidden = truth["effects"][0]["name"];
   const nlohmann::json* discovery = nullptr;
   const nlohmann::json* lqg = nullptr;
+  const nlohmann::json* diagnosis = nullptr;
   for (const auto& s : j["sections"]) {
     if (s["title"] == "Discovery: the missing effect") discovery = &s["values"];
     if (s["title"] == "LQG design (chapter 8)") lqg = &s["values"];
+    if (s["title"] == "Diagnosis (chapter 7)") diagnosis = &s["values"];
   }
   ASSERT_NE(discovery, nullptr);
   ASSERT_NE(lqg, nullptr);
@@ -125,6 +129,26 @@ TEST(CliRun, PdfTextHasTitlesParametersChecksumAndTheJsonFitPercent) {
   for (const char* title : {"Design options", "Nyquist curve of F_y G near -1",
                             "Sensitivity |S| (8.36) and complementary sensitivity |T|"})
     EXPECT_NE(text.find(title), std::string::npos) << title;
+  // The diagnosis of the log whose torque constant steps up at 12 s names it shortly after,
+  // and the report states the thresholds with the false-alarm rate they were chosen for.
+  ASSERT_NE(diagnosis, nullptr);
+  const nlohmann::json step = nlohmann::json::parse(
+      readAll(std::string(FLEXARM_SAMPLE_DIR) + "/diagnosis_step_k_T.truth.json"))["parameter_steps"][0];
+  EXPECT_EQ((*diagnosis)["verdict"], step["name"]);
+  const double delay = (*diagnosis)["alarm_time_s"].get<double>() - step["time_s"].get<double>();
+  EXPECT_GT(delay, 0.0);
+  EXPECT_LT(delay, 2.0);
+  // Paragraphs wrap where the page ends: the words are looked for with every run of white
+  // space read as one space.
+  std::string flat;
+  for (char c : text)
+    if (!std::isspace(static_cast<unsigned char>(c))) flat += c;
+    else if (flat.empty() || flat.back() != ' ') flat += ' ';
+  for (const char* words : {"Diagnosis (chapter 7)", "Verdict: k_T changed", "Thresholds",
+                            "no false alarm in 0.3 h of fault-free runs (at most 10 false alarms per hour",
+                            "Decision structure (Section 7.5.2)",
+                            "CUSUM (7.1), (7.15)-(7.17) against its threshold", "Alarm timeline"})
+    EXPECT_NE(flat.find(words), std::string::npos) << words;
 }
 
 TEST(CliRun, HtmlIsSelfContained) {

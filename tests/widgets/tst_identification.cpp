@@ -14,7 +14,12 @@
 #include <QtTest>
 #include <qcustomplot.h>
 
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+#include "app/cli/cli.h"
 #include "app/main_window.h"
+#include "app/session_controller.h"
 #include "core/models/physical_models.h"
 #include "widget_test_support.h"
 #include "widgets/arm/vtk_view.h"
@@ -108,7 +113,8 @@ class IdentificationTest : public QObject {
     QVERIFY2(s.contains("% on the estimation data") && s.contains("% on the validation data"),
              qPrintable(s));
     QVERIFY2(s.contains("Notches: ") && s.contains("rad/s"), qPrintable(s));
-    // The log has a reference channel: the default is the two-stage closed-loop fit.
+    // The log has a reference channel and is decimated, so the indirect fit cannot run at the
+    // controller's rate: Auto takes the two-stage closed-loop fit and says why.
     QVERIFY2(s.contains("two-stage closed-loop fit: the reference explains"), qPrintable(s));
     test::saveShot(fit->grab().toImage(), "fit_panel_three_mass");
     // Direct on request, and the combo is off for the innovations form (it needs output error).
@@ -117,14 +123,14 @@ class IdentificationTest : public QObject {
     fit->setNoiseModel(NoiseModel::Innovations);
     QVERIFY(!combo->isEnabled());
     fit->setNoiseModel(NoiseModel::OutputError);
-    fit->setClosedLoopMethod(ClosedLoopMethod::Direct);
+    fit->setClosedLoopMethod(ClosedLoopChoice::Direct);
     QVERIFY2(clickEstimate(fit), qPrintable(fit->summaryText()));
     QVERIFY2(fit->summaryText().contains("direct fit of closed-loop data"),
              qPrintable(fit->summaryText()));
     // Indirect: the log's controller closed around the model. Decimated data cannot carry the
     // loop (a sentence says so); at the log's own rate every free truth lies in its interval.
     QVERIFY(combo->findData("indirect") >= 0);
-    fit->setClosedLoopMethod(ClosedLoopMethod::Indirect);
+    fit->setClosedLoopMethod(ClosedLoopChoice::Indirect);
     QCOMPARE(combo->currentData().toString(), QString("indirect"));
     QVERIFY(!clickEstimate(fit));
     QVERIFY2(fit->summaryText().contains("controller's rate"), qPrintable(fit->summaryText()));
@@ -141,7 +147,73 @@ class IdentificationTest : public QObject {
     }
     test::saveShot(fit->grab().toImage(), "fit_panel_indirect");
     fit->setDecimation(10);
-    fit->setClosedLoopMethod(ClosedLoopMethod::TwoStage);
+    fit->setClosedLoopMethod(ClosedLoopChoice::TwoStage);
+  }
+
+  // Issue 13's identity: one log and one model through the Fit panel, `flexarm fit` and
+  // `flexarm run` of the session the window saves give the same numbers, bit for bit, because
+  // all three run the one fit pipeline (core/ident/fit.h) on the same options.
+  void panelCommandLineAndReplayGiveIdenticalNumbers() {
+    FitPanel* fit = window_->fitPanel();
+    QVERIFY(fit->setModelChoice("three-mass"));
+    fit->setFreeParameters({"J_m", "J_a", "k_g", "k_a"});
+    fit->setDecimation(1);
+    fit->setNoiseModel(NoiseModel::OutputError);
+    fit->setStarts(0);
+    fit->setClosedLoopMethod(ClosedLoopChoice::Auto);
+    QVERIFY2(clickEstimate(fit), qPrintable(fit->summaryText()));
+    const ModelEntry panel = window_->workspace()->models().back();
+    QVERIFY(panel.model != nullptr);
+    QVERIFY2(fit->summaryText().contains("indirect closed-loop fit"), qPrintable(fit->summaryText()));
+
+    std::ostringstream out, err;
+    QCOMPARE(cli::runCommandLine({"fit", kSampleLog.toStdString(), "--model", "three-mass", "--free",
+                                  "J_m,J_a,k_g,k_a", "--range", "0.5:9", "--validation-range", "9:17.5",
+                                  "--json"},
+                                 out, err),
+             0);
+    const auto line = nlohmann::json::parse(out.str());
+    QCOMPARE(line["closed_loop_method"].get<std::string>(), std::string("indirect"));
+
+    QTemporaryDir dir;
+    const QString path = dir.filePath("identity.json");
+    QString why;
+    QVERIFY2(window_->sessionController()->save(path, &why), qPrintable(why));
+    std::ostringstream rout, rerr;
+    QCOMPARE(cli::runCommandLine({"run", path.toStdString(), "--json"}, rout, rerr), 0);
+    const auto report = nlohmann::json::parse(rout.str());
+    const nlohmann::json* replay = nullptr;
+    for (const auto& section : report["sections"])
+      if (section["title"] == "Fit " + panel.name.toStdString()) replay = &section["values"];
+    QVERIFY2(replay, rout.str().c_str());
+
+    int free = 0;
+    for (std::size_t i = 0; i < panel.model->parameters().size(); ++i) {
+      const auto& p = panel.model->parameters()[i];
+      QCOMPARE(line["parameters"][p.name].get<double>(), p.value);
+      QCOMPARE((*replay)["parameters"][p.name].get<double>(), p.value);
+      const auto at = std::find(panel.covarianceIndices.begin(), panel.covarianceIndices.end(), static_cast<int>(i));
+      if (at == panel.covarianceIndices.end()) continue;
+      const auto k = static_cast<Eigen::Index>(at - panel.covarianceIndices.begin());
+      const double sd = std::sqrt(std::max(0.0, panel.covariance(k, k)));
+      QCOMPARE(line["std"][p.name].get<double>(), sd);
+      QCOMPARE((*replay)["std"][p.name].get<double>(), sd);
+      ++free;
+    }
+    QCOMPARE(free, 4);
+    QCOMPARE((*replay)["loss"].get<double>(), line["loss"].get<double>());
+    QCOMPARE((*replay)["fit_estimation_percent"].get<double>(), line["fit_percent"].get<double>());
+    QCOMPARE((*replay)["fit_validation_percent"].get<double>(), line["fit_percent_validation"].get<double>());
+    QVERIFY((*replay)["notches_rad_s"] == line["notches_rad_s"]);
+    const QString shown = QString::number(line["fit_percent_validation"].get<double>(), 'f', 1) + " %";
+    QVERIFY2(fit->summaryText().contains(shown), qPrintable(shown + " not in " + fit->summaryText()));
+    // As a user sees it on a 1366 x 768 screen.
+    window_->resize(1366, 768);
+    QTest::qWait(300);
+    test::saveShot(window_->grab().toImage(), "fit_identity_1366x768");
+    test::saveShot(fit->grab().toImage(), "fit_panel_identity");
+    window_->resize(1500, 1000);
+    QTest::qWait(100);
   }
 
   void blackBoxFitJoinsTheListToo() {

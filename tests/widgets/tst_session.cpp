@@ -180,7 +180,7 @@ class SessionTest : public QObject {
     QVERIFY2(clickEstimate(fit), qPrintable(fit->summaryText()));
     const QString blackBoxSummary = fit->summaryText();
     const ModelEntry blackBox = ws->models().back();
-    QVERIFY(blackBox.polynomial && blackBox.fitRequest && blackBox.fitRequest->decimation == 2);
+    QVERIFY(blackBox.polynomial && blackBox.fitRequest && blackBox.fitRequest->options.decimation == 2);
 
     const QString path = dir_.filePath("fits.json");
     QString why;

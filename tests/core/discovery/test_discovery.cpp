@@ -4,6 +4,8 @@
 // the base model (two-mass, the chapter-3 model (3.13)) and must name the effect.
 #include <gtest/gtest.h>
 
+#include "tests/test_scale.h"
+
 #include <algorithm>
 #include <atomic>
 #include <cmath>
@@ -152,14 +154,17 @@ TEST(Discovery, RejectsMisuseAndReportsBadData) {
 // validation residual RMS at least 30 % lower.
 TEST(Discovery, NamesTheHiddenEffect) {
   std::vector<Case> cases;
+  // Three magnitudes of every effect and four logs without one; under the sanitizers the
+  // strongest magnitude and one clean log (tests/test_scale.h).
+  const bool reduced = flexarm::test::reducedSizes();
   const double magnitudes[] = {1.5, 2.0, 3.0};
   for (EffectKind k : allEffectKinds())
-    for (int s = 0; s < 3; ++s) {
+    for (int s = reduced ? 2 : 0; s < 3; ++s) {
       double mag = magnitudes[s];
       if (k == EffectKind::ExtraMass) mag = 0.7 + 0.3 * s;  // 70, 100, 130 rad/s
       cases.push_back({k, 11 + 7 * s + static_cast<int>(k), mag});
     }
-  for (int s = 0; s < 4; ++s) cases.push_back({std::nullopt, 5 + 3 * s, 0.0});
+  for (int s = 0; s < (reduced ? 1 : 4); ++s) cases.push_back({std::nullopt, 5 + 3 * s, 0.0});
 
   const auto outcomes = runAll(cases);
   std::map<std::string, std::map<std::string, int>> confusion;
@@ -185,6 +190,11 @@ TEST(Discovery, NamesTheHiddenEffect) {
       continue;
     }
     ++withEffect;
+    // A gap's or a delay's interval comes from a loss that is not smooth in it (issue 13:
+    // 46 standard deviations off): the evidence says so; a smooth effect's does not.
+    const bool rough = said == toString(EffectKind::Backlash) || said == toString(EffectKind::InputDelay);
+    EXPECT_EQ(o.result.evidence.find("promises too much") != std::string::npos, rough)
+        << said << ": " << o.result.evidence;
     if (said == truth) {
       ++right;
       EXPECT_LE(o.result.augmented.rmsValidation, 0.7 * o.result.base.rmsValidation)
@@ -202,7 +212,7 @@ TEST(Discovery, NamesTheHiddenEffect) {
     std::printf("\n");
   }
   std::printf("right %d of %d; slowest run %.1f s\n", right, withEffect, seconds);
-  EXPECT_GE(right, static_cast<int>(std::ceil(0.9 * withEffect)));
+  EXPECT_GE(right, reduced ? withEffect - 1 : static_cast<int>(std::ceil(0.9 * withEffect)));
 }
 
 }  // namespace

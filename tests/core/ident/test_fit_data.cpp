@@ -78,6 +78,29 @@ TEST(FitData, VelocityDecimationRangesAndMeansMatchTheStepsDoneOneByOne) {
   EXPECT_EQ(p.steps.size(), 3u) << p.note();
 }
 
+// Decimated, a held input is the mean over each new sample period (what a zero-order hold of
+// that period must hold), while the output stays the FIR's.
+TEST(FitData, HeldMeanInputIsTheMeanOverEachHeldPeriod) {
+  const IdData log = makeLog();
+  FitDataOptions o;
+  o.decimation = 10;
+  o.removeMeans = false;
+  const PreparedData filtered = prepareFitData(log, o);
+  o.decimatedInput = FitDataOptions::DecimatedInput::HeldMean;
+  const PreparedData held = prepareFitData(log, o);
+  ASSERT_TRUE(held.ok()) << held.message;
+  ASSERT_EQ(held.u.size(), 800);
+  const auto& u = log.input()->values;
+  for (Eigen::Index k : {0, 1, 399, 799}) {
+    double sum = 0.0;
+    for (int j = 0; j < 10; ++j) sum += u[static_cast<std::size_t>(10 * k + j)];
+    EXPECT_NEAR(held.u[k], sum / 10.0, 1e-14) << k;
+  }
+  EXPECT_GT((held.u - filtered.u).cwiseAbs().maxCoeff(), 1e-3);
+  EXPECT_EQ(held.y, filtered.y);
+  EXPECT_NE(held.note().find("mean over each held period"), std::string::npos) << held.note();
+}
+
 TEST(FitData, UnsetRangesMeanEverythingAndNoValidationAndMeansCanStay) {
   IdData log = makeLog();
   // A range the log stores is not used unless it is passed.

@@ -59,6 +59,8 @@ TEST(Etfe, SmoothingReducesTheErrorOnNoisyData) {
     eSmooth += std::norm(rs.response.value[i] - t.value[i]) / std::norm(t.value[i]);
   }
   EXPECT_LT(eSmooth, 0.3 * eRaw);
+  EXPECT_EQ(rr.window, 1);
+  EXPECT_EQ(rs.window, 30);
   EXPECT_LT(std::sqrt(eSmooth / grid.size()), 0.1);
 }
 
@@ -86,6 +88,11 @@ TEST(Spa, EstimatesKnownSystemAndItsBandCoversTheTruth) {
   const auto h = spa(s.u, s.y, 1.0, o);
   EXPECT_NE(h.response.magnitude[10], r.response.magnitude[10]);
   EXPECT_NEAR(h.response.magnitude[10] / t.magnitude[10], 1.0, 0.05);
+  EXPECT_EQ(h.window, 200);
+  // The default lag window, which a report prints beside the estimate: N / 10 up to 30,
+  // never more than N - 1.
+  EXPECT_EQ(spa(s.u, s.y, 1.0).window, 30);
+  EXPECT_EQ(spa(s.u.head(120), s.y.head(120), 1.0).window, 12);
 }
 
 TEST(Spa, ClosedLoopDataCarryTheBiasWarning) {

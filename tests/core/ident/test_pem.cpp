@@ -7,6 +7,7 @@
 #include <random>
 
 #include "core/ident/pem.h"
+#include "core/models/physical_models.h"
 #include "sim_helpers.h"
 #include "two_mass_test_model.h"
 
@@ -163,6 +164,29 @@ TEST(GreyBox, SeveralStartsRescueAFarStart) {
   const double noiseVar = std::pow(0.05, 2) * (d.yClean.array() - d.yClean.mean()).square().mean();
   EXPECT_LT(r2.summary.loss, 1.2 * noiseVar);
   EXPECT_NEAR(r2.model->parameters()[3].value / 1.5e5, 1.0, 0.05);
+}
+
+TEST(GreyBox, AStartOnABoundIsFittedNotRefused) {
+  // exp(log(1e4)) rounds one ulp past 1e4, the friction's upper bound: a start there (as a
+  // random start clamped to its bounds, or a step projected onto them) ended the fit with
+  // "f_m = 10000 is outside its bounds".
+  const auto truth = makeModel("two-mass");
+  std::mt19937 rng(8);
+  const Eigen::VectorXd u = testing::whiteNoise(600, 1.0, rng);
+  const Eigen::VectorXd y = testing::rk4Simulate(truth->stateSpace(), u, kTs);
+  auto start = makeModel("two-mass");
+  start->setParameter("f_m", 1e4);
+  PemOptions o;
+  o.maxIterations = 5;
+  o.randomStarts = 2;
+  PemResult r;
+  ASSERT_NO_THROW(r = pem(*start, u, y, kTs, o));
+  EXPECT_NE(r.summary.termination, Termination::Failed) << r.summary.message;
+  EXPECT_EQ(r.starts, 3);
+  for (const auto& p : r.model->parameters()) {
+    EXPECT_GE(p.value, p.lower) << p.name;
+    EXPECT_LE(p.value, p.upper) << p.name;
+  }
 }
 
 TEST(GreyBox, CancelStopsTheSearch) {

@@ -11,6 +11,7 @@
 
 #include "core/io/log_io.h"
 #include "core/models/analysis.h"
+#include "core/signal/preprocess.h"
 #include "core/session/fit_request.h"
 #include "core/session/replay.h"
 #include "core/session/session.h"
@@ -41,30 +42,39 @@ std::map<std::string, double> truth() {
 FitRequest blackBoxRequest() {
   FitRequest r;
   r.name = "oe[4 4 1]";
-  r.structure = PolyStructure::Oe;
-  r.orders.na = 0;
-  r.orders.nb = 4;
-  r.orders.nf = 4;
-  r.orders.nk = 1;
-  r.decimation = 2;
+  FitModelSpec& m = r.options.model;
+  m.kind = FitModelKind::BlackBox;
+  m.structure = PolyStructure::Oe;
+  m.orders.na = 0;
+  m.orders.nb = 4;
+  m.orders.nf = 4;
+  m.orders.nk = 1;
+  r.options.decimation = 2;
   r.estimation = SecondsRange{0.5, 12.0};
+  return r;
+}
+
+FitRequest physicalRequest(std::shared_ptr<const PhysicalModel> start) {
+  FitRequest r;
+  r.options.model.kind = FitModelKind::Physical;
+  r.options.model.start = std::move(start);
   return r;
 }
 
 }  // namespace
 
 TEST(FitRequest, JsonRoundTripKeepsEveryField) {
-  FitRequest p;
-  p.name = "three-mass estimate";
   auto start = makeModel("three-mass");
   for (const auto& q : start->parameters()) start->setFree(q.name, q.name == "k_g" || q.name == "J_a");
   start->setParameter("k_g", 123456.0);
-  p.start = std::move(start);
-  p.noiseModel = NoiseModel::Innovations;
-  p.randomStarts = 3;
-  p.seed = 7;
-  p.decimation = 5;
-  p.maxIterations = 40;
+  FitRequest p = physicalRequest(std::move(start));
+  p.name = "three-mass estimate";
+  p.options.noiseModel = NoiseModel::Innovations;
+  p.options.closedLoop = ClosedLoopChoice::Direct;
+  p.options.randomStarts = 3;
+  p.options.seed = 7;
+  p.options.decimation = 5;
+  p.options.maxIterations = 40;
   p.estimation = SecondsRange{0.5, 12.0};
   p.validation = SecondsRange{12.0, 17.5};
   std::string why;
@@ -72,15 +82,23 @@ TEST(FitRequest, JsonRoundTripKeepsEveryField) {
   ASSERT_TRUE(back) << why;
   EXPECT_EQ(fitRequestToJson(*back).dump(), fitRequestToJson(p).dump());
   EXPECT_TRUE(back->physical());
-  EXPECT_EQ(back->start->value("k_g"), 123456.0);
-  EXPECT_EQ(back->noiseModel, NoiseModel::Innovations);
-  EXPECT_EQ(back->seed, 7u);
+  EXPECT_EQ(back->options.model.start->value("k_g"), 123456.0);
+  EXPECT_EQ(back->options.noiseModel, NoiseModel::Innovations);
+  EXPECT_EQ(back->options.seed, 7u);
   EXPECT_EQ(*back->validation, (SecondsRange{12.0, 17.5}));
+  // Auto is stored as such; a request written before closed_loop existed ran direct fits.
+  p.options.noiseModel = NoiseModel::OutputError;
+  p.options.closedLoop = ClosedLoopChoice::Auto;
+  json j = fitRequestToJson(p);
+  EXPECT_EQ(j["closed_loop"], "auto");
+  EXPECT_EQ(fitRequestFromJson(j, &why)->options.closedLoop, ClosedLoopChoice::Auto);
+  j.erase("closed_loop");
+  EXPECT_EQ(fitRequestFromJson(j, &why)->options.closedLoop, ClosedLoopChoice::Direct);
 
   auto bb = fitRequestFromJson(fitRequestToJson(blackBoxRequest()), &why);
   ASSERT_TRUE(bb) << why;
   EXPECT_FALSE(bb->physical());
-  EXPECT_EQ(bb->orders.nf, 4);
+  EXPECT_EQ(bb->options.model.orders.nf, 4);
   EXPECT_FALSE(bb->validation.has_value());
 }
 
@@ -105,11 +123,10 @@ TEST(FitRequest, MalformedRequestsAreRefusedWithASentence) {
   EXPECT_NE(why.find("orders"), std::string::npos) << why;
 
   // A physical request without a free parameter is refused, and so is a session holding it.
-  FitRequest p;
-  p.name = "fixed";
   auto start = makeModel("two-mass");
   for (const auto& q : start->parameters()) start->setFree(q.name, false);
-  p.start = std::move(start);
+  FitRequest p = physicalRequest(std::move(start));
+  p.name = "fixed";
   EXPECT_FALSE(fitRequestFromJson(fitRequestToJson(p), &why));
   EXPECT_NE(why.find("free parameter"), std::string::npos) << why;
   auto loaded = loadSession(kSample);
@@ -208,10 +225,10 @@ TEST(FitsPart, BlackBoxRequestIsReplayedAtItsDecimatedRate) {
   // The same request on the same data gives the same numbers.
   auto prepared = prepareSession(s, kSample);
   ASSERT_TRUE(prepared.ok) << prepared.message;
-  const FitRun run = runFitRequest(bb, prepared.logs[0].data);
+  const FitResult run = runFitRequest(bb, prepared.logs[0].data);
   ASSERT_TRUE(run.polynomial);
   EXPECT_NEAR(run.polynomial->sampleTime, 0.01, 1e-12);  // 200 Hz decimated by 2
-  EXPECT_EQ(run.fitValidation.value(), (*fit)["fit_validation_percent"].get<double>());
+  EXPECT_EQ(run.fitValidation().value(), (*fit)["fit_validation_percent"].get<double>());
 }
 
 TEST(FitsPart, DataFailuresBecomeSentences) {
@@ -226,7 +243,8 @@ TEST(FitsPart, DataFailuresBecomeSentences) {
   for (const auto& sec : r.report.sections)
     if (sec.title == "Fit oe[4 4 1]") {
       ASSERT_FALSE(sec.paragraphs.empty());
-      EXPECT_NE(sec.paragraphs.back().find("No fit: the estimation range holds only"), std::string::npos)
+      EXPECT_NE(sec.paragraphs.back().find("No fit: the estimation range 100-200 s holds no samples of the log"),
+                std::string::npos)
           << sec.paragraphs.back();
       return;
     }
@@ -240,24 +258,26 @@ TEST(FitsPart, DataFailuresBecomeSentences) {
 TEST(FitsPart, IndirectRequestRecoversTheChirpTruthInsideItsIntervals) {
   const auto read = readLog(std::string(FLEXARM_SAMPLE_DIR) + "/three_mass_estimation_chirp.csv");
   ASSERT_TRUE(read.ok) << read.error.problem;
-  FitRequest req;
-  req.name = "three-mass indirect";
   auto start = makeModel("three-mass");
   const std::pair<const char*, double> off[] = {{"J_m", 1.2}, {"J_g", 0.8}, {"J_a", 1.15},
                                                 {"k_g", 0.85}, {"k_a", 1.1}, {"d_a", 1.25}};
   for (const auto& [name, f] : off) start->setParameter(name, start->value(name) * f);
-  req.start = std::move(start);
-  req.closedLoop = ClosedLoopMethod::Indirect;
+  FitRequest req = physicalRequest(std::move(start));
+  req.name = "three-mass indirect";
+  req.options.closedLoop = ClosedLoopChoice::Indirect;
   req.estimation = SecondsRange{0.0, 12.0};
   req.validation = SecondsRange{12.0, 17.5};
   std::string why;
   const auto back = fitRequestFromJson(fitRequestToJson(req), &why);
   ASSERT_TRUE(back) << why;
-  EXPECT_EQ(back->closedLoop, ClosedLoopMethod::Indirect);
+  EXPECT_EQ(back->options.closedLoop, ClosedLoopChoice::Indirect);
 
-  const FitRun run = runFitRequest(*back, read.data);
+  const FitResult run = runFitRequest(*back, read.data);
   ASSERT_EQ(run.termination, Termination::Converged) << run.message;
-  EXPECT_NE(run.data.note.find("indirect closed-loop fit"), std::string::npos) << run.data.note;
+  ASSERT_TRUE(run.method.has_value());
+  EXPECT_EQ(*run.method, ClosedLoopMethod::Indirect);
+  EXPECT_NE(run.methodDescription.find("indirect closed-loop fit"), std::string::npos) << run.methodDescription;
+  EXPECT_NE(run.controllerSource.find("metadata"), std::string::npos) << run.controllerSource;
   const auto t = truth();
   int checked = 0;
   for (const auto& p : run.parameters) {
@@ -267,12 +287,19 @@ TEST(FitsPart, IndirectRequestRecoversTheChirpTruthInsideItsIntervals) {
     ++checked;
   }
   EXPECT_EQ(checked, 8);
-  ASSERT_TRUE(run.fitValidation.has_value());
-  EXPECT_GT(*run.fitValidation, 70.0);
+  ASSERT_TRUE(run.fitValidation().has_value());
+  EXPECT_GT(*run.fitValidation(), 70.0);
 
+  // Decimated data cannot carry the controller's loop: the request is refused with a sentence.
   FitRequest decimated = *back;
-  decimated.decimation = 4;
-  const FitRun refused = runFitRequest(decimated, read.data);
+  decimated.options.decimation = 4;
+  EXPECT_FALSE(decimated.isValid(&why));
+  EXPECT_NE(why.find("controller's rate"), std::string::npos) << why;
+  EXPECT_THROW(runFitRequest(decimated, read.data), std::invalid_argument);
+  // The session's own preprocessing may decimate the log: then the data say so.
+  DecimateOptions d4;
+  d4.factor = 4;
+  const FitResult refused = runFitRequest(*back, decimate(read.data, d4));
   EXPECT_EQ(refused.termination, Termination::Failed);
   EXPECT_NE(refused.message.find("controller's rate"), std::string::npos) << refused.message;
 }

@@ -65,11 +65,15 @@ TEST(Sha256, KnownDigestsOfFips180Examples) {
 
 TEST(Session, SampleSessionChecksumsMatchItsLogs) {
   Session s = sampleSession();
-  ASSERT_EQ(s.logs.size(), 2u);  // the chirp analysed, the torque-ripple log for discovery
+  // The chirp analysed, the torque-ripple log for discovery, the log diagnosed and its
+  // fault-free reference.
+  ASSERT_EQ(s.logs.size(), 4u);
   std::string why;
   EXPECT_EQ(sha256OfFile(kChirp, &why).value_or(why), s.logs[0].sha256);
-  EXPECT_EQ(sha256OfFile(std::string(FLEXARM_SAMPLE_DIR) + "/effect_torque_ripple.csv", &why).value_or(why),
-            s.logs[1].sha256);
+  const char* others[] = {"effect_torque_ripple.csv", "diagnosis_step_k_T.csv", "diagnosis_no_fault.csv"};
+  for (std::size_t i = 1; i < 4; ++i)
+    EXPECT_EQ(sha256OfFile(std::string(FLEXARM_SAMPLE_DIR) + "/" + others[i - 1], &why).value_or(why),
+              s.logs[i].sha256) << others[i - 1];
   EXPECT_TRUE(s.preprocessed);
   EXPECT_TRUE(s.preprocess.differentiateAngle);
   EXPECT_EQ(s.preprocess.decimation.factor, 10);

@@ -93,8 +93,9 @@ TEST(ClosedLoop, EncoderQuantizesTheMeasuredAngle) {
   SimulationOptions o = shortRun();
   o.disturbance.encoderCountsPerRev = 4096;
   const double q = 2.0 * M_PI / 4096;
-  for (double v : channel(simulateClosedLoop(*m, {}, o), columns::kMotorAngle))
-    EXPECT_NEAR(v / q, std::round(v / q), 1e-6);
+  // The result is kept by name: a range-for over a member of a temporary reads freed memory.
+  const SimulationResult r = simulateClosedLoop(*m, {}, o);
+  for (double v : channel(r, columns::kMotorAngle)) EXPECT_NEAR(v / q, std::round(v / q), 1e-6);
 }
 
 TEST(ClosedLoop, RandomIsReproducibleAndNormal) {
@@ -300,6 +301,59 @@ TEST(ClosedLoop, LogRateDecimatesTheControllerSamples) {
   EXPECT_DOUBLE_EQ(slow.data.sampleTime, 0.005);
   for (std::size_t i = 0; i < slow.data.samples(); ++i)
     EXPECT_EQ(channel(slow, columns::kTorqueRef)[i], channel(full, columns::kTorqueRef)[10 * i]);
+}
+
+TEST(ClosedLoop, ParameterStepChangesThePlantFromItsTimeOn) {
+  auto m = makeModel("three-mass");
+  SimulationOptions o = shortRun();
+  const auto healthy = simulateClosedLoop(*m, {}, o);
+  o.parameterSteps = {{"k_T", 1.2, 1.0}};
+  const auto faulty = simulateClosedLoop(*m, {}, o);
+  ASSERT_EQ(faulty.termination, Termination::Converged);
+  const auto& a = channel(healthy, columns::kMotorVelocity);
+  const auto& b = channel(faulty, columns::kMotorVelocity);
+  const std::size_t step = healthy.data.rangeForTimes(1.0, 1.0).begin;
+  // Before the step the runs are the same sample for sample; the first sample after it still
+  // is (the state is continuous), then the stronger torque shows.
+  for (std::size_t k = 0; k <= step; ++k) ASSERT_EQ(a[k], b[k]) << k;
+  double after = 0.0;
+  for (std::size_t k = step + 1; k < a.size(); ++k) after = std::max(after, std::abs(a[k] - b[k]));
+  EXPECT_GT(after, 1e-3);
+  EXPECT_EQ(faulty.data.meta("parameter_steps"), "k_T=1.2@1");
+  EXPECT_TRUE(healthy.data.meta("parameter_steps").empty());
+}
+
+TEST(ClosedLoop, ParameterStepAtTheStartIsTheChangedModel) {
+  auto m = makeModel("three-mass");
+  SimulationOptions o = shortRun();
+  o.parameterSteps = {{"f_m", 0.0426, 0.0}};
+  const auto stepped = simulateClosedLoop(*m, {}, o);
+  m->setParameter("f_m", 0.0426);
+  o.parameterSteps.clear();
+  const auto changed = simulateClosedLoop(*m, {}, o);
+  EXPECT_EQ(channel(stepped, columns::kMotorAngle), channel(changed, columns::kMotorAngle));
+}
+
+TEST(ClosedLoop, ParameterStepMisuseThrowsAndTextRoundTrips) {
+  auto m = makeModel("three-mass");
+  SimulationOptions o = shortRun();
+  o.parameterSteps = {{"no_such", 1.0, 0.5}};
+  EXPECT_THROW(simulateClosedLoop(*m, {}, o), std::invalid_argument);
+  o.parameterSteps = {{"J_a", -1.0, 0.5}};  // below J_a's bound
+  EXPECT_THROW(simulateClosedLoop(*m, {}, o), std::invalid_argument);
+  o.parameterSteps = {{"J_a", 1.0, -0.5}};
+  EXPECT_THROW(simulateClosedLoop(*m, {}, o), std::invalid_argument);
+  std::string why;
+  const auto s = parseParameterStep("J_a=1.4333333333333333@20", &why);
+  ASSERT_TRUE(s);
+  EXPECT_EQ(s->name, "J_a");
+  EXPECT_DOUBLE_EQ(s->value, 1.4333333333333333);
+  EXPECT_DOUBLE_EQ(s->timeS, 20.0);
+  EXPECT_EQ(toString(*s), "J_a=1.43333333333@20");
+  for (const char* bad : {"k_T=1.2", "k_T@20", "=1@2", "k_T=x@2", "k_T=1@-1", "k_T=1@2s"}) {
+    EXPECT_FALSE(parseParameterStep(bad, &why)) << bad;
+    EXPECT_NE(why.find("NAME=VALUE@SECONDS"), std::string::npos);
+  }
 }
 
 }  // namespace

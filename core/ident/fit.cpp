@@ -1,0 +1,330 @@
+#include "core/ident/fit.h"
+
+#include <chrono>
+#include <cmath>
+#include <stdexcept>
+
+#include "core/ident/evaluation.h"
+#include "core/ident/fit_internal.h"
+
+namespace flexarm {
+
+const char* toString(FitModelKind k) {
+  switch (k) {
+    case FitModelKind::Physical: return "physical";
+    case FitModelKind::BlackBox: return "black-box";
+    case FitModelKind::Spa: return "spa";
+    case FitModelKind::Etfe: return "etfe";
+  }
+  return "black-box";
+}
+
+std::optional<FitModelKind> fitModelKindFromString(std::string_view s) {
+  for (auto k : {FitModelKind::Physical, FitModelKind::BlackBox, FitModelKind::Spa, FitModelKind::Etfe})
+    if (s == toString(k)) return k;
+  return std::nullopt;
+}
+
+const char* toString(ClosedLoopChoice c) {
+  switch (c) {
+    case ClosedLoopChoice::Auto: return "auto";
+    case ClosedLoopChoice::Direct: return "direct";
+    case ClosedLoopChoice::TwoStage: return "two-stage";
+    case ClosedLoopChoice::Indirect: return "indirect";
+  }
+  return "auto";
+}
+
+std::optional<ClosedLoopChoice> closedLoopChoiceFromString(std::string_view s) {
+  for (auto c : {ClosedLoopChoice::Auto, ClosedLoopChoice::Direct, ClosedLoopChoice::TwoStage,
+                 ClosedLoopChoice::Indirect})
+    if (s == toString(c)) return c;
+  return std::nullopt;
+}
+
+bool FitModelSpec::isValid(std::string* why) const {
+  auto fail = [why](const std::string& text) {
+    if (why) *why = text;
+    return false;
+  };
+  switch (kind) {
+    case FitModelKind::Physical: {
+      if (!start) return fail("a physical fit needs its start model");
+      bool anyFree = false;
+      for (const auto& p : start->parameters()) anyFree = anyFree || p.free;
+      if (!anyFree) return fail("a physical fit needs at least one free parameter");
+      return true;
+    }
+    case FitModelKind::BlackBox: {
+      std::string reason;
+      if (!orders.isValid(&reason)) return fail("orders: " + reason);
+      return true;
+    }
+    case FitModelKind::Spa:
+    case FitModelKind::Etfe:
+      if (windowWidth < 0) return fail("the window width cannot be negative");
+      return true;
+  }
+  return true;
+}
+
+std::string FitModelSpec::name() const {
+  switch (kind) {
+    case FitModelKind::Physical: return start ? start->structureName() : "physical";
+    case FitModelKind::BlackBox: return PolynomialModel::zero(structure, orders, 1.0).name();
+    case FitModelKind::Spa: return "spa";
+    case FitModelKind::Etfe: return "etfe";
+  }
+  return "";
+}
+
+bool FitModelSpec::wantsVelocity() const {
+  return kind != FitModelKind::Physical || !start || start->options().output == ModelOutput::MotorVelocity;
+}
+
+bool FitOptions::isValidExceptData(std::string* why) const {
+  auto fail = [why](const std::string& text) {
+    if (why) *why = text;
+    return false;
+  };
+  if (!model.isValid(why)) return false;
+  if (estimation.size() != 1)
+    return fail(estimation.empty() ? "the fit needs an estimation experiment"
+                                   : "the fit takes one estimation experiment for now");
+  for (const auto* list : {&estimation, &validation})
+    for (const auto& e : *list)
+      if (e.range && !(e.range->start < e.range->end))
+        return fail("a range must have start < end");
+  if (decimation < 1) return fail("the decimation factor must be at least 1");
+  if (maxIterations < 1) return fail("at least one iteration is needed");
+  if (randomStarts < 0) return fail("the number of random starts cannot be negative");
+  if (!(level > 0.0 && level < 1.0)) return fail("the level must lie strictly between 0 and 1");
+  if (responsePoints < 2) return fail("the frequency response needs at least two points");
+  if (!(notchDepthDb >= 0.0)) return fail("the notch depth cannot be negative");
+  if (model.kind == FitModelKind::Physical) {
+    if (noiseModel == NoiseModel::Innovations && closedLoop != ClosedLoopChoice::Auto &&
+        closedLoop != ClosedLoopChoice::Direct)
+      return fail(std::string("the ") + toString(closedLoop) +
+                  " closed-loop fit is output error; it excludes the innovations form");
+    if (closedLoop == ClosedLoopChoice::Indirect && decimation > 1)
+      return fail("the indirect closed-loop fit runs at the controller's rate; it excludes decimation");
+    if (controller && !controller->isValid(why)) return false;
+    if (!controllerIdent.isValid(why)) return false;
+  }
+  return true;
+}
+
+bool FitOptions::isValid(std::string* why) const {
+  if (!isValidExceptData(why)) return false;
+  for (const auto* list : {&estimation, &validation})
+    for (const auto& e : *list)
+      if (!e.data) {
+        if (why) *why = "an experiment has no data";
+        return false;
+      }
+  return true;
+}
+
+std::optional<double> FitResult::fitValidation() const {
+  if (validation.empty()) return std::nullopt;
+  return validation.front().fitPercent;
+}
+
+std::string FitResult::modelName() const {
+  if (physical)
+    return model.name() + (K.size() ? std::string(" (innovations form)") : std::string(" (K = 0)"));
+  if (polynomial) return polynomial->name();
+  return model.name();
+}
+
+std::vector<double> fitFrequencyGrid(const PreparedData& data, int points) {
+  const double T = data.sampleTime;
+  const double n = static_cast<double>(std::max<std::size_t>(2, data.estimation.size()));
+  return logGrid(2.0 * M_PI / (n * T), M_PI / T, points);
+}
+
+FrequencyResponse fitResponse(const FitResult& r, const std::vector<double>& omega, double level) {
+  const PreparedData& d = r.data;
+  switch (r.model.kind) {
+    case FitModelKind::Spa: {
+      SpaOptions so;
+      so.windowWidth = r.model.windowWidth;
+      so.omega = omega;
+      so.level = level;
+      return spa(d.estimationInput(), d.estimationOutput(), d.sampleTime, so).response;
+    }
+    case FitModelKind::Etfe: {
+      EtfeOptions eo;
+      eo.smoothingWidth = r.model.windowWidth;
+      eo.omega = omega;
+      return etfe(d.estimationInput(), d.estimationOutput(), d.sampleTime, eo).response;
+    }
+    case FitModelKind::Physical:
+    case FitModelKind::BlackBox:
+      // Physical bands from the physical parameters only (K does not change G).
+      return estimateResponse(r.physical.get(), r.covariance, r.freeIndices, r.polynomial.get(), omega, level);
+  }
+  return {};
+}
+
+FrequencyResponse estimateResponse(const PhysicalModel* physical, const Eigen::MatrixXd& covariance,
+                                   const std::vector<int>& freeIndices, const PolynomialModel* polynomial,
+                                   const std::vector<double>& omega, double level) {
+  if (physical) return frequencyResponse(*physical, omega, covariance, freeIndices, level);
+  if (!polynomial) return {};
+  std::vector<double> below;  // a discrete response stops short of the Nyquist frequency
+  for (double w : omega)
+    if (w < M_PI / polynomial->sampleTime) below.push_back(w);
+  if (below.empty()) return {};
+  return frequencyResponse(*polynomial, below, level);
+}
+
+namespace {
+
+// Black-box structures (4.8) by prediction error (4.6).
+bool fitBlackBox(const FitOptions& o, FitResult& r, const ProgressCallback& progress) {
+  PolyEstimateOptions po;
+  po.maxIterations = o.maxIterations;
+  PolyEstimate e = estimatePolynomial(r.data.estimationInput(), r.data.estimationOutput(),
+                                      o.model.structure, o.model.orders, r.data.sampleTime, po, progress);
+  r.summary = e.summary;
+  const auto names = e.model.parameterNames();
+  const Eigen::VectorXd th = e.model.parameterVector(), sd = e.model.standardDeviations();
+  const double z = twoSidedNormalQuantile(o.level);
+  for (std::size_t i = 0; i < names.size(); ++i) {
+    const auto k = static_cast<Eigen::Index>(i);
+    const double s = sd.size() > k ? sd[k] : 0.0;
+    r.parameters.push_back({names[i], "", th[k], s, th[k] - z * s, th[k] + z * s, true});
+  }
+  r.polynomial = std::make_shared<PolynomialModel>(std::move(e.model));
+  return true;
+}
+
+// SPA (4.28) or ETFE (4.24) of the estimation data on the default grid.
+bool fitNonparametric(const FitOptions& o, FitResult& r) {
+  const auto grid = fitFrequencyGrid(r.data, o.responsePoints);
+  if (o.model.kind == FitModelKind::Spa) {
+    SpaOptions so;
+    so.windowWidth = o.model.windowWidth;
+    so.omega = grid;
+    so.level = o.level;
+    r.nonparametric = spa(r.data.estimationInput(), r.data.estimationOutput(), r.data.sampleTime, so);
+  } else {
+    EtfeOptions eo;
+    eo.smoothingWidth = o.model.windowWidth;
+    eo.omega = grid;
+    r.nonparametric = etfe(r.data.estimationInput(), r.data.estimationOutput(), r.data.sampleTime, eo);
+  }
+  if (r.data.closedLoop) {
+    r.nonparametric.closedLoopBias = true;
+    r.nonparametric.warning = kClosedLoopBiasWarning;
+  }
+  r.summary.termination = r.nonparametric.termination;
+  r.summary.message = r.nonparametric.message;
+  r.summary.seconds = r.nonparametric.seconds;
+  return true;
+}
+
+// Validation experiments prepared as the estimation data, with the estimation data's means.
+bool prepareValidation(const FitOptions& o, const FitDataOptions& base, FitResult& r) {
+  for (std::size_t i = 0; i < o.validation.size(); ++i) {
+    const FitExperiment& e = o.validation[i];
+    FitDataOptions vo = base;
+    vo.estimation = e.range;
+    vo.validation.reset();
+    vo.removeMeans = false;
+    vo.minimumSamples = 2;
+    FitValidation v;
+    v.data = prepareFitData(*e.data, vo);
+    const std::string which = o.validation.size() > 1 ? " " + std::to_string(i + 1) : "";
+    if (!v.data.ok()) {
+      r.termination = Termination::Failed;
+      r.message = "validation data" + which + ": " + v.data.message;
+      return false;
+    }
+    if (std::abs(v.data.sampleTime - r.data.sampleTime) > 1e-9 * r.data.sampleTime) {
+      r.termination = Termination::Failed;
+      r.message = "validation data" + which + ": its sample time differs from the estimation data's";
+      return false;
+    }
+    v.data.validation = v.data.estimation;
+    v.data.u.array() -= r.data.inputMean;
+    v.data.y.array() -= r.data.outputMean;
+    if (v.data.r.size()) v.data.r.array() -= r.data.referenceMean;
+    v.data.inputMean = r.data.inputMean;
+    v.data.outputMean = r.data.outputMean;
+    v.data.referenceMean = r.data.referenceMean;
+    if (r.data.inputMean != 0.0 || r.data.outputMean != 0.0)
+      v.data.steps.push_back("the estimation data's means removed");
+    r.validation.push_back(std::move(v));
+  }
+  return true;
+}
+
+}  // namespace
+
+FitResult fitModel(const FitOptions& options, const ProgressCallback& progress) {
+  std::string why;
+  if (!options.isValid(&why)) throw std::invalid_argument("fitModel: " + why);
+  const auto t0 = std::chrono::steady_clock::now();
+  FitResult r;
+  r.model = options.model;
+  auto finish = [&](Termination t, std::string message) -> FitResult {
+    r.termination = t;
+    r.message = std::move(message);
+    r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    return std::move(r);
+  };
+
+  // 1. Data.
+  FitDataOptions d;
+  d.input = options.input;
+  d.output = options.output;
+  d.reference = options.reference;
+  d.velocityOutput = options.model.wantsVelocity();
+  d.decimation = options.decimation;
+  // A physical model holds its input over each sample (5.3): decimated, the torque it holds
+  // is the logged torque's mean over the sample period (fit_data.h).
+  if (options.model.kind == FitModelKind::Physical)
+    d.decimatedInput = FitDataOptions::DecimatedInput::HeldMean;
+  d.removeMeans = options.removeMeans;
+  d.estimation = options.estimation.front().range;
+  r.data = prepareFitData(*options.estimation.front().data, d);
+  r.badData = !r.data.ok();
+  if (r.badData) return finish(Termination::Failed, r.data.message);
+  r.badData = !prepareValidation(options, d, r);
+  if (r.badData) return finish(r.termination, r.message);
+  const bool nonparametric = options.model.kind == FitModelKind::Spa || options.model.kind == FitModelKind::Etfe;
+  const Eigen::VectorXd uEst = r.data.estimationInput();
+  if (!nonparametric && (uEst.array() - uEst.mean()).abs().maxCoeff() == 0.0)
+    return finish(Termination::Failed,
+                  "the input is constant over the estimation range, so the data say nothing about the system");
+
+  // 2-4. Method, starts, estimator.
+  try {
+    switch (options.model.kind) {
+      case FitModelKind::Physical:
+        if (!fit_detail::fitPhysical(options, r, progress)) return finish(r.termination, r.message);
+        break;
+      case FitModelKind::BlackBox: {
+        std::string tooMuch;
+        r.badRequest = !options.model.orders.fitsData(
+            options.model.structure, static_cast<long long>(r.data.estimationOutput().size()), &tooMuch);
+        if (r.badRequest) return finish(Termination::Failed, tooMuch);
+        fitBlackBox(options, r, progress);
+        break;
+      }
+      case FitModelKind::Spa:
+      case FitModelKind::Etfe: fitNonparametric(options, r); break;
+    }
+  } catch (const std::invalid_argument& e) {
+    return finish(Termination::Failed, std::string("the fit was refused: ") + e.what());
+  }
+  if (!r.summary.ok()) return finish(r.summary.termination, r.summary.message);
+
+  // 5. Evaluation.
+  fit_detail::evaluate(options, r);
+  return finish(r.summary.termination, r.summary.message);
+}
+
+}  // namespace flexarm

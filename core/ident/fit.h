@@ -1,0 +1,203 @@
+#pragma once
+// The fit pipeline: one call from logs and choices to an estimated model and its evaluation,
+// used unchanged by `flexarm fit` and `flexarm bode`, the Fit panel and the session part
+// "fits" (front ends only collect choices, run it, and show or store what it returns):
+//   1. data: prepareFitData (fit_data.h) of every estimation and validation experiment;
+//      models whose output is the motor velocity (physical ones as built, black-box and
+//      non-parametric ones as the seed does, Section 5.2) get it from a logged motor angle;
+//   2. the closed-loop method of a physical output-error fit of a log with a reference
+//      (closed_loop_pem.h): direct, two-stage or indirect, or Auto, which picks one by the
+//      rule measured in bench/bench_fit_closed_loop.cpp and says which and why. The indirect
+//      fit's controller is the log's (metadata) or, when the log does not name it, the
+//      cascade of Figure 5.1 identified from the log (controller_ident.h);
+//   3. start values: the start model's own, plus random ones and two whose notches and peaks
+//      match the SPA estimate when random starts are asked for;
+//   4. the estimator: pem (5.7) / pemClosedLoop for physical models, estimatePolynomial (4.6)
+//      for black-box structures (4.8), spa (4.28) or etfe (4.24) for non-parametric ones;
+//   5. evaluation: fit % (5.2) on the estimation and every validation experiment, residual
+//      tests, the frequency response with its band, notches and peaks (5.4), and a sentence
+//      beside the 99 % intervals where they are known to promise too much.
+#include <memory>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include <Eigen/Dense>
+
+#include "core/common/progress.h"
+#include "core/ident/blackbox.h"
+#include "core/ident/closed_loop_pem.h"
+#include "core/ident/controller_ident.h"
+#include "core/ident/fit_data.h"
+#include "core/ident/nonparametric.h"
+#include "core/ident/pem.h"
+#include "core/ident/residuals.h"
+#include "core/models/physical_models.h"
+
+namespace flexarm {
+
+enum class FitModelKind { Physical, BlackBox, Spa, Etfe };
+const char* toString(FitModelKind k);  // "physical", "black-box", "spa", "etfe"
+std::optional<FitModelKind> fitModelKindFromString(std::string_view s);
+
+// What to estimate.
+struct FitModelSpec {
+  FitModelKind kind = FitModelKind::BlackBox;
+  // Physical: the start model (structure, output, start values, free flags).
+  std::shared_ptr<const PhysicalModel> start;
+  // Black-box: the structure (4.8) and its orders.
+  PolyStructure structure = PolyStructure::Oe;
+  PolyOrders orders;
+  // Spa: the lag window M; Etfe: the smoothing width; 0: the default.
+  int windowWidth = 0;
+  bool isValid(std::string* why) const;
+  // "three-mass", "oe[2 2 1]", "spa", "etfe".
+  std::string name() const;
+  // The output the model gives is the motor velocity (Section 5.2), so a logged motor angle
+  // is differentiated first.
+  bool wantsVelocity() const;
+};
+
+// The closed-loop method a physical output-error fit uses on a log with a reference.
+enum class ClosedLoopChoice { Auto, Direct, TwoStage, Indirect };
+const char* toString(ClosedLoopChoice c);  // "auto", "direct", "two-stage", "indirect"
+std::optional<ClosedLoopChoice> closedLoopChoiceFromString(std::string_view s);
+
+// One experiment: a log and the part of it used.
+struct FitExperiment {
+  std::shared_ptr<const IdData> data;
+  std::optional<SecondsRange> range;  // unset: the whole log
+};
+
+struct FitOptions {
+  FitModelSpec model;
+  // Estimation data: one experiment (several are the next step: the estimator then restarts
+  // the model's state at each experiment's first sample).
+  std::vector<FitExperiment> estimation;
+  // Validation data: any number of experiments; an experiment on the estimation log has the
+  // estimation range's means removed, one on another log as well (the model's operating
+  // point is the estimation data's).
+  std::vector<FitExperiment> validation;
+  // Preparation (fit_data.h): channels by name (empty: by role), decimation, means.
+  std::string input, output, reference;
+  int decimation = 1;
+  bool removeMeans = true;
+  // Physical models.
+  NoiseModel noiseModel = NoiseModel::OutputError;
+  ClosedLoopChoice closedLoop = ClosedLoopChoice::Auto;
+  // The controller the log was recorded with, for the indirect fit; unset: the log's
+  // metadata (controller_rate_hz, controller_kp, controller_kv, controller_ti), else the
+  // cascade identified from the log.
+  std::optional<ControllerOptions> controller;
+  ControllerIdentOptions controllerIdent;
+  int randomStarts = 0;  // > 0 adds two starts at the SPA notches and peaks as well
+  unsigned seed = 1;
+  // Physical and black-box models.
+  int maxIterations = 100;
+  double level = 0.99;  // of the parameter intervals and the response's band
+  // Evaluation: points of the frequency response (2 pi / (N T) .. pi / T) and the depth an
+  // extremum needs to count as a notch or peak (dB; non-parametric curves use 3).
+  int responsePoints = 2000;
+  double notchDepthDb = 1.0;
+  // Everything but the experiments' data (what a session stores).
+  bool isValidExceptData(std::string* why) const;
+  bool isValid(std::string* why) const;
+};
+
+// A parameter row as the seed's Tables 5.3-5.7 print it.
+struct FitParameter {
+  std::string name, unit;
+  double value = 0.0, std = 0.0, lower = 0.0, upper = 0.0;  // interval at FitOptions::level
+  bool free = false;
+};
+
+// The evaluation on one validation experiment.
+struct FitValidation {
+  PreparedData data;  // its means: the estimation data's
+  std::optional<double> fitPercent;  // (5.2) on its range, simulated from the log's first sample
+  Eigen::VectorXd simulated;         // the whole log
+};
+
+struct FitResult {
+  Termination termination = Termination::Failed;
+  std::string message;  // a sentence: how it ended, or why it failed
+  double seconds = 0.0;
+  // The data cannot carry the fit asked for (no usable channel or range, a closed-loop method
+  // the log cannot run), as opposed to an estimator that failed on them.
+  bool badData = false;
+  // The options ask for more than the data can carry (polynomial orders beyond the samples
+  // or the work FlexArm allows): a request to change, not an estimator that failed.
+  bool badRequest = false;
+
+  FitModelSpec model;
+  PreparedData data;  // the estimation experiment as prepared
+  std::vector<FitValidation> validation;
+
+  // Physical fits of closed-loop logs: the method used and why (Auto states its rule), stage
+  // 1's fit % of the input (two-stage), the controller the indirect fit closed around the model and where it
+  // came from.
+  std::optional<ClosedLoopMethod> method;
+  std::string methodDescription;  // what the method did, e.g. "two-stage closed-loop fit: the
+                                  // reference explains 45.1 % of the input, ..."
+  std::string methodReason;       // why it was used ("asked for", or Auto's rule and evidence)
+  std::optional<double> referenceFitPercent;
+  std::optional<ControllerOptions> controller;
+  std::string controllerSource;  // a sentence: metadata or identified, and its fit % of the torque
+  std::optional<double> controllerFitPercent;
+
+  EstimateSummary summary;
+  std::shared_ptr<const PhysicalModel> physical;  // physical estimate (the start's output)
+  Eigen::VectorXd K;                              // innovations gain (empty: output error)
+  Eigen::MatrixXd covariance;                     // of physical->parameters()[freeIndices]
+  std::vector<int> freeIndices;
+  CovarianceKind covarianceKind = CovarianceKind::White;
+  std::shared_ptr<const PolynomialModel> polynomial;  // black-box estimate
+  NonparametricEstimate nonparametric;                // spa / etfe
+  std::vector<FitParameter> parameters;
+
+  // Fit % (5.2) on the estimation range (simulated from its first sample), or nullopt when
+  // the simulated output diverges (unstable G) or for non-parametric estimates.
+  std::optional<double> fitEstimation;
+  // Of the first validation experiment, when there is one.
+  std::optional<double> fitValidation() const;
+  Eigen::VectorXd simulated;  // of the whole estimation log, from its first sample
+  // Prediction errors (one-step for black-box models, output errors for physical ones) of
+  // the validation range (the estimation range without one), tested for whiteness and
+  // independence of the input at 99 %; nullopt when the range is too short.
+  std::optional<ResidualAnalysis> residuals;
+  bool residualsOnValidation = false;
+  FrequencyResponse response;
+  std::vector<double> notches, peaks;  // rad/s (5.4)
+  // Sentences for the user: biased method, unstable model, intervals to read with care.
+  std::vector<std::string> warnings;
+
+  bool ok() const { return termination == Termination::Converged || termination == Termination::MaxIterations; }
+  // "three-mass (K = 0)", "three-mass (innovations form)", "oe[2 2 1]", "spa".
+  std::string modelName() const;
+};
+
+// Runs the pipeline. Data failures (no usable data, a constant input, a method the log cannot
+// support, a diverged or failed estimator) end in termination Failed or Diverged with a
+// sentence; invalid options throw std::invalid_argument; Abort from progress gives Cancelled.
+FitResult fitModel(const FitOptions& options, const ProgressCallback& progress = {});
+
+// The estimate's frequency response at omega (rad/s) with bands at level: a physical model's
+// continuous response with the covariance of its free parameters, a black-box model's up to
+// its Nyquist frequency, or the non-parametric estimate recomputed on this grid (SPA leaves
+// out frequencies where the input has no power).
+FrequencyResponse fitResponse(const FitResult& result, const std::vector<double>& omega, double level);
+
+// Frequency response of an estimate at omega (rad/s) with bands at level: a physical model's
+// continuous response C (i w - A)^{-1} B + D with the covariance of its free parameters
+// (freeIndices into its parameters(); empty: no bands), or a black-box model's (4.8) up to its
+// Nyquist frequency. Exactly one of physical and polynomial is given.
+FrequencyResponse estimateResponse(const PhysicalModel* physical, const Eigen::MatrixXd& covariance,
+                                   const std::vector<int>& freeIndices, const PolynomialModel* polynomial,
+                                   const std::vector<double>& omega, double level);
+
+// The default frequency grid of a fit: responsePoints from 2 pi / (N T) to pi / T, N the
+// estimation samples.
+std::vector<double> fitFrequencyGrid(const PreparedData& data, int points);
+
+}  // namespace flexarm

@@ -1,0 +1,53 @@
+#pragma once
+// Opening input files without trusting them: only regular files are read (a device such as
+// /dev/zero, a pipe or a directory is refused before a byte is read), never more than a
+// budget derived from the file's real size, and text in an encoding FlexArm does not read
+// (UTF-16, a byte-order mark, binary data) is named as such.
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <string_view>
+
+namespace flexarm {
+
+// Releases a FileBytes buffer: a mapping of `mapped` bytes, or new[] when mapped is 0.
+struct FileBufferDeleter {
+  std::size_t mapped = 0;
+  void operator()(char* p) const;
+};
+
+// The bytes of a whole file, read once (not zero-filled first: large logs are read at the
+// speed of the disk cache).
+struct FileBytes {
+  std::unique_ptr<char, FileBufferDeleter> data;
+  std::size_t size = 0;
+  std::string_view view() const { return {data.get(), size}; }
+};
+
+// Asks the kernel to back [p, p + bytes) with huge pages where it can (a large buffer then
+// costs hundreds of page faults instead of hundreds of thousands); no effect on small ones.
+void preferHugePages(void* p, std::size_t bytes);
+
+// Checks that path names an existing regular file of at most maxBytes and gives its size;
+// otherwise false with a sentence ("the file does not exist", "is a character device, not a
+// regular file ...", "the file is 3.0 GiB, larger than ...").
+bool checkInputFile(const std::string& path, std::uint64_t maxBytes, std::uint64_t* size,
+                    std::string* problem);
+
+// Reads a whole regular file of at most maxBytes. The file is opened first and then checked
+// (no window between check and open), and at most the size it had when opened is read.
+bool readInputFile(const std::string& path, std::uint64_t maxBytes, FileBytes& out,
+                   std::string* problem);
+
+// A sentence naming the encoding of text that is not plain ASCII/UTF-8 without BOM (UTF-16
+// or UTF-32 with or without BOM, a UTF-8 BOM, binary data with NUL bytes), judged from the
+// first bytes; empty for plain text.
+std::string textEncodingProblem(std::string_view head);
+
+// What a stat mode names when it is not a regular file: "a character device", "a pipe", ...
+const char* fileKind(unsigned mode);
+
+// "3.0 GiB", "12.5 MiB", "512 bytes".
+std::string humanBytes(std::uint64_t n);
+
+}  // namespace flexarm

@@ -1,0 +1,300 @@
+#include "core/io/mat_check.h"
+
+#include <zlib.h>
+
+#include <cstdio>
+#include <cstring>
+#include <memory>
+#include <vector>
+
+namespace flexarm {
+namespace {
+
+using Byte = unsigned char;
+
+constexpr std::uint32_t kMiInt8 = 1, kMiInt32 = 5, kMiUint32 = 6, kMiMatrix = 14,
+                        kMiCompressed = 15;
+constexpr std::uint64_t kMaxName = 4096;  // MATLAB names have at most 63 characters
+constexpr int kMaxDepth = 16;             // cells and structs nested deeper are refused
+constexpr std::uint64_t kMaxElements = 1ull << 40;
+
+const char* const kNotMat = "not a readable MATLAB .mat file (damaged, or not a .mat file at all)";
+
+// Bytes per element of a level-5 data type; 0 when the type holds no numbers.
+std::uint64_t typeSize(std::uint32_t t) {
+  switch (t) {
+    case 1: case 2: case 16: return 1;       // int8, uint8, utf8
+    case 3: case 4: case 17: return 2;       // int16, uint16, utf16
+    case 5: case 6: case 7: case 18: return 4;  // int32, uint32, single, utf32
+    case 9: case 12: case 13: return 8;      // double, int64, uint64
+    default: return 0;
+  }
+}
+
+std::string sprintfString(const char* format, unsigned long long a, unsigned long long b) {
+  char buf[200];
+  std::snprintf(buf, sizeof buf, format, a, b);
+  return buf;
+}
+
+struct Tag {
+  std::uint32_t type = 0;
+  std::uint64_t nbytes = 0;
+  const Byte* data = nullptr;
+  std::uint64_t total = 0;  // bytes the element takes, tag and padding included
+};
+
+class Level5 {
+ public:
+  Level5(bool swap, std::uint64_t budget) : swap_(swap), inflateLeft_(budget) {}
+  std::string problem;
+
+  std::uint32_t u32(const Byte* p) const {
+    std::uint32_t v;
+    std::memcpy(&v, p, 4);
+    return swap_ ? __builtin_bswap32(v) : v;
+  }
+
+  // The sub-element at p (small or normal form); false when it does not fit before end.
+  bool tag(const Byte* p, const Byte* end, Tag& t, const std::string& where) {
+    if (end - p < 8) return fail(where + ": an element is cut short");
+    const std::uint32_t first = u32(p);
+    if (first >> 16) {  // small data element: type and size in one word, data in the next
+      t.type = first & 0xffff;
+      t.nbytes = first >> 16;
+      t.data = p + 4;
+      t.total = 8;
+      if (t.nbytes > 4) return fail(where + ": a small element claims more than 4 bytes");
+      return true;
+    }
+    t.type = first;
+    t.nbytes = u32(p + 4);
+    t.data = p + 8;
+    const auto left = static_cast<std::uint64_t>(end - p - 8);
+    if (t.nbytes > left)
+      return fail(where + sprintfString(": an element claims %llu bytes where only %llu remain",
+                                        t.nbytes, left));
+    t.total = 8 + ((t.nbytes + 7) & ~std::uint64_t{7});
+    if (t.total > left + 8) t.total = left + 8;  // the last element may lack its padding
+    return true;
+  }
+
+  // The contents of one miMATRIX element, [p, end).
+  bool matrix(const Byte* p, const Byte* end, const std::string& where0, int depth) {
+    if (p == end) return true;  // an empty array
+    if (depth > kMaxDepth) return fail(where0 + ": cells or structs nested too deeply");
+    Tag flags, dims, name;
+    if (!tag(p, end, flags, where0)) return false;
+    if (flags.type != kMiUint32 || flags.nbytes != 8)
+      return fail(where0 + ": the array flags are damaged");
+    const std::uint32_t word = u32(flags.data);
+    const std::uint32_t cls = word & 0xff;
+    const bool complex = (word & (1u << 11)) != 0;
+    p += flags.total;
+    if (!tag(p, end, dims, where0)) return false;
+    if (dims.type != kMiInt32 || dims.nbytes % 4 != 0 || dims.nbytes < 8 || dims.nbytes > 4 * 32)
+      return fail(where0 + ": the dimensions are damaged");
+    std::uint64_t count = 1;
+    for (std::uint64_t i = 0; i < dims.nbytes / 4; ++i) {
+      const auto d = static_cast<std::int32_t>(u32(dims.data + 4 * i));
+      if (d < 0) return fail(where0 + ": a negative dimension");
+      count = d == 0 ? 0 : count * static_cast<std::uint64_t>(d);
+      if (count > kMaxElements) return fail(where0 + ": the array claims more elements than the file can hold");
+    }
+    p += dims.total;
+    if (!tag(p, end, name, where0)) return false;
+    if (name.type != kMiInt8 || name.nbytes > kMaxName)
+      return fail(where0 + ": the variable name is damaged or longer than 4096 characters");
+    const std::string where =
+        name.nbytes ? "variable '" + std::string(reinterpret_cast<const char*>(name.data), name.nbytes) + "'"
+                    : where0;
+    p += name.total;
+    const auto left = static_cast<std::uint64_t>(end - p);
+    switch (cls) {
+      case 1: {  // cell: count nested arrays
+        if (count > left / 8) return fail(where + ": the cell array claims more cells than its bytes hold");
+        for (std::uint64_t i = 0; i < count; ++i)
+          if (!nested(p, end, where, depth)) return false;
+        return true;
+      }
+      case 2: {  // struct: field-name length, names, then count * fields nested arrays
+        Tag len, names;
+        if (!tag(p, end, len, where)) return false;
+        if (len.type != kMiInt32 || len.nbytes != 4) return fail(where + ": the struct is damaged");
+        const std::uint64_t l = u32(len.data);
+        p += len.total;
+        if (!tag(p, end, names, where)) return false;
+        if (l == 0 || l > kMaxName || names.type != kMiInt8 || names.nbytes % l != 0)
+          return fail(where + ": the struct's field names are damaged");
+        p += names.total;
+        const std::uint64_t fields = names.nbytes / l;
+        const auto rest = static_cast<std::uint64_t>(end - p);
+        if (fields && count > rest / 8 / fields)
+          return fail(where + ": the struct claims more fields than its bytes hold");
+        for (std::uint64_t i = 0; i < count * fields; ++i)
+          if (!nested(p, end, where, depth)) return false;
+        return true;
+      }
+      case 3: return fail(where + " is a MATLAB object, which FlexArm does not read; save the signals as numeric vectors");
+      case 5: return fail(where + " is a sparse matrix, which FlexArm does not read; save the signals as full numeric vectors");
+      case 4: case 6: case 7: case 8: case 9: case 10: case 11: case 12: case 13: case 14: case 15: {
+        for (int part = 0; part < (complex ? 2 : 1); ++part) {
+          if (p == end && count == 0) return true;
+          Tag data;
+          if (!tag(p, end, data, where)) return false;
+          const std::uint64_t size = typeSize(data.type);
+          if (size == 0) return fail(where + ": the data have an unknown number type");
+          if (count > data.nbytes / size)
+            return fail(where + sprintfString(": the array claims %llu elements but its data hold %llu",
+                                              count, data.nbytes / size));
+          p += data.total;
+        }
+        return true;
+      }
+      default: return fail(where + ": an array class FlexArm does not read (function handle or opaque object)");
+    }
+  }
+
+  // One nested miMATRIX element at p; advances p.
+  bool nested(const Byte*& p, const Byte* end, const std::string& where, int depth) {
+    Tag t;
+    if (!tag(p, end, t, where)) return false;
+    if (t.type != kMiMatrix) return fail(where + ": a cell or field is not an array");
+    if (!matrix(t.data, t.data + t.nbytes, where, depth + 1)) return false;
+    p += t.total;
+    return true;
+  }
+
+  // A compressed variable: inflated within the budget, then checked as an array.
+  bool compressed(const Byte* p, std::uint64_t n, const std::string& where) {
+    z_stream z{};
+    if (inflateInit(&z) != Z_OK) return fail(where + ": cannot start decompressing");
+    struct End {
+      z_stream* z;
+      ~End() { inflateEnd(z); }
+    } ender{&z};
+    Byte head[8];
+    z.next_in = const_cast<Byte*>(p);
+    z.avail_in = static_cast<uInt>(std::min<std::uint64_t>(n, 0xffffffffu));
+    z.next_out = head;
+    z.avail_out = 8;
+    int rc = inflate(&z, Z_SYNC_FLUSH);
+    if (z.avail_out != 0 || (rc != Z_OK && rc != Z_STREAM_END))
+      return fail(where + ": a compressed variable is damaged");
+    if (u32(head) != kMiMatrix) return fail(where + ": a compressed element is not an array");
+    const std::uint64_t inner = u32(head + 4);
+    if (inner > inflateLeft_)
+      return fail(where + sprintfString(": a compressed variable claims to inflate to %llu bytes, "
+                                        "more than the %llu this file's size allows",
+                                        inner, inflateLeft_));
+    inflateLeft_ -= inner;
+    std::unique_ptr<Byte[]> body(new Byte[inner ? inner : 1]);
+    z.next_out = body.get();
+    z.avail_out = static_cast<uInt>(inner);
+    if (inner) {
+      rc = inflate(&z, Z_FINISH);
+      if (z.avail_out != 0 || (rc != Z_OK && rc != Z_STREAM_END && rc != Z_BUF_ERROR))
+        return fail(where + ": a compressed variable is damaged or cut short");
+    }
+    return matrix(body.get(), body.get() + inner, where, 0);
+  }
+
+  bool file(const Byte* p, std::uint64_t n) {
+    std::uint64_t off = 128;
+    int index = 0;
+    while (n - off >= 8) {
+      const std::string where = "variable " + std::to_string(++index);
+      const std::uint32_t type = u32(p + off);
+      const std::uint64_t nbytes = u32(p + off + 4);
+      if (nbytes > n - off - 8)
+        return fail(where + sprintfString(" claims %llu bytes but the file has only %llu left "
+                                          "(damaged or cut short)",
+                                          nbytes, n - off - 8));
+      if (type == kMiMatrix && !matrix(p + off + 8, p + off + 8 + nbytes, where, 0)) return false;
+      if (type == kMiCompressed && !compressed(p + off + 8, nbytes, where)) return false;
+      off += 8 + nbytes;
+    }
+    return true;
+  }
+
+ private:
+  bool fail(const std::string& text) {
+    problem = text;
+    return false;
+  }
+  bool swap_;
+  std::uint64_t inflateLeft_;
+};
+
+// Level 4: records of five int32 (type MOPT, rows, columns, imaginary flag, name length),
+// the name and the data.
+bool level4(const Byte* p, std::uint64_t n, std::string& problem) {
+  std::uint64_t off = 0;
+  bool swap = false;
+  int index = 0;
+  while (off < n) {
+    ++index;
+    if (n - off < 20) {
+      problem = kNotMat;
+      return false;
+    }
+    auto word = [&](int i) {
+      std::uint32_t v;
+      std::memcpy(&v, p + off + 4 * i, 4);
+      return static_cast<std::int32_t>(swap ? __builtin_bswap32(v) : v);
+    };
+    if (index == 1 && (word(0) < 0 || word(0) > 4052)) swap = true;
+    const std::int32_t type = word(0), rows = word(1), cols = word(2), imag = word(3), namelen = word(4);
+    const int m = type / 1000, o = type / 100 % 10, prec = type / 10 % 10, t = type % 10;
+    if (type < 0 || m > 1 || o != 0 || prec > 5 || t > 2 || rows < 0 || cols < 0 || imag < 0 ||
+        imag > 1 || namelen < 1 || namelen > static_cast<std::int32_t>(kMaxName)) {
+      problem = kNotMat;
+      return false;
+    }
+    static const std::uint64_t sizes[] = {8, 4, 4, 2, 2, 1};
+    const std::uint64_t bytes = static_cast<std::uint64_t>(rows) * static_cast<std::uint64_t>(cols) *
+                                sizes[prec] * (imag ? 2u : 1u);
+    if (20 + static_cast<std::uint64_t>(namelen) > n - off || bytes > n - off - 20 - static_cast<std::uint64_t>(namelen)) {
+      problem = "variable " + std::to_string(index) + sprintfString(
+          " claims %llu bytes of data but the file has only %llu left (damaged or cut short)",
+          bytes, n - off - 20 - std::min<std::uint64_t>(n - off - 20, static_cast<std::uint64_t>(namelen)));
+      return false;
+    }
+    off += 20 + static_cast<std::uint64_t>(namelen) + bytes;
+  }
+  return true;
+}
+
+}  // namespace
+
+MatCheck checkMatFile(std::string_view bytes, std::uint64_t inflateBudget) {
+  MatCheck r;
+  const auto* p = reinterpret_cast<const Byte*>(bytes.data());
+  const std::uint64_t n = bytes.size();
+  if (n >= 128 && ((p[126] == 'I' && p[127] == 'M') || (p[126] == 'M' && p[127] == 'I'))) {
+    // Written as a 16-bit 'MI': read back as "IM" the file has this machine's byte order.
+    const bool swap = p[126] == 'M';
+    const unsigned version = swap ? (p[124] << 8 | p[125]) : (p[125] << 8 | p[124]);
+    if (version == 0x0200) {
+      r.kind = MatKind::V73;
+      r.ok = true;
+      return r;
+    }
+    if (version == 0x0100) {
+      r.kind = MatKind::V5;
+      Level5 walker(swap, inflateBudget);
+      r.ok = walker.file(p, n);
+      r.problem = walker.problem;
+      return r;
+    }
+  }
+  r.kind = MatKind::V4;
+  if (n == 0) {
+    r.problem = kNotMat;
+    return r;
+  }
+  r.ok = level4(p, n, r.problem);
+  return r;
+}
+
+}  // namespace flexarm

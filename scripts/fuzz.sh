@@ -1,0 +1,72 @@
+#!/usr/bin/env bash
+# Builds the libFuzzer targets (clang, AddressSanitizer + UndefinedBehaviorSanitizer) and runs
+# each for a set time on a corpus seeded from tests/data and sample_logs; prints executions and
+# crashes per target and exits non-zero when any target crashed, leaked or hung.
+#
+#   bash scripts/fuzz.sh [--seconds N] [TARGET...]
+#
+# TARGET: fuzz_csv fuzz_table fuzz_mat fuzz_session fuzz_cli_options (default: all).
+# The corpus grows in $FUZZ_DIR/corpus/TARGET (default build-fuzz/); crashing inputs are kept
+# in $FUZZ_DIR/artifacts. BUILD_DIR reuses an existing build configured with FLEXARM_FUZZ=ON
+# (scripts/sanitize.sh makes one).
+set -euo pipefail
+here="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+seconds=60
+targets=()
+while [ $# -gt 0 ]; do
+  case "$1" in
+    --seconds) seconds="$2"; shift 2 ;;
+    -h|--help) sed -n '2,12p' "$0"; exit 0 ;;
+    *) targets+=("$1"); shift ;;
+  esac
+done
+[ ${#targets[@]} -gt 0 ] || targets=(fuzz_csv fuzz_table fuzz_mat fuzz_session fuzz_cli_options)
+
+build="${BUILD_DIR:-$here/build-fuzz}"
+fuzzdir="${FUZZ_DIR:-$build}"
+if [ ! -f "$build/CMakeCache.txt" ] || ! grep -q "FLEXARM_FUZZ:BOOL=ON" "$build/CMakeCache.txt"; then
+  bash "$here/scripts/sanitize.sh" --configure-only "$build"
+fi
+cmake --build "$build" -j "${JOBS:-$(nproc)}" --target "${targets[@]}"
+
+# Seeds: the inputs the tests already use, good and bad, plus the heads of the sample logs.
+seed() {  # seed TARGET FILE...
+  local dir="$fuzzdir/corpus/$1"; shift
+  mkdir -p "$dir"
+  for f in "$@"; do
+    [ -f "$f" ] && head -c 8192 "$f" > "$dir/seed-$(basename "$f")"
+  done
+  return 0
+}
+d="$here/tests/data"
+seed fuzz_csv "$d"/bad/*.csv "$d"/hostile/*.csv "$d"/good/*.csv "$here"/sample_logs/effect_backlash.csv
+seed fuzz_table "$d"/bad/*.dat "$d"/good/*.dat "$here"/sample_logs/daisy_robot_arm.dat
+seed fuzz_mat "$d"/bad/*.mat "$d"/hostile/*.mat "$d"/good/*.mat
+seed fuzz_session "$here"/sample_logs/sample_session.json "$d"/hostile/*.json
+mkdir -p "$fuzzdir/corpus/fuzz_cli_options"
+printf 'x\0--model\0arx:2,2,1\0--range\0002:10\0--max-iterations\00050' > "$fuzzdir/corpus/fuzz_cli_options/seed-fit"
+printf 'x\0--input-column\0003\0--sample-time=0.01\0--format\0table\0--fix\0backlash:2e-4' \
+  > "$fuzzdir/corpus/fuzz_cli_options/seed-log"
+mkdir -p "$fuzzdir/artifacts"
+tmp="$(mktemp -d)"
+trap 'rm -rf "$tmp"' EXIT
+
+status=0
+printf '%-18s %14s %10s %8s  %s\n' target executions exec/s crashes result
+for t in "${targets[@]}"; do
+  log="$fuzzdir/$t.log"
+  rc=0
+  touch "$tmp/start"
+  FLEXARM_FUZZ_TMP="$tmp" ASAN_OPTIONS="detect_leaks=1:allocator_may_return_null=1" \
+    LSAN_OPTIONS="suppressions=$here/tests/sanitizer/lsan.supp" \
+    "$build/fuzz/$t" "$fuzzdir/corpus/$t" -max_total_time="$seconds" \
+    -print_final_stats=1 -rss_limit_mb=2048 -timeout=10 -max_len=65536 \
+    -artifact_prefix="$fuzzdir/artifacts/$t-" > "$log" 2>&1 || rc=$?
+  execs=$( (grep -h "stat::number_of_executed_units" "$log" || true) | awk '{s += $2} END {print s + 0}')
+  rate=$(( execs / (seconds > 0 ? seconds : 1) ))
+  crashes=$(find "$fuzzdir/artifacts" -name "$t-*" -newer "$tmp/start" | wc -l)
+  result=ok
+  if [ "$rc" -ne 0 ] || [ "$crashes" -ne 0 ]; then result="FAILED (see $log)"; status=1; fi
+  printf '%-18s %14s %10s %8s  %s\n' "$t" "$execs" "$rate" "$crashes" "$result"
+done
+exit $status

@@ -1,0 +1,133 @@
+// The Diagnosis dock in the main window at 1366x768, as a user runs it: open the sample log
+// whose torque constant steps up 20 % at 12 s (sample_logs/README.md), choose the fault-free
+// log diagnosis_no_fault.csv as the reference, click "Diagnose", then move the window's
+// playhead: green before the fault, the decision table and the verdict naming k_T once the
+// playhead passes the alarm (a screenshot at that moment), and the session keeps the request.
+// The healthy log of the same experiment stays green to its end.
+#include <QCheckBox>
+#include <QComboBox>
+#include <QDockWidget>
+#include <QPushButton>
+#include <QSignalSpy>
+#include <QTableWidget>
+#include <QtTest>
+#include <qcustomplot.h>
+
+#include "app/main_window.h"
+#include "app/session_controller.h"
+#include "core/session/session.h"
+#include "widget_test_support.h"
+#include "widgets/arm_panel.h"
+#include "widgets/diagnosis_panel.h"
+#include "widgets/playhead.h"
+
+using namespace flexarm;
+
+namespace {
+const QString kFaulty = QString(FLEXARM_SAMPLE_DIR) + "/diagnosis_step_k_T.csv";
+const QString kHealthy = QString(FLEXARM_SAMPLE_DIR) + "/diagnosis_step_none.csv";
+const QString kReference = QString(FLEXARM_SAMPLE_DIR) + "/diagnosis_no_fault.csv";
+}  // namespace
+
+class DiagnosisPanelTest : public QObject {
+  Q_OBJECT
+ private:
+  MainWindow* window_ = nullptr;
+
+  DiagnosisPanel* panel() const { return window_->diagnosisPanel(); }
+
+  void open(const QString& path) {
+    QSignalSpy opened(window_, &MainWindow::logOpened);
+    window_->openFile(path);
+    QVERIFY(opened.wait(30000));
+  }
+
+  void runDiagnosis() {
+    panel()->setReferenceLog(kReference);
+    QComboBox* model = panel()->referenceBox();
+    model->setCurrentIndex(model->findText("three-mass (nominal)"));
+    QSignalSpy done(panel(), &DiagnosisPanel::finished);
+    QTest::mouseClick(panel()->runButton(), Qt::LeftButton);
+    QVERIFY(panel()->isBusy());
+    QVERIFY(done.wait(240000));
+    QVERIFY2(panel()->lastRun() && panel()->lastRun()->ok(), qPrintable(panel()->verdictText()));
+  }
+
+ private slots:
+  void initTestCase() {
+    window_ = new MainWindow;
+    window_->resize(1366, 768);
+    window_->show();
+    QVERIFY(QTest::qWaitForWindowExposed(window_));
+    auto* dock = window_->findChild<QDockWidget*>("diagnosisDock");
+    QVERIFY(dock != nullptr);
+    dock->show();
+    dock->raise();
+  }
+
+  void isolatesTheTorqueConstant() {
+    open(kFaulty);
+    runDiagnosis();
+    const DiagnosisResult& r = panel()->lastRun()->result;
+    QCOMPARE(QString::fromStdString(r.verdictName()), QString("k_T"));
+    QVERIFY(r.decision.verdictTime && *r.decision.verdictTime > 12.0 && *r.decision.verdictTime < 14.0);
+    Playhead* playhead = window_->playhead();
+    // Before the fault: green, every mode still possible.
+    playhead->setTime(8.0);
+    QTest::qWait(50);
+    QVERIFY2(panel()->verdictText().startsWith("No fault so far"), qPrintable(panel()->verdictText()));
+    QVERIFY(!window_->armPanel()->fault());  // the Arm view highlights nothing yet
+    QTableWidget* t = panel()->decisionTable();
+    QCOMPARE(t->item(3, 4)->text(), QString("possible"));  // NF
+    // The curves grow with the playhead.
+    const int before = panel()->cusumPlot()->graph(0)->dataCount();
+    QVERIFY(before > 100 && before < static_cast<int>(r.time.size()) / 2);
+    // At the alarm: red, k_T named with its time; the table's NF row rejected, F_kT possible.
+    playhead->setTime(*r.decision.verdictTime + 0.01);
+    QTest::qWait(100);
+    QVERIFY2(panel()->verdictText().contains("k_T"), qPrintable(panel()->verdictText()));
+    QCOMPARE(t->item(3, 4)->text(), QString("rejected"));
+    QCOMPARE(t->item(0, 4)->text(), QString("possible"));
+    QCOMPARE(t->item(1, 4)->text(), QString("rejected"));
+    QVERIFY2(panel()->statementText().contains("{F_k_T}"), qPrintable(panel()->statementText()));
+    QVERIFY(panel()->cusumPlot()->graph(0)->dataCount() > before);
+    // The Arm view lights the motor, the part k_T belongs to; back before the alarm it clears.
+    QVERIFY(window_->armPanel()->fault() == ArmPart::Motor);
+    playhead->setTime(8.0);
+    QTest::qWait(50);
+    QVERIFY(!window_->armPanel()->fault());
+    playhead->setTime(*r.decision.verdictTime + 0.01);
+    QTest::qWait(50);
+    QTest::qWait(200);
+    test::saveShot(window_->grab().toImage(), "diagnosis_window_at_alarm");
+    test::saveShot(panel()->grab().toImage(), "diagnosis_panel_at_alarm");
+  }
+
+  void sessionKeepsTheRequest() {
+    const Session s = window_->sessionController()->capture(QString());
+    QVERIFY(s.parts.contains("diagnosis"));
+    const auto& section = s.parts["diagnosis"];
+    QCOMPARE(section["request"]["reference_log"].get<std::string>(), std::string("diagnosis_reference"));
+    QCOMPARE(section["result"]["verdict"].get<std::string>(), std::string("k_T"));
+    bool named = false;
+    for (const auto& l : s.logs) named = named || (l.name == "diagnosis_reference" && l.path.find("diagnosis_no_fault") != std::string::npos);
+    QVERIFY(named);
+  }
+
+  void healthyLogStaysGreen() {
+    open(kHealthy);
+    runDiagnosis();
+    const DiagnosisResult& r = panel()->lastRun()->result;
+    QCOMPARE(QString::fromStdString(r.verdictName()), QString("none"));
+    window_->playhead()->setTime(r.time.back());
+    QTest::qWait(100);
+    QVERIFY2(panel()->verdictText().startsWith("No fault"), qPrintable(panel()->verdictText()));
+    QCOMPARE(panel()->decisionTable()->item(3, 4)->text(), QString("possible"));
+    test::saveShot(window_->grab().toImage(), "diagnosis_window_healthy");
+  }
+
+  void cleanupTestCase() { delete window_; }
+};
+
+QTEST_MAIN(DiagnosisPanelTest)
+#include "tst_diagnosis.moc"
