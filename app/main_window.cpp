@@ -32,6 +32,7 @@
 #include "app/recent_files.h"
 #include "app/session_controller.h"
 #include "core/io/ranges.h"
+#include "core/models/physical_models.h"
 #include "widgets/arm_panel.h"
 #include "widgets/bode_panel.h"
 #include "widgets/compare_panel.h"
@@ -158,6 +159,16 @@ MainWindow::MainWindow(QWidget* parent)
   discoveryPanel_->setPlayhead(playhead_);
   diagnosisPanel_->setPlayhead(playhead_);
   recursivePanel_->setPlayhead(playhead_);
+  // A finished recursive run hands the Arm view the model at its final estimate, named so.
+  connect(recursivePanel_, &RecursivePanel::runFinished, this, [this] {
+    const RecursivePanel::Run* run = recursivePanel_->currentRun();
+    if (!run || !run->result || !run->result->model) return;
+    if (auto m = std::dynamic_pointer_cast<const PhysicalModel>(run->result->model))
+      armPanel_->setExternalModel(tr("recursive estimate (run %1, at %2 s)")
+                                      .arg(run->id)
+                                      .arg(run->reached, 0, 'f', 1),
+                                  m);
+  });
   // The Arm view highlights the part whose parameter the diagnosis names at the playhead.
   connect(diagnosisPanel_, &DiagnosisPanel::verdictShown, this, [this](const QString& parameter) {
     if (parameter.isEmpty())

@@ -3,6 +3,8 @@
 
 #include <cmath>
 #include <cstdlib>
+#include <filesystem>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <ostream>
 #include <sstream>
@@ -109,6 +111,50 @@ bool rangeOption(ArgParser& args, const char* option, const IdData& data, const 
   return true;
 }
 
+// A log named by --log or --validation-log: FILE, or FILE@A:B for the part from A to B
+// seconds (a FILE that exists is taken whole, whatever it is named). Without a range, the
+// range stored in the log (stored), else all of it. Exit code, kExitOk when `out` is set.
+// A file named again (LOG@A:B, or one file in several options) is read once (read: by path),
+// so a validation range of an estimation log shares that experiment's means.
+int experimentOption(const std::string& text, const char* option, const LogReadOptions& readOptions,
+                     bool validation, std::map<std::string, std::shared_ptr<const IdData>>& read,
+                     FitExperiment& out, const std::string& pre, std::ostream& err) {
+  std::string path = text, rangeText;
+  const auto at = text.rfind('@');
+  std::error_code ec;
+  if (at != std::string::npos && !std::filesystem::exists(text, ec)) {
+    path = text.substr(0, at);
+    rangeText = text.substr(at + 1);
+  }
+  std::shared_ptr<const IdData>& data = read[path];
+  if (!data) {
+    auto loaded = loadLog(path, readOptions, err);
+    if (!loaded) return kExitBadInput;
+    data = std::make_shared<const IdData>(std::move(*loaded));
+    if (!data->input() || !data->output()) {
+      err << "flexarm: " << path << ": the log has no input or no output channel\n";
+      return kExitBadInput;
+    }
+  }
+  out = FitExperiment{data, std::nullopt};
+  const auto& stored = validation ? data->validationRange : data->estimationRange;
+  if (!rangeText.empty()) {
+    std::string why;
+    out.range = secondsRangeFromText(rangeText, &why);
+    if (!out.range) {
+      err << pre << "--" << option << " " << text << ": " << why << "\n";
+      return kExitUsage;
+    }
+    if (samplesIn(*data, *out.range).empty()) {
+      err << pre << "--" << option << " " << text << ": the range " << rangeText << " s holds no samples of the log\n";
+      return kExitUsage;
+    }
+  } else if (stored && !stored->empty()) {
+    out.range = secondsOf(*data, *stored);
+  }
+  return kExitOk;
+}
+
 }  // namespace
 
 bool parseModelSpec(const std::string& text, FitModelSpec& spec, std::string* why,
@@ -171,7 +217,7 @@ bool parseModelSpec(const std::string& text, FitModelSpec& spec, std::string* wh
 
 std::vector<std::string> fitValuedOptionNames() {
   std::vector<std::string> v = logReadOptionNames();
-  for (const char* n : {"model", "free", "fix", "decimate", "range", "validation-log",
+  for (const char* n : {"model", "free", "fix", "decimate", "range", "log", "validation-log",
                         "validation-range", "max-iterations", "starts", "seed", "closed-loop"})
     v.push_back(n);
   return v;
@@ -221,9 +267,20 @@ const char* fitOptionsHelp() {
          "                        warning says how far its 99 % intervals were measured to miss)\n"
          "  --range A:B           estimation data from A to B seconds (default: the log's\n"
          "                        stored estimation range, else everything)\n"
-         "  --validation-log LOG2 validation data from another log (same reading options; its\n"
-         "                        stored validation range, else all of it)\n"
+         "  --log LOG2[@A:B]      one more estimation experiment (repeatable): LOG2, or its\n"
+         "                        part from A to B seconds (without @A:B its stored estimation\n"
+         "                        range, else all of it; a range of LOG itself is LOG@A:B).\n"
+         "                        The loss is summed over LOG and every --log, each simulated\n"
+         "                        from zero state at its own first sample with its own means\n"
+         "                        removed and its errors weighted by its own noise level;\n"
+         "                        physical models then take the direct fit\n"
+         "  --validation-log LOG2[@A:B] a validation experiment (repeatable; same reading\n"
+         "                        options; without @A:B its stored validation range, else all\n"
+         "                        of it), with the means of the estimation experiment on the\n"
+         "                        same file, else LOG's\n"
          "  --validation-range A:B validation data from A to B seconds of LOG\n"
+         "Every experiment's fit % is listed (JSON: fit_percent_experiments and\n"
+         "fit_percent_validation_experiments, with their files and ranges).\n"
          "  --max-iterations N    Gauss-Newton iterations (default 100)\n"
          "  --keep-means          do not remove the estimation data's means (the seed does)\n"
          "  --json                print the result as JSON\n"
@@ -235,7 +292,7 @@ const char* fitOptionsHelp() {
 }
 
 int runFitPipeline(ArgParser& args, const std::string& verb, FitResult& result, std::ostream& err,
-                   bool allowNonparametric) {
+                   bool allowNonparametric, FitFiles* files) {
   const std::string pre = "flexarm " + verb + ": ";
   if (args.positional().size() != 1) {
     err << pre << "expected exactly one LOG\n";
@@ -300,10 +357,6 @@ int runFitPipeline(ArgParser& args, const std::string& verb, FitResult& result, 
     if (!applyFreeAndFix(args, *start, pre, err)) return kExitUsage;
     o.model.start = start;
   }
-  if (args.value("validation-log") && args.value("validation-range")) {
-    err << pre << "give --validation-log or --validation-range, not both\n";
-    return kExitUsage;
-  }
   auto readOptions = logReadOptions(args, err);
   if (!readOptions) return kExitUsage;
   auto loaded = loadLog(args.positional()[0], *readOptions, err);
@@ -316,20 +369,30 @@ int runFitPipeline(ArgParser& args, const std::string& verb, FitResult& result, 
   FitExperiment est{data, std::nullopt};
   if (!rangeOption(args, "range", *data, data->estimationRange, est.range, pre, err)) return kExitUsage;
   o.estimation = {est};
-  if (auto vlog = args.value("validation-log")) {
-    auto v = loadLog(*vlog, *readOptions, err);
-    if (!v) return kExitBadInput;
-    auto vdata = std::make_shared<const IdData>(std::move(*v));
-    std::optional<SecondsRange> range;
-    if (vdata->validationRange && !vdata->validationRange->empty())
-      range = secondsOf(*vdata, *vdata->validationRange);
-    o.validation.push_back({vdata, range});
-  } else {
-    FitExperiment val{data, std::nullopt};
-    if (!rangeOption(args, "validation-range", *data, data->validationRange, val.range, pre, err))
-      return kExitUsage;
-    if (val.range) o.validation.push_back(val);
+  std::map<std::string, std::shared_ptr<const IdData>> read{{args.positional()[0], data}};
+  auto experiment = [&](const std::string& text, const char* option, bool validation) {
+    FitExperiment e;
+    const int rc = experimentOption(text, option, *readOptions, validation, read, e, pre, err);
+    if (rc == kExitOk) {
+      (validation ? o.validation : o.estimation).push_back(e);
+      std::error_code ec;
+      const std::string file = std::filesystem::exists(text, ec) ? text : text.substr(0, text.rfind('@'));
+      if (files) (validation ? files->validation : files->estimation).push_back(file);
+    }
+    return rc;
+  };
+  if (files) *files = FitFiles{{args.positional()[0]}, {}};
+  for (const auto& text : args.values("log"))
+    if (const int rc = experiment(text, "log", false); rc != kExitOk) return rc;
+  FitExperiment val{data, std::nullopt};
+  if (!rangeOption(args, "validation-range", *data, data->validationRange, val.range, pre, err))
+    return kExitUsage;
+  if (args.value("validation-range") || (val.range && args.values("validation-log").empty())) {
+    o.validation.push_back(val);
+    if (files) files->validation.push_back(args.positional()[0]);
   }
+  for (const auto& text : args.values("validation-log"))
+    if (const int rc = experiment(text, "validation-log", true); rc != kExitOk) return rc;
   if (!o.isValid(&why)) {
     err << pre << why << "\n";
     return kExitUsage;
@@ -359,11 +422,28 @@ int runFit(const std::vector<std::string>& argv, std::ostream& out, std::ostream
     return kExitOk;
   }
   FitResult fit;
-  if (const int rc = runFitPipeline(args, "fit", fit, err); rc != kExitOk) return rc;
+  FitFiles files;
+  if (const int rc = runFitPipeline(args, "fit", fit, err, false, &files); rc != kExitOk) return rc;
   const auto& s = fit.summary;
   auto optJson = [](const std::optional<double>& v) {
     return v ? nlohmann::json(*v) : nlohmann::json(nullptr);
   };
+  // Every experiment: its file, its range (s, first and last sample) and its fit % (5.2).
+  auto experiments = [&](const std::vector<FitValidation>& list, const std::vector<std::string>& names,
+                         bool validation) {
+    nlohmann::json a = nlohmann::json::array();
+    for (std::size_t i = 0; i < list.size(); ++i) {
+      const PreparedData& d = list[i].data;
+      const SampleRange& range = validation ? d.validation : d.estimation;
+      a.push_back({{"log", i < names.size() ? names[i] : std::string()},
+                   {"range_s", {d.timeAt(range.begin), d.timeAt(range.end - 1)}},
+                   {"samples", range.size()},
+                   {"fit_percent", optJson(list[i].fitPercent)}});
+    }
+    return a;
+  };
+  std::size_t samples = 0;  // of every estimation experiment
+  for (const auto& e : fit.estimation) samples += e.data.estimation.size();
   nlohmann::json params = nlohmann::json::object(), stds = nlohmann::json::object();
   for (const auto& p : fit.parameters) {
     params[p.name] = p.value;
@@ -383,6 +463,8 @@ int runFit(const std::vector<std::string>& argv, std::ostream& out, std::ostream
                         {"std", stds},
                         {"fit_percent", optJson(fit.fitEstimation)},
                         {"fit_percent_validation", optJson(fit.fitValidation())},
+                        {"fit_percent_experiments", experiments(fit.estimation, files.estimation, false)},
+                        {"fit_percent_validation_experiments", experiments(fit.validation, files.validation, true)},
                         {"warnings", fit.warnings},
                         {"loss", s.loss},
                         {"fpe", s.fpe},
@@ -394,7 +476,7 @@ int runFit(const std::vector<std::string>& argv, std::ostream& out, std::ostream
                         {"iterations", s.iterations},
                         {"seconds", fit.seconds},
                         {"sample_time_s", fit.data.sampleTime},
-                        {"samples_estimation", fit.data.estimation.size()},
+                        {"samples_estimation", samples},
                         {"samples_validation", fit.validation.empty() ? 0 : fit.validation.front().data.validation.size()},
                         {"data", fit.data.note()},
                         {"closed_loop", fit.data.closedLoop},
@@ -409,7 +491,9 @@ int runFit(const std::vector<std::string>& argv, std::ostream& out, std::ostream
   }
   out << fit.modelName() << ": " << toString(s.termination) << " after " << s.iterations
       << " iterations (" << s.message << ")\n";
-  out << "data: " << fit.data.estimation.size() << " estimation samples at " << 1.0 / fit.data.sampleTime
+  out << "data: " << samples << " estimation samples"
+      << (fit.estimation.size() > 1 ? " in " + std::to_string(fit.estimation.size()) + " experiments" : std::string())
+      << " at " << 1.0 / fit.data.sampleTime
       << " Hz (" << fit.data.note() << ")\n";
   if (fit.method) out << "closed-loop method: " << fit.methodDescription << " (" << fit.methodReason << ")\n";
   if (fit.controller) out << "controller: " << fit.controllerSource << "\n";
@@ -419,6 +503,21 @@ int runFit(const std::vector<std::string>& argv, std::ostream& out, std::ostream
   if (fit.fitEstimation) out << ", fit " << *fit.fitEstimation << " %";
   if (auto v = fit.fitValidation()) out << ", validation fit " << *v << " %";
   out << "\n";
+  // Each experiment's fit % when there are several of a kind.
+  auto listFits = [&](const char* what, const std::vector<FitValidation>& list,
+                      const std::vector<std::string>& names, bool validation) {
+    if (list.size() < 2) return;
+    for (std::size_t i = 0; i < list.size(); ++i) {
+      const PreparedData& d = list[i].data;
+      const SampleRange& range = validation ? d.validation : d.estimation;
+      out << what << " " << i + 1 << " (" << (i < names.size() ? names[i] : std::string()) << ", "
+          << d.timeAt(range.begin) << "-" << d.timeAt(range.end - 1) << " s): fit ";
+      if (list[i].fitPercent) out << *list[i].fitPercent << " %\n";
+      else out << "undefined\n";
+    }
+  };
+  listFits("estimation", fit.estimation, files.estimation, false);
+  listFits("validation", fit.validation, files.validation, true);
   for (const auto& w : fit.warnings) out << "warning: " << w << "\n";
   auto list = [&](const char* what, const std::vector<double>& w) {
     out << what;

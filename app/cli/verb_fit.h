@@ -32,7 +32,12 @@ const char* fitOptionsHelp();
 
 // Reads LOG and the fit options, runs the pipeline and returns kExitOk, or the exit code
 // after printing a message prefixed by "flexarm VERB: " (usage 2, bad input 3, numerical 4).
+// files: when given, the file of each estimation and validation experiment, in the order of
+// FitOptions (and so of FitResult::estimation and validation).
+struct FitFiles {
+  std::vector<std::string> estimation, validation;
+};
 int runFitPipeline(ArgParser& args, const std::string& verb, FitResult& result, std::ostream& err,
-                   bool allowNonparametric = false);
+                   bool allowNonparametric = false, FitFiles* files = nullptr);
 
 }  // namespace flexarm::cli

@@ -100,6 +100,11 @@ bool PolyEstimateOptions::isValid(std::string* why) const {
     if (why) *why = "maxIterations >= 0, relativeTolerance > 0 and initialDamping > 0 required";
     return false;
   }
+  for (Eigen::Index n : experimentLengths)
+    if (n < 1) {
+      if (why) *why = "every experiment needs at least one sample";
+      return false;
+    }
   return true;
 }
 
@@ -188,6 +193,25 @@ double since(Clock::time_point t0) {
 void checkData(const Eigen::VectorXd& u, const Eigen::VectorXd& y) {
   if (u.size() != y.size())
     throw std::invalid_argument("input and output must have the same number of samples");
+}
+
+// An experiment's first sample and sample count in the joined u and y.
+struct Segment {
+  Eigen::Index from, n;
+};
+
+// The experiments of lengths (empty: one of every sample); throws when they do not add up.
+std::vector<Segment> segmentsOf(const std::vector<Eigen::Index>& lengths, Eigen::Index total) {
+  if (lengths.empty()) return {{0, total}};
+  std::vector<Segment> out;
+  Eigen::Index from = 0;
+  for (Eigen::Index n : lengths) {
+    out.push_back({from, n});
+    from += n;
+  }
+  if (from != total)
+    throw std::invalid_argument("the experiments' lengths must add up to the samples of u and y");
+  return out;
 }
 
 // Regression matrix whose columns are sign * signal(t - lag), rows t = first..N-1.
@@ -348,8 +372,9 @@ Eigen::VectorXd predictionErrors(const PolynomialModel& m, const Eigen::VectorXd
 }
 
 PolyEstimate arx(const Eigen::VectorXd& u, const Eigen::VectorXd& y, int na, int nb, int nk,
-                 double sampleTime) {
+                 double sampleTime, const std::vector<Eigen::Index>& experimentLengths) {
   checkData(u, y);
+  const std::vector<Segment> segments = segmentsOf(experimentLengths, y.size());
   PolyOrders o;
   o.na = na;
   o.nb = nb;
@@ -363,12 +388,28 @@ PolyEstimate arx(const Eigen::VectorXd& u, const Eigen::VectorXd& y, int na, int
   const int first = std::max(na, nb + nk - 1);
   const int p = o.parameters();
   if (!o.fitsData(PolyStructure::Arx, n, &r.summary.message)) return r;
+  Eigen::Index rows = 0;  // regressions: each experiment's samples from its `first` on
+  for (const auto& g : segments) rows += std::max<Eigen::Index>(0, g.n - first);
+  if (rows <= p) {
+    r.summary.message = "too few samples (" + std::to_string(n) + " in " + std::to_string(segments.size()) +
+                        " experiments) for " + std::to_string(p) + " parameters";
+    return r;
+  }
   if (!u.allFinite() || !y.allFinite()) {
     r.summary.message = "the data contain NaN or infinite values";
     return r;
   }
-  const Eigen::MatrixXd phi = regressors({{&y, -1.0, 1, na}, {&u, 1.0, nk, nb}}, first, n);
-  const Eigen::VectorXd rhs = y.tail(n - first);
+  // Each experiment's regressors from its own samples only, stacked.
+  Eigen::MatrixXd phi(rows, p);
+  Eigen::VectorXd rhs(rows);
+  Eigen::Index at = 0;
+  for (const auto& g : segments) {
+    if (g.n <= first) continue;
+    const Eigen::VectorXd ug = u.segment(g.from, g.n), yg = y.segment(g.from, g.n);
+    phi.middleRows(at, g.n - first) = regressors({{&yg, -1.0, 1, na}, {&ug, 1.0, nk, nb}}, first, g.n);
+    rhs.segment(at, g.n - first) = yg.tail(g.n - first);
+    at += g.n - first;
+  }
   Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(phi);
   if (qr.rank() < p) {
     r.summary.message = "the regressors are rank deficient (rank " + std::to_string(qr.rank()) +
@@ -380,7 +421,7 @@ PolyEstimate arx(const Eigen::VectorXd& u, const Eigen::VectorXd& y, int na, int
   r.model.setParameterVector(th);
   const Eigen::VectorXd res = rhs - phi * th;
   const double sumSq = res.squaredNorm();
-  const Eigen::Index m = n - first;
+  const Eigen::Index m = rows;
   r.model.noiseVariance = sumSq / static_cast<double>(m - p);
   // (Phi^T Phi)^{-1} = P R^{-1} R^{-T} P^T from the QR factors.
   const Eigen::MatrixXd R = qr.matrixR().topLeftCorner(p, p).template triangularView<Eigen::Upper>();
@@ -417,14 +458,48 @@ PolyEstimate refinePolynomial(const Eigen::VectorXd& u, const Eigen::VectorXd& y
     s.message = "the data contain NaN or infinite values";
     return r;
   }
+  const std::vector<Segment> segments = segmentsOf(options.experimentLengths, n);
   PolynomialModel work = initial;
-  PolyPredictor predictor(u, y, initial.orders);
+  // One predictor per experiment, each run from zero initial conditions at its own first
+  // sample over its own criterion samples; the records outlive the predictors.
+  std::vector<Eigen::VectorXd> us, ys;
+  us.reserve(segments.size());
+  ys.reserve(segments.size());
+  std::vector<PolyPredictor> predictors;
+  predictors.reserve(segments.size());
+  Eigen::Index used = 0;  // the rows in the criterion
+  for (const auto& g : segments) {
+    us.push_back(u.segment(g.from, g.n));
+    ys.push_back(y.segment(g.from, g.n));
+    predictors.emplace_back(us.back(), ys.back(), initial.orders);
+    used += std::max<Eigen::Index>(0, g.n - predictors.back().criterionStart());
+  }
+  // Several experiments: each one's squared errors weighted by lambda / lambda_k once a first
+  // fit has estimated its noise variance (empty: unweighted), as pem does.
+  std::vector<double> weights;
   LeastSquaresProblem problem;
   problem.samples = n;
   problem.normalEquations = [&](const Eigen::VectorXd& th, double bound, double& sumSquares,
                                 Eigen::MatrixXd* R, Eigen::VectorXd* g) {
     work.setParameterVector(th);
-    sumSquares = predictor.run(work, R, g, bound);
+    if (predictors.size() == 1) {
+      sumSquares = predictors.front().run(work, R, g, bound);
+      return true;
+    }
+    sumSquares = 0.0;
+    if (R) R->setZero(p, p);
+    if (g) g->setZero(p);
+    Eigen::MatrixXd Rk;
+    Eigen::VectorXd gk;
+    for (std::size_t k = 0; k < predictors.size(); ++k) {
+      const double w = weights.empty() ? 1.0 : weights[k];
+      const double sk = predictors[k].run(work, R ? &Rk : nullptr, g ? &gk : nullptr,
+                                          (bound - sumSquares) / w);
+      sumSquares += w * sk;
+      if (sumSquares > bound) return true;  // rejected anyway; R and g are not used
+      if (R) *R += w * Rk;
+      if (g) *g += w * gk;
+    }
     return true;
   };
   if (options.enforceStability)
@@ -435,10 +510,30 @@ PolyEstimate refinePolynomial(const Eigen::VectorXd& u, const Eigen::VectorXd& y
   LeastSquaresSolution sol = levenbergMarquardt(problem, initial.parameterVector(),
                                                 options.maxIterations, options.relativeTolerance,
                                                 options.initialDamping, progress);
+  if (predictors.size() > 1 && sol.summary.termination != Termination::Failed &&
+      sol.summary.termination != Termination::Cancelled) {
+    // Each experiment's noise variance from the first fit, then the weighted fit from there.
+    work.setParameterVector(sol.phi);
+    std::vector<double> own(predictors.size());
+    double total = 0.0;
+    for (std::size_t k = 0; k < predictors.size(); ++k) {
+      const double sk = predictors[k].run(work);
+      total += sk;
+      const Eigen::Index rows = segments[k].n - predictors[k].criterionStart();
+      own[k] = sk / static_cast<double>(std::max<Eigen::Index>(1, rows));
+    }
+    const double pooled = total / static_cast<double>(std::max<Eigen::Index>(1, used));
+    for (double o : own) weights.push_back(o > 0.0 && pooled > 0.0 ? pooled / o : 1.0);
+    LeastSquaresSolution weighted = levenbergMarquardt(problem, sol.phi, options.maxIterations,
+                                                       options.relativeTolerance, options.initialDamping);
+    if (weighted.summary.termination != Termination::Failed) {
+      weighted.summary.iterations += sol.summary.iterations;
+      sol = std::move(weighted);
+    }
+  }
   s = sol.summary;
   if (s.termination == Termination::Failed) return r;
   r.model.setParameterVector(sol.phi);
-  const Eigen::Index used = n - predictor.criterionStart();
   r.model.noiseVariance = sol.sumSquares / static_cast<double>(used - p);
   r.model.covariance = gaussNewtonCovariance(sol.R, used, sol.sumSquares);
   if (r.model.covariance.size() == 0)
@@ -462,7 +557,8 @@ PolyEstimate estimatePolynomial(const Eigen::VectorXd& u, const Eigen::VectorXd&
   std::string why;
   if (!o.isValid(&why)) throw std::invalid_argument(std::string(toString(structure)) + ": " + why);
   const auto t0 = Clock::now();
-  if (structure == PolyStructure::Arx) return arx(u, y, o.na, o.nb, o.nk, sampleTime);
+  if (structure == PolyStructure::Arx) return arx(u, y, o.na, o.nb, o.nk, sampleTime, options.experimentLengths);
+  segmentsOf(options.experimentLengths, y.size());  // throws when they do not add up
   if (std::string tooBig; !o.fitsData(structure, y.size(), &tooBig)) {
     PolyEstimate r;
     r.model = PolynomialModel::zero(structure, o, sampleTime);

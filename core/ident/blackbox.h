@@ -79,12 +79,24 @@ struct PolyEstimateOptions {
   double relativeTolerance = 1e-7;   // stop when the loss improves by less than this fraction
   double initialDamping = 1e-3;      // Levenberg-Marquardt lambda relative to diag(R) (4.21)
   bool enforceStability = true;      // reflect roots of C, D, F into the unit circle
+  // Several experiments: u and y hold them one after another and these are their sample
+  // counts (they sum to the samples of u); empty: one experiment. The loss (4.6) is summed
+  // over the experiments, each filtered from zero initial conditions at its own first sample
+  // with its first max(na, nb + nk - 1, nc, nd, nf) errors left out (ARX: no regressor
+  // reaches into another experiment); the covariance comes from the stacked gradient. The
+  // start values are computed from the experiments joined (a start only). Iterative
+  // structures are then refined with each experiment's errors weighted by
+  // sqrt(lambda / lambda_k), lambda_k its noise variance from the first fit and lambda the
+  // pooled one (the likelihood's loss for experiments of different noise levels); ARX keeps
+  // plain least squares.
+  std::vector<Eigen::Index> experimentLengths;
   bool isValid(std::string* why) const;
 };
 
-// ARX by least squares via QR (4.16); any orders (very high order included). u, y equal length.
+// ARX by least squares via QR (4.16); any orders (very high order included). u, y equal length;
+// experimentLengths as in PolyEstimateOptions (empty: one experiment).
 PolyEstimate arx(const Eigen::VectorXd& u, const Eigen::VectorXd& y, int na, int nb, int nk,
-                 double sampleTime = 1.0);
+                 double sampleTime = 1.0, const std::vector<Eigen::Index>& experimentLengths = {});
 
 // Prediction-error estimate of any structure (4.8) by Levenberg-Marquardt (4.17)-(4.21), started
 // from SITB-like initial values (ARX, instrumental variables, Hannan-Rissanen for the noise).

@@ -88,9 +88,15 @@ bool FitOptions::isValidExceptData(std::string* why) const {
     return false;
   };
   if (!model.isValid(why)) return false;
-  if (estimation.size() != 1)
-    return fail(estimation.empty() ? "the fit needs an estimation experiment"
-                                   : "the fit takes one estimation experiment for now");
+  if (estimation.empty()) return fail("the fit needs an estimation experiment");
+  if (estimation.size() > 1) {
+    if (model.kind == FitModelKind::Spa || model.kind == FitModelKind::Etfe)
+      return fail(std::string(toString(model.kind)) + " takes one estimation experiment");
+    if (model.kind == FitModelKind::Physical &&
+        (closedLoop == ClosedLoopChoice::TwoStage || closedLoop == ClosedLoopChoice::Indirect))
+      return fail(std::string("the ") + toString(closedLoop) +
+                  " closed-loop fit takes one estimation experiment; several take the direct fit");
+  }
   for (const auto* list : {&estimation, &validation})
     for (const auto& e : *list)
       if (e.range && !(e.range->start < e.range->end))
@@ -179,14 +185,37 @@ FrequencyResponse estimateResponse(const PhysicalModel* physical, const Eigen::M
   return frequencyResponse(*polynomial, below, level);
 }
 
+namespace fit_detail {
+
+JoinedEstimation joinedEstimation(const FitResult& r) {
+  JoinedEstimation j;
+  Eigen::Index total = 0;
+  for (const auto& e : r.estimation) total += static_cast<Eigen::Index>(e.data.estimation.size());
+  j.u.resize(total);
+  j.y.resize(total);
+  Eigen::Index at = 0;
+  for (const auto& e : r.estimation) {
+    const auto n = static_cast<Eigen::Index>(e.data.estimation.size());
+    j.u.segment(at, n) = e.data.estimationInput();
+    j.y.segment(at, n) = e.data.estimationOutput();
+    j.lengths.push_back(n);
+    at += n;
+  }
+  if (j.lengths.size() == 1) j.lengths.clear();  // one experiment: the estimators' default
+  return j;
+}
+
+}  // namespace fit_detail
+
 namespace {
 
-// Black-box structures (4.8) by prediction error (4.6).
+// Black-box structures (4.8) by prediction error (4.6), over every estimation experiment.
 bool fitBlackBox(const FitOptions& o, FitResult& r, const ProgressCallback& progress) {
   PolyEstimateOptions po;
   po.maxIterations = o.maxIterations;
-  PolyEstimate e = estimatePolynomial(r.data.estimationInput(), r.data.estimationOutput(),
-                                      o.model.structure, o.model.orders, r.data.sampleTime, po, progress);
+  const fit_detail::JoinedEstimation j = fit_detail::joinedEstimation(r);
+  po.experimentLengths = j.lengths;
+  PolyEstimate e = estimatePolynomial(j.u, j.y, o.model.structure, o.model.orders, r.data.sampleTime, po, progress);
   r.summary = e.summary;
   const auto names = e.model.parameterNames();
   const Eigen::VectorXd th = e.model.parameterVector(), sd = e.model.standardDeviations();
@@ -225,7 +254,34 @@ bool fitNonparametric(const FitOptions& o, FitResult& r) {
   return true;
 }
 
-// Validation experiments prepared as the estimation data, with the estimation data's means.
+// Every estimation experiment prepared on its own (its own range and means); r.data is the
+// first. False with termination and message set when one cannot be used.
+bool prepareEstimation(const FitOptions& o, const FitDataOptions& base, FitResult& r) {
+  for (std::size_t i = 0; i < o.estimation.size(); ++i) {
+    FitDataOptions eo = base;
+    eo.estimation = o.estimation[i].range;
+    FitValidation e;
+    e.data = prepareFitData(*o.estimation[i].data, eo);
+    const std::string which =
+        o.estimation.size() > 1 ? "estimation experiment " + std::to_string(i + 1) + ": " : "";
+    if (!e.data.ok()) {
+      r.termination = Termination::Failed;
+      r.message = which + e.data.message;
+      return false;
+    }
+    if (i > 0 && std::abs(e.data.sampleTime - r.data.sampleTime) > 1e-9 * r.data.sampleTime) {
+      r.termination = Termination::Failed;
+      r.message = which + "its sample time differs from the first estimation experiment's";
+      return false;
+    }
+    if (i == 0) r.data = e.data;
+    r.estimation.push_back(std::move(e));
+  }
+  return true;
+}
+
+// Validation experiments prepared as the estimation data, with the means of the estimation
+// experiment on the same log, else of the first.
 bool prepareValidation(const FitOptions& o, const FitDataOptions& base, FitResult& r) {
   for (std::size_t i = 0; i < o.validation.size(); ++i) {
     const FitExperiment& e = o.validation[i];
@@ -248,13 +304,19 @@ bool prepareValidation(const FitOptions& o, const FitDataOptions& base, FitResul
       return false;
     }
     v.data.validation = v.data.estimation;
-    v.data.u.array() -= r.data.inputMean;
-    v.data.y.array() -= r.data.outputMean;
-    if (v.data.r.size()) v.data.r.array() -= r.data.referenceMean;
-    v.data.inputMean = r.data.inputMean;
-    v.data.outputMean = r.data.outputMean;
-    v.data.referenceMean = r.data.referenceMean;
-    if (r.data.inputMean != 0.0 || r.data.outputMean != 0.0)
+    const PreparedData* means = &r.data;
+    for (std::size_t k = 0; k < o.estimation.size(); ++k)
+      if (o.estimation[k].data == e.data) {
+        means = &r.estimation[k].data;
+        break;
+      }
+    v.data.u.array() -= means->inputMean;
+    v.data.y.array() -= means->outputMean;
+    if (v.data.r.size()) v.data.r.array() -= means->referenceMean;
+    v.data.inputMean = means->inputMean;
+    v.data.outputMean = means->outputMean;
+    v.data.referenceMean = means->referenceMean;
+    if (means->inputMean != 0.0 || means->outputMean != 0.0)
       v.data.steps.push_back("the estimation data's means removed");
     r.validation.push_back(std::move(v));
   }
@@ -288,15 +350,15 @@ FitResult fitModel(const FitOptions& options, const ProgressCallback& progress) 
   if (options.model.kind == FitModelKind::Physical)
     d.decimatedInput = FitDataOptions::DecimatedInput::HeldMean;
   d.removeMeans = options.removeMeans;
-  d.estimation = options.estimation.front().range;
-  r.data = prepareFitData(*options.estimation.front().data, d);
-  r.badData = !r.data.ok();
-  if (r.badData) return finish(Termination::Failed, r.data.message);
-  r.badData = !prepareValidation(options, d, r);
+  r.badData = !prepareEstimation(options, d, r) || !prepareValidation(options, d, r);
   if (r.badData) return finish(r.termination, r.message);
   const bool nonparametric = options.model.kind == FitModelKind::Spa || options.model.kind == FitModelKind::Etfe;
-  const Eigen::VectorXd uEst = r.data.estimationInput();
-  if (!nonparametric && (uEst.array() - uEst.mean()).abs().maxCoeff() == 0.0)
+  bool constant = true;
+  for (const auto& e : r.estimation) {
+    const Eigen::VectorXd uEst = e.data.estimationInput();
+    constant = constant && (uEst.array() - uEst.mean()).abs().maxCoeff() == 0.0;
+  }
+  if (!nonparametric && constant)
     return finish(Termination::Failed,
                   "the input is constant over the estimation range, so the data say nothing about the system");
 
@@ -308,8 +370,9 @@ FitResult fitModel(const FitOptions& options, const ProgressCallback& progress) 
         break;
       case FitModelKind::BlackBox: {
         std::string tooMuch;
-        r.badRequest = !options.model.orders.fitsData(
-            options.model.structure, static_cast<long long>(r.data.estimationOutput().size()), &tooMuch);
+        long long samples = 0;  // of every estimation experiment
+        for (const auto& e : r.estimation) samples += static_cast<long long>(e.data.estimation.size());
+        r.badRequest = !options.model.orders.fitsData(options.model.structure, samples, &tooMuch);
         if (r.badRequest) return finish(Termination::Failed, tooMuch);
         fitBlackBox(options, r, progress);
         break;

@@ -72,12 +72,17 @@ struct FitExperiment {
 
 struct FitOptions {
   FitModelSpec model;
-  // Estimation data: one experiment (several are the next step: the estimator then restarts
-  // the model's state at each experiment's first sample).
+  // Estimation data: one experiment or several (logs, or ranges of one log). Each is prepared
+  // on its own (its own means removed) and the estimator sums the loss (4.6) over them, each
+  // predicted or simulated from zero state at its own first sample, so nothing carries across
+  // from one experiment to the next (physical models by pem, black-box ones by
+  // estimatePolynomial, with PemOptions / PolyEstimateOptions::experimentLengths); the
+  // covariance comes from the stacked gradient. Several experiments take the direct fit of a
+  // physical model (the two-stage and indirect closed-loop fits take one) and no SPA or ETFE.
   std::vector<FitExperiment> estimation;
-  // Validation data: any number of experiments; an experiment on the estimation log has the
-  // estimation range's means removed, one on another log as well (the model's operating
-  // point is the estimation data's).
+  // Validation data: any number of experiments. Each has the means of the estimation
+  // experiment on the same log (the same IdData) removed, else those of the first estimation
+  // experiment (the model's operating point is the estimation data's).
   std::vector<FitExperiment> validation;
   // Preparation (fit_data.h): channels by name (empty: by role), decimation, means.
   std::string input, output, reference;
@@ -112,11 +117,14 @@ struct FitParameter {
   bool free = false;
 };
 
-// The evaluation on one validation experiment.
+// The evaluation on one experiment. Validation: data with the estimation data's means, fit %
+// (5.2) on its validation range simulated from the log's first sample. Estimation: data as
+// prepared (its own means), fit % on its estimation range simulated from the range's first
+// sample, as the estimator saw it.
 struct FitValidation {
-  PreparedData data;  // its means: the estimation data's
-  std::optional<double> fitPercent;  // (5.2) on its range, simulated from the log's first sample
-  Eigen::VectorXd simulated;         // the whole log
+  PreparedData data;
+  std::optional<double> fitPercent;
+  Eigen::VectorXd simulated;  // the whole log, from its first sample
 };
 
 struct FitResult {
@@ -131,7 +139,9 @@ struct FitResult {
   bool badRequest = false;
 
   FitModelSpec model;
-  PreparedData data;  // the estimation experiment as prepared
+  PreparedData data;  // the (first) estimation experiment as prepared
+  // Every estimation experiment (the first's data are `data`), in FitOptions order.
+  std::vector<FitValidation> estimation;
   std::vector<FitValidation> validation;
 
   // Physical fits of closed-loop logs: the method used and why (Auto states its rule), stage
@@ -157,7 +167,9 @@ struct FitResult {
   std::vector<FitParameter> parameters;
 
   // Fit % (5.2) on the estimation range (simulated from its first sample), or nullopt when
-  // the simulated output diverges (unstable G) or for non-parametric estimates.
+  // the simulated output diverges (unstable G) or for non-parametric estimates. With several
+  // experiments, of them all together: 1 - sum of every squared error / sum of every squared
+  // deviation from its own experiment's mean (each experiment's own is in `estimation`).
   std::optional<double> fitEstimation;
   // Of the first validation experiment, when there is one.
   std::optional<double> fitValidation() const;

@@ -72,10 +72,23 @@ void evaluate(const FitOptions& o, FitResult& r) {
   const PreparedData& d = r.data;
   bool finite = true;
   if (parametric) {
-    const Eigen::VectorXd yEst = d.estimationOutput();
-    const double fe = fitPercent(yEst, simulated(r, d.estimationInput()));
-    r.simulated = simulated(r, d.u);  // from the log's first sample
-    finite = std::isfinite(fe);
+    // Each estimation experiment simulated from its range's first sample, as the estimator
+    // saw it; the whole fit % pools the errors and each experiment's own deviations.
+    double errors = 0.0, deviations = 0.0;
+    for (auto& e : r.estimation) {
+      const Eigen::VectorXd yEst = e.data.estimationOutput();
+      const Eigen::VectorXd ySim = simulated(r, e.data.estimationInput());
+      const double fe = fitPercent(yEst, ySim);
+      e.simulated = simulated(r, e.data.u);  // from the log's first sample
+      if (std::isfinite(fe)) e.fitPercent = fe;
+      else finite = false;
+      errors += (yEst - ySim).squaredNorm();
+      deviations += (yEst.array() - yEst.mean()).square().sum();
+    }
+    r.simulated = r.estimation.front().simulated;
+    const double fe = r.estimation.size() == 1 ? r.estimation.front().fitPercent.value_or(NAN)
+                                               : 100.0 * (1.0 - errors / deviations);
+    finite = finite && std::isfinite(fe);
     if (finite) r.fitEstimation = fe;
     for (auto& v : r.validation) {
       v.simulated = simulated(r, v.data.u);
@@ -86,6 +99,7 @@ void evaluate(const FitOptions& o, FitResult& r) {
     }
     if (!finite) {
       r.fitEstimation.reset();
+      for (auto& v : r.estimation) v.fitPercent.reset();
       for (auto& v : r.validation) v.fitPercent.reset();
       r.warnings.push_back("the model's G is unstable, so its simulated output diverges and the fit % is "
                            "undefined; it can still predict one step ahead");
@@ -114,7 +128,9 @@ void evaluate(const FitOptions& o, FitResult& r) {
     r.peaks = np.peaks;
   }
   if (nonparametric && !r.nonparametric.warning.empty()) r.warnings.push_back(r.nonparametric.warning);
-  if (r.method == ClosedLoopMethod::Direct && d.closedLoop && o.closedLoop == ClosedLoopChoice::Direct)
+  if (r.method == ClosedLoopMethod::Direct && d.closedLoop &&
+      (o.closedLoop == ClosedLoopChoice::Direct ||
+       (r.estimation.size() > 1 && o.noiseModel == NoiseModel::OutputError)))
     r.warnings.push_back(std::string("the log was recorded in closed loop: only models with a flexible, "
                                      "independently parameterized noise model (BJ) are free of bias (4.43); "
                                      "on simulated logs at the sample logs' noise only ") +

@@ -110,7 +110,10 @@ void keepEstimate(PemResult&& e, const FitOptions& o, FitResult& r) {
 
 bool fitPhysical(const FitOptions& o, FitResult& r, const ProgressCallback& progress) {
   const PreparedData& d = r.data;
-  const Eigen::VectorXd u = d.estimationInput(), y = d.estimationOutput();
+  const JoinedEstimation joined = joinedEstimation(r);  // every estimation experiment
+  const Eigen::VectorXd& u = joined.u;
+  const Eigen::VectorXd& y = joined.y;
+  const bool several = !joined.lengths.empty();
   const double T = d.sampleTime;
   auto fail = [&r](const std::string& text) {  // the log cannot carry the method asked for
     r.termination = Termination::Failed;
@@ -124,8 +127,9 @@ bool fitPhysical(const FitOptions& o, FitResult& r, const ProgressCallback& prog
   po.randomStarts = o.randomStarts;
   po.seed = o.seed;
   po.level = o.level;
+  po.experimentLengths = joined.lengths;
   if (po.randomStarts > 0) {  // two more starts whose notches and peaks match the SPA estimate
-    const NonparametricEstimate sp = spa(u, y, T);
+    const NonparametricEstimate sp = spa(d.estimationInput(), d.estimationOutput(), T);  // of the first
     if (sp.termination == Termination::Converged) {
       const auto np = notchesAndPeaks(sp.response, 3.0);
       po.targetNotches = np.notches;
@@ -138,7 +142,7 @@ bool fitPhysical(const FitOptions& o, FitResult& r, const ProgressCallback& prog
   const bool outputError = o.noiseModel == NoiseModel::OutputError;
   std::string loopWhy;
   std::optional<Loop> loop;
-  if (d.closedLoop && outputError &&
+  if (d.closedLoop && outputError && !several &&
       (o.closedLoop == ClosedLoopChoice::Auto || o.closedLoop == ClosedLoopChoice::Indirect))
     loop = loopOf(o, d, &loopWhy);
 
@@ -185,6 +189,10 @@ bool fitPhysical(const FitOptions& o, FitResult& r, const ProgressCallback& prog
       } else if (!outputError) {
         cl = run(ClosedLoopMethod::Direct, CovarianceKind::White);
         r.methodReason = "auto: the innovations form models the noise, which only the direct fit can do";
+      } else if (several) {
+        cl = run(ClosedLoopMethod::Direct, CovarianceKind::White);
+        r.methodReason = "auto: several estimation experiments, which only the direct fit takes (it is "
+                         "biased in closed loop (4.43))";
       } else if (loop) {
         cl = run(ClosedLoopMethod::Indirect, CovarianceKind::Sandwich);
         r.methodReason = std::string("auto: ") + kIndirectEvidence;

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <numeric>
 #include <random>
 #include <stdexcept>
 
@@ -63,6 +64,8 @@ bool PemOptions::isValid(std::string* why) const {
   if (covarianceLags < 0) return fail("covarianceLags must not be negative");
   if (predictor && noiseModel != NoiseModel::OutputError)
     return fail("a custom predictor is output error: it excludes the innovations form");
+  for (Eigen::Index n : experimentLengths)
+    if (n < 1) return fail("every experiment needs at least one sample");
   return true;
 }
 
@@ -353,6 +356,10 @@ PemResult pem(const ParametricModel& model0, const Eigen::VectorXd& u, const Eig
   if (u.size() != y.size())
     throw std::invalid_argument("pem: input and output must have the same number of samples");
   if (!(T > 0.0)) throw std::invalid_argument("pem: the sample time must be positive");
+  const std::vector<Eigen::Index> lengths =
+      options.experimentLengths.empty() ? std::vector<Eigen::Index>{y.size()} : options.experimentLengths;
+  if (std::accumulate(lengths.begin(), lengths.end(), Eigen::Index{0}) != y.size())
+    throw std::invalid_argument("pem: the experiments' lengths must add up to the samples of u and y");
   const auto t0 = Clock::now();
   const auto& params0 = model0.parameters();
   Transform tr;
@@ -407,14 +414,45 @@ PemResult pem(const ParametricModel& model0, const Eigen::VectorXd& u, const Eig
       if (!(tr.logParam[j] && th <= 0.0)) phi[j] = tr.toPhi(j, th);
     }
   };
+  // Several experiments: each one's errors weighted by sqrt(lambda / lambda_k), lambda_k its
+  // own noise variance and lambda the pooled one, once a first fit has estimated them (empty:
+  // unweighted). The loss is then the likelihood's for experiments of different noise levels.
+  std::vector<double> weights;
+  std::vector<Eigen::Index> partRows;  // error rows of each experiment in the last evaluation
   problem.evaluate = [&](const Eigen::VectorXd& phi, Eigen::VectorXd& eps, Eigen::MatrixXd* psi) {
     Eigen::VectorXd K;
     setPhi(phi, K);
+    // Each experiment from zero state at its first sample, its errors and gradient stacked.
+    auto one = [&](const Eigen::VectorXd& ue, const Eigen::VectorXd& ye) {
+      return options.predictor ? options.predictor(*work, ue, ye, T, tr.free, psi != nullptr)
+                               : evaluatePredictor(*work, K, ue, ye, T, tr.free, psi != nullptr, innovations);
+    };
     PemEvaluation ev;
     try {
-      ev = options.predictor
-               ? options.predictor(*work, u, y, T, tr.free, psi != nullptr)
-               : evaluatePredictor(*work, K, u, y, T, tr.free, psi != nullptr, innovations);
+      if (lengths.size() == 1) {
+        ev = one(u, y);
+      } else {
+        std::vector<PemEvaluation> parts;
+        Eigen::Index rows = 0, from = 0;
+        for (Eigen::Index count : lengths) {
+          parts.push_back(one(u.segment(from, count), y.segment(from, count)));
+          from += count;
+          rows += parts.back().eps.size();
+          ev.stable = ev.stable && parts.back().stable;
+        }
+        ev.eps.resize(rows);
+        if (psi) ev.psi.resize(rows, parts.front().psi.cols());
+        Eigen::Index at = 0;
+        partRows.clear();
+        for (std::size_t k = 0; k < parts.size(); ++k) {
+          const auto& part = parts[k];
+          const double w = weights.empty() ? 1.0 : weights[k];
+          ev.eps.segment(at, part.eps.size()) = w * part.eps;
+          if (psi) ev.psi.middleRows(at, part.eps.size()) = w * part.psi;
+          at += part.eps.size();
+          partRows.push_back(part.eps.size());
+        }
+      }
     } catch (const std::invalid_argument&) {
       return false;  // the model rejects these values (e.g. a zero inertia)
     }
@@ -534,6 +572,28 @@ PemResult pem(const ParametricModel& model0, const Eigen::VectorXd& u, const Eig
   // Fixed parameters of the best start, then the estimate.
   for (std::size_t i = 0; i < params0.size(); ++i)
     if (!params0[i].free) work->setParameter(params0[i].name, starts[result.bestStart][i]);
+  if (lengths.size() > 1 && !cancelled) {
+    // Each experiment's noise variance from the first fit's errors, then the weighted fit
+    // from there (the covariance below is then that of the weighted loss).
+    Eigen::VectorXd eps;
+    if (problem.evaluate(best.sol.phi, eps, nullptr) && partRows.size() == lengths.size()) {
+      const double pooled = eps.squaredNorm() / static_cast<double>(eps.size());
+      Eigen::Index at = 0;
+      for (Eigen::Index rows : partRows) {
+        const double own = eps.segment(at, rows).squaredNorm() / static_cast<double>(std::max<Eigen::Index>(1, rows));
+        weights.push_back(own > 0.0 && pooled > 0.0 ? std::sqrt(pooled / own) : 1.0);
+        at += rows;
+      }
+      LeastSquaresSolution sol = levenbergMarquardt(problem, best.sol.phi, options.maxIterations,
+                                                    options.relativeTolerance, options.initialDamping);
+      totalIterations += sol.summary.iterations;
+      if (sol.summary.termination != Termination::Failed) {
+        best.sol = std::move(sol);
+      } else {
+        weights.clear();  // keep the unweighted estimate
+      }
+    }
+  }
   Eigen::VectorXd K;
   setPhi(best.sol.phi, K);
   result.model = work->clone();

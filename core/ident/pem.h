@@ -95,6 +95,15 @@ struct PemOptions {
   // When set, the loss is formed with this predictor instead of the ZOH simulation of the
   // model from u (output error only).
   OutputErrorPredictor predictor;
+  // Several experiments: u and y hold them one after another and these are their sample
+  // counts (they sum to the samples of u); empty: one experiment. The loss (4.6) is summed
+  // over the experiments, each predicted from zero state at its own first sample (no
+  // transient across a seam), and the covariance comes from the stacked gradient. Once a
+  // first fit has estimated each experiment's noise variance lambda_k, the fit is refined
+  // with each experiment's errors weighted by sqrt(lambda / lambda_k) (lambda the pooled
+  // one), the likelihood's loss for experiments of different noise levels; the reported loss
+  // is that weighted one.
+  std::vector<Eigen::Index> experimentLengths;
   bool isValid(std::string* why) const;
 };
 

@@ -374,3 +374,45 @@ TEST(CliIdent, PhysicalFitOfTheAngleLogDifferentiatesAndRecoversTheTruth) {
   }
   EXPECT_EQ(checked, 4);
 }
+
+// Issue 14: two estimation experiments (--log, here a range of the same log) and two
+// validation experiments (repeatable --validation-log FILE@A:B), each one's fit % printed and
+// in the JSON with its file and range.
+TEST(CliIdent, FitOnTwoLogsListsEveryExperimentsFit) {
+  const std::vector<std::string> args = daisy({"fit", "--model", "oe:2,2,1", "--range", "0:399", "--log",
+                                               kDaisy + "@400:699", "--validation-log", kDaisy + "@700:849",
+                                               "--validation-log", kDaisy + "@850:1023"});
+  const auto text = runFlexarm(args);
+  ASSERT_EQ(text.code, 0) << text.err;
+  int fits = 0;
+  for (const char* what : {"estimation 1 (", "estimation 2 (", "validation 1 (", "validation 2 ("}) {
+    const auto at = text.out.find(what);
+    ASSERT_NE(at, std::string::npos) << what << "\n" << text.out;
+    if (text.out.find(" %", at) < text.out.find('\n', at)) ++fits;
+  }
+  EXPECT_EQ(fits, 4) << text.out;
+  EXPECT_NE(text.out.find("700 estimation samples in 2 experiments"), std::string::npos) << text.out;
+  auto withJson = args;
+  withJson.push_back("--json");
+  const auto r = runFlexarm(withJson);
+  ASSERT_EQ(r.code, 0) << r.err;
+  const json j = json::parse(r.out);
+  ASSERT_EQ(j["fit_percent_experiments"].size(), 2u);
+  ASSERT_EQ(j["fit_percent_validation_experiments"].size(), 2u);
+  EXPECT_EQ(j["fit_percent_experiments"][1]["range_s"][0].get<double>(), 400.0);
+  EXPECT_EQ(j["fit_percent_experiments"][1]["samples"].get<int>(), 300);
+  EXPECT_EQ(j["fit_percent_validation_experiments"][1]["range_s"][1].get<double>(), 1023.0);
+  EXPECT_EQ(j["samples_estimation"].get<int>(), 700);
+  for (const auto* list : {&j["fit_percent_experiments"], &j["fit_percent_validation_experiments"]})
+    for (const auto& e : *list) {
+      EXPECT_EQ(e["log"].get<std::string>(), kDaisy);
+      EXPECT_GT(e["fit_percent"].get<double>(), 80.0);  // DaISy's arm: 88-94 % on each part
+    }
+  EXPECT_EQ(j["fit_percent_validation"].get<double>(),
+            j["fit_percent_validation_experiments"][0]["fit_percent"].get<double>());
+  // A range outside the log, and a file that does not exist.
+  auto bad = daisy({"fit", "--model", "oe:2,2,1", "--log", kDaisy + "@5000:6000"});
+  EXPECT_EQ(runFlexarm(bad).code, 2);
+  bad = daisy({"fit", "--model", "oe:2,2,1", "--validation-log", kDaisy + ".missing"});
+  EXPECT_EQ(runFlexarm(bad).code, 3);
+}

@@ -21,6 +21,7 @@
 #include "core/io/log_io.h"
 #include "core/sim/closed_loop.h"
 #include "widget_test_support.h"
+#include "widgets/arm_panel.h"
 #include "widgets/playhead.h"
 #include "widgets/recursive_panel.h"
 #include "widgets/workspace.h"
@@ -142,6 +143,9 @@ class RecursivePanelTest : public QObject {
     QVERIFY2(panel_->statusText().contains("J_a = 1.7"), qPrintable(panel_->statusText()));
     QCOMPARE(panel_->progressBar()->value(), 1000);
     QVERIFY(!panel_->cancelButton()->isEnabled());
+    // The Arm view offers the model at the final estimate as the source of its angles.
+    QVERIFY2(window_->armPanel()->sourceCombo()->currentText().startsWith("recursive estimate"),
+             qPrintable(window_->armPanel()->sourceCombo()->currentText()));
     flexarm::test::saveShot(window_->grab().toImage(), "recursive_panel_finished");
   }
 

@@ -203,7 +203,8 @@ TEST(Fit, DataFailuresAreSentencesAndMisuseThrows) {
   EXPECT_NE(why.find("controller's rate"), std::string::npos) << why;
   EXPECT_THROW(fitModel(o), std::invalid_argument);
   o = physicalFit(log);
-  o.estimation.push_back(o.estimation.front());
+  o.estimation.push_back(o.estimation.front());  // several experiments take the direct fit only
+  o.closedLoop = ClosedLoopChoice::Indirect;
   EXPECT_THROW(fitModel(o), std::invalid_argument);
   o = physicalFit(nullptr);
   EXPECT_FALSE(o.isValid(&why));
