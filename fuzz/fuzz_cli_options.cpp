@@ -29,7 +29,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   (void)parser.integer("max-iterations", n, 0, 100000);
   (void)parser.integer("seed", l);
   if (auto m = parser.value("model")) {
-    ModelSpec spec;
+    flexarm::FitModelSpec spec;
     std::string why;
     (void)parseModelSpec(*m, spec, &why, true);
   }

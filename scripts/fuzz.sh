@@ -3,7 +3,7 @@
 # each for a set time on a corpus seeded from tests/data and sample_logs; prints executions and
 # crashes per target and exits non-zero when any target crashed, leaked or hung.
 #
-#   bash scripts/fuzz.sh [--seconds N] [TARGET...]
+#   bash scripts/fuzz.sh [--seconds N] [--seed N] [TARGET...]
 #
 # TARGET: fuzz_csv fuzz_table fuzz_mat fuzz_session fuzz_cli_options (default: all).
 # The corpus grows in $FUZZ_DIR/corpus/TARGET (default build-fuzz/); crashing inputs are kept
@@ -12,10 +12,12 @@
 set -euo pipefail
 here="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 seconds=60
+fuzz_seed=0  # libFuzzer's: 0 draws one; a fixed one repeats the same mutations (CI)
 targets=()
 while [ $# -gt 0 ]; do
   case "$1" in
     --seconds) seconds="$2"; shift 2 ;;
+    --seed) fuzz_seed="$2"; shift 2 ;;
     -h|--help) sed -n '2,12p' "$0"; exit 0 ;;
     *) targets+=("$1"); shift ;;
   esac
@@ -59,7 +61,7 @@ for t in "${targets[@]}"; do
   touch "$tmp/start"
   FLEXARM_FUZZ_TMP="$tmp" ASAN_OPTIONS="detect_leaks=1:allocator_may_return_null=1" \
     LSAN_OPTIONS="suppressions=$here/tests/sanitizer/lsan.supp" \
-    "$build/fuzz/$t" "$fuzzdir/corpus/$t" -max_total_time="$seconds" \
+    "$build/fuzz/$t" "$fuzzdir/corpus/$t" -max_total_time="$seconds" -seed="$fuzz_seed" \
     -print_final_stats=1 -rss_limit_mb=2048 -timeout=10 -max_len=65536 \
     -artifact_prefix="$fuzzdir/artifacts/$t-" > "$log" 2>&1 || rc=$?
   execs=$( (grep -h "stat::number_of_executed_units" "$log" || true) | awk '{s += $2} END {print s + 0}')

@@ -150,27 +150,7 @@ DiagnosisReference completeReference(const DiagnosisReference& reference,
     ref.noiseVariance = quietestMeanSquare(outputErrors(*ref.nominal, monitored));
   }
   if (ref.p0.size() != n || ref.p0Single.size() != n) {
-    const auto predictor = predictorModel(*ref.nominal, monitored);
-    const auto all = steadyStateCovariance(*predictor, monitored.input, monitored.output,
-                                           monitored.sampleTime,
-                                           estimatorOptions(options, options.parameters));
-    if (all.termination != Termination::Converged) {
-      ref.termination = Termination::Failed;
-      ref.message = "P(0) could not be formed on the monitored log: " + all.message;
-      return ref;
-    }
-    ref.p0.assign(all.p0.data(), all.p0.data() + all.p0.size());
-    ref.p0Single.clear();
-    for (const auto& name : options.parameters) {
-      const auto one = steadyStateCovariance(*predictor, monitored.input, monitored.output,
-                                             monitored.sampleTime, estimatorOptions(options, {name}));
-      if (one.termination != Termination::Converged || one.p0.size() != 1) {
-        ref.termination = Termination::Failed;
-        ref.message = "P(0) for " + name + " could not be formed on the monitored log: " + one.message;
-        return ref;
-      }
-      ref.p0Single.push_back(one.p0(0));
-    }
+    if (!formInitialCovariances(ref, monitored, options, "the monitored log")) return ref;
   }
   ref.sigma0.resize(n, 0.0);
   return ref;

@@ -96,6 +96,31 @@ NominalFit fitNominalModel(const PhysicalModel& start, const DiagnosisSignals& d
   return fit;
 }
 
+bool formInitialCovariances(DiagnosisReference& ref, const DiagnosisSignals& data,
+                            const DiagnosisOptions& options, const std::string& where) {
+  const auto predictor = predictorModel(*ref.nominal, data);
+  const InitialCovariance all = steadyStateCovariance(*predictor, data.input, data.output, data.sampleTime,
+                                                      estimatorOptions(options, options.parameters));
+  if (all.termination != Termination::Converged) {
+    ref.termination = Termination::Failed;
+    ref.message = "P(0) could not be formed on " + where + ": " + all.message;
+    return false;
+  }
+  ref.p0.assign(all.p0.data(), all.p0.data() + all.p0.size());
+  ref.p0Single.clear();
+  for (const auto& name : options.parameters) {
+    const InitialCovariance one = steadyStateCovariance(*predictor, data.input, data.output,
+                                                        data.sampleTime, estimatorOptions(options, {name}));
+    if (one.termination != Termination::Converged || one.p0.size() != 1) {
+      ref.termination = Termination::Failed;
+      ref.message = "P(0) for " + name + " alone could not be formed on " + where + ": " + one.message;
+      return false;
+    }
+    ref.p0Single.push_back(one.p0(0));
+  }
+  return true;
+}
+
 DiagnosisReference referenceFromSignals(const PhysicalModel& start, const DiagnosisSignals& healthy,
                                         const DiagnosisOptions& options,
                                         const ReferenceOptions& referenceOptions,
@@ -164,27 +189,9 @@ DiagnosisReference referenceFromSignals(const PhysicalModel& start, const Diagno
     ref.message = "cancelled";
     return ref;
   }
-  const auto predictor = predictorModel(*ref.nominal, healthy);
-  const InitialCovariance all = steadyStateCovariance(*predictor, healthy.input, healthy.output,
-                                                      healthy.sampleTime,
-                                                      estimatorOptions(options, options.parameters));
-  if (all.termination != Termination::Converged) {
-    ref.termination = Termination::Failed;
-    ref.message = "P(0) could not be formed on the fault-free data: " + all.message;
+  if (!formInitialCovariances(ref, healthy, options, "the fault-free data")) {
     ref.seconds = seconds(begin);
     return ref;
-  }
-  ref.p0.assign(all.p0.data(), all.p0.data() + all.p0.size());
-  for (const auto& name : options.parameters) {
-    const InitialCovariance one = steadyStateCovariance(
-        *predictor, healthy.input, healthy.output, healthy.sampleTime, estimatorOptions(options, {name}));
-    if (one.termination != Termination::Converged || one.p0.size() != 1) {
-      ref.termination = Termination::Failed;
-      ref.message = "P(0) for " + name + " alone could not be formed: " + one.message;
-      ref.seconds = seconds(begin);
-      return ref;
-    }
-    ref.p0Single.push_back(one.p0(0));
   }
   ref.termination = Termination::Converged;
   ref.source = "theta_0 from the output-error fit of " + std::to_string(healthy.size()) +

@@ -103,6 +103,12 @@ DiagnosisReference referenceFromModel(const PhysicalModel& model, const IdData& 
 DiagnosisReference withSeedFault(const DiagnosisReference& reference, const DiagnosisOptions& options,
                                  const std::string& name, double factor);
 
+// P(0) as the seed forms it (Section 6.6.2) on `data`, into ref.p0 (every monitored parameter
+// together) and ref.p0Single (each one alone). False, with ref.termination Failed and a
+// message naming `where`, when a covariance cannot be formed.
+bool formInitialCovariances(DiagnosisReference& ref, const DiagnosisSignals& data,
+                            const DiagnosisOptions& options, const std::string& where);
+
 // Output error of the plant inside the signals' predictor (simulated from the input).
 Eigen::VectorXd outputErrors(const PhysicalModel& model, const DiagnosisSignals& data);
 // The mean square of e over its quietest quarter: the noise level of a log in which a fault

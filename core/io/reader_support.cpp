@@ -118,8 +118,10 @@ std::vector<int> linesOfRows(std::string_view text, std::size_t offset, int firs
   std::vector<int> lines;
   while (cursor.next(line)) {
     if (isBlank(line)) continue;
-    const std::string t = trim(line.substr(0, std::min<std::size_t>(line.size(), 64)));
-    if (!t.empty() && comments.find(t[0]) != std::string_view::npos) continue;
+    // As the readers decide: a comment starts after spaces and tabs only.
+    std::size_t b = 0;
+    while (b < line.size() && (line[b] == ' ' || line[b] == '\t')) ++b;
+    if (b < line.size() && comments.find(line[b]) != std::string_view::npos) continue;
     lines.push_back(firstLine + cursor.number() - 1);
   }
   return lines;

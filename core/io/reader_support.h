@@ -1,6 +1,7 @@
 #pragma once
 // Pieces the log readers share (internal to core/io): failures as ReadError, numbers and
 // fields of a text line, line counting, and the checks of the time column.
+#include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <cstddef>
@@ -113,7 +114,11 @@ bool checkTime(const std::string& path, const std::vector<double>& t, LineOf lin
   std::string problem;
   const long long bad = firstTimeProblem(t, jitter, problem);
   if (bad >= 0) {
-    const std::vector<int> lines = allLines();
+    std::vector<int> lines = allLines();
+    if (lines.size() != t.size()) {  // never expected: sample numbers rather than a wrong pairing
+      lines.resize(t.size());
+      for (std::size_t i = 0; i < lines.size(); ++i) lines[i] = static_cast<int>(std::min<std::size_t>(i + 1, 2147483647u));
+    }
     if (options.keepIrregularTime && keepIrregularTime(t, lines, jitter, data)) return true;
     const auto i = static_cast<std::size_t>(bad);
     if (problem.empty()) problem = notIncreasingProblem(t[i], lineOf(i - 1), t[i - 1]);

@@ -321,6 +321,9 @@ SessionParseResult parseSession(const std::string& text) {
     r.message = "not a readable session: the JSON is damaged at " + placeOf(text, e.byte) +
                 (e.byte >= text.size() ? " (the file ends too early)" : "");
     return r;
+  } catch (const json::exception&) {  // e.g. a number beyond what a double holds
+    r.message = "not a readable session: it holds a number too large to read";
+    return r;
   }
   if (!j.is_object() || !j.contains("format") || j["format"] != kSessionFormat) {
     r.message = "not a FlexArm session (\"format\": \"flexarm-session\" is missing)";
@@ -331,7 +334,9 @@ SessionParseResult parseSession(const std::string& text) {
     return r;
   }
   const int version = j["version"].get<int>();
-  const std::string writer = j.value("written_by", std::string("a newer FlexArm"));
+  const std::string writer = j.contains("written_by") && j["written_by"].is_string()
+                                 ? j["written_by"].get<std::string>()
+                                 : std::string("a newer FlexArm");
   if (version > kSessionVersion) {
     r.message = "this session is in session format " + std::to_string(version) + " (written by " +
                 writer + "); FlexArm " + FLEXARM_VERSION + " reads formats up to " +

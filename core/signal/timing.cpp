@@ -167,7 +167,11 @@ TimingReport analyzeTiming(const std::vector<double>& t, const std::vector<int>&
     if (d <= 1e-6 * nominal) {
       slot[j] = slot[j - 1];
     } else {
-      slot[j] = slot[j - 1] + std::max(1L, std::lround(d / nominal));
+      // Slots stay below 2^53 (exact in a double): a stamp absurdly far ahead saturates
+      // rather than overflowing; such a gap is refused downstream anyway.
+      constexpr long kMaxSlot = 1L << 53;
+      const long step = std::max(1L, std::lround(std::min(d / nominal, static_cast<double>(kMaxSlot))));
+      slot[j] = std::min(slot[j - 1] + step, kMaxSlot);
       firsts.push_back(j);
     }
   }

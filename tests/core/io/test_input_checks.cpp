@@ -147,3 +147,28 @@ TEST(InputChecks, WritingRefusesDevicesAndKeepsTheOldFileOnFailure) {
   EXPECT_EQ(bytesOf(target).size(), 10000u);
   fs::remove_all(dir);
 }
+
+// Found by fuzz_table: comment lines ('%' followed by bytes that are no text) between rows of a
+// table whose time column is irregular. The time-stamp report must pair each stamp with its
+// line; it threw because it counted those lines differently from the reader.
+TEST(InputChecks, IrregularTimeAmongCommentLinesIsRefusedWithASentence) {
+  std::ifstream in(data("fuzz/table_comment_lines_irregular_time.bin"), std::ios::binary);
+  const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  ASSERT_GT(bytes.size(), 1u);
+  LogReadOptions o;  // as the fuzz target maps the first byte
+  o.timeColumn = static_cast<unsigned char>(bytes[0]) % 3;
+  o.inputColumn = o.timeColumn == 1 ? 2 : 1;
+  o.outputColumn = o.timeColumn == 2 || o.timeColumn == 1 ? 3 : 2;
+  LogReadResult r;
+  ASSERT_NO_THROW(r = readTableText(std::string_view(bytes).substr(1), "fuzz.dat", o));
+  if (!r.ok) {
+    EXPECT_FALSE(r.error.problem.empty());
+  } else {
+    EXPECT_TRUE(r.data.isValid());
+  }
+  o.keepIrregularTime = true;
+  ASSERT_NO_THROW(r = readTableText(std::string_view(bytes).substr(1), "fuzz.dat", o));
+  if (r.ok) {
+    EXPECT_EQ(r.data.sourceLines.size(), r.data.timeStamps.size());
+  }
+}

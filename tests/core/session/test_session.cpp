@@ -149,6 +149,18 @@ TEST(Session, DamagedFilesAreRefusedWithThePlace) {
   EXPECT_NE(noSum.message.find("sha256"), std::string::npos) << noSum.message;
 
   EXPECT_FALSE(parseSession("{\"hello\": 1}").ok);
+
+  // A number beyond a double (found by fuzz_session) is a refusal, not an exception.
+  SessionParseResult huge;
+  ASSERT_NO_THROW(huge = parseSession("{\"format\": 2e66666666662666666666666}"));
+  EXPECT_FALSE(huge.ok);
+  EXPECT_NE(huge.message.find("too large"), std::string::npos) << huge.message;
+  // A writer that is no text (found by fuzz_session) does not stop the version message.
+  SessionParseResult odd;
+  ASSERT_NO_THROW(odd = parseSession(
+                      "{\"format\": \"flexarm-session\", \"version\": 99, \"written_by\": {}}"));
+  EXPECT_FALSE(odd.ok);
+  EXPECT_NE(odd.message.find("99"), std::string::npos) << odd.message;
 }
 
 TEST(Session, NewerVersionIsRefusedNamingBothVersions) {
