@@ -71,9 +71,12 @@ int main() {
       return 1;
     }
     const double bytes = static_cast<double>(std::filesystem::file_size(csv[i]));
-    row.size = megabytes(bytes) + ", " + std::to_string(res.data.samples() / 1000) + "k x 4";
+    const double mbPerSecond = bytes / 1e6 / row.flexarmSeconds;
+    char rate[64];
+    std::snprintf(rate, sizeof rate, ", FlexArm %.0f MB/s", mbPerSecond);
+    row.size = megabytes(bytes) + ", " + std::to_string(res.data.samples() / 1000) + "k x 4" + rate;
     row.extra["bytes"] = bytes;
-    row.extra["flexarm_mb_s"] = bytes / 1e6 / row.flexarmSeconds;
+    row.extra["flexarm_mb_s"] = mbPerSecond;
     row.peer = "pandas.read_csv";
     const Json p = peerResult(peer, "csv" + std::to_string(i));
     if (!p.is_null()) {

@@ -7,7 +7,9 @@
 
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 #include <filesystem>
+#include <fstream>
 #include <limits>
 #include <vector>
 
@@ -158,5 +160,95 @@ TEST(MatRead, NonFiniteElementsMatricesAndTextAreRefusedByName) {
   ASSERT_TRUE(r.ok) << r.error.toString();
   EXPECT_EQ(r.data.channels.size(), 2u);
   EXPECT_EQ(r.data.output()->values, y);
+  fs::remove_all(tempDir());
+}
+
+// MATLAB stores a double array whose values fit a smaller integer type in that type; the
+// reader converts every stored type to the variable's class.
+TEST(MatRead, DoublesStoredAsSmallerTypesReadAsTheirValues) {
+  const fs::path p = tempDir() / "stored.mat";
+  const std::size_t n = 300;
+  std::vector<std::uint8_t> t8(n);
+  std::vector<std::int16_t> u16(n);
+  std::vector<float> yf(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    t8[i] = static_cast<std::uint8_t>(i % 256);
+    u16[i] = static_cast<std::int16_t>(static_cast<int>(i) * 100 - 15000);
+    yf[i] = 0.1f * static_cast<float>(i);
+  }
+  for (auto compression : {MAT_COMPRESSION_NONE, MAT_COMPRESSION_ZLIB}) {
+    mat_t* mat = Mat_CreateVer(p.string().c_str(), nullptr, MAT_FT_MAT5);
+    ASSERT_NE(mat, nullptr);
+    std::size_t dims[2] = {n, 1};
+    const auto put = [&](const char* name, matio_types type, void* data) {
+      matvar_t* var = Mat_VarCreate(name, MAT_C_DOUBLE, type, 2, dims, data, 0);
+      ASSERT_NE(var, nullptr);
+      EXPECT_EQ(Mat_VarWrite(mat, var, compression), 0);
+      Mat_VarFree(var);
+    };
+    put("u", MAT_T_INT16, u16.data());
+    put("y", MAT_T_SINGLE, yf.data());
+    put("k", MAT_T_UINT8, t8.data());
+    Mat_Close(mat);
+    const LogReadResult r = readLog(p.string());
+    ASSERT_TRUE(r.ok) << r.error.toString();
+    ASSERT_EQ(r.data.samples(), n);
+    EXPECT_EQ(r.data.channel("u")->values[0], -15000.0);
+    EXPECT_EQ(r.data.channel("u")->values[299], 14900.0);
+    EXPECT_EQ(r.data.channel("y")->values[7], static_cast<double>(0.7f));
+    ASSERT_TRUE(r.data.channel("k"));
+    EXPECT_EQ(r.data.channel("k")->values[257], 1.0);
+  }
+  fs::remove_all(tempDir());
+}
+
+// A level-5 file written on a big-endian machine (built here byte by byte: header 'MI', then
+// the miMATRIX elements of u and y) reads as the same numbers.
+TEST(MatRead, BigEndianLevel5FileReadsTheSameNumbers) {
+  std::string file(128, ' ');
+  file[124] = 1;  // version 0x0100, most significant byte first
+  file[125] = 0;
+  file[126] = 'M';
+  file[127] = 'I';
+  const auto u32 = [](std::string& s, std::uint32_t v) {
+    for (int b = 3; b >= 0; --b) s.push_back(static_cast<char>((v >> (8 * b)) & 0xff));
+  };
+  const auto variable = [&](const std::string& name, const std::vector<double>& values) {
+    std::string body;
+    u32(body, 6);  // miUINT32 array flags: class double
+    u32(body, 8);
+    u32(body, 6);
+    u32(body, 0);
+    u32(body, 5);  // miINT32 dimensions: n x 1
+    u32(body, 8);
+    u32(body, static_cast<std::uint32_t>(values.size()));
+    u32(body, 1);
+    u32(body, 1);  // miINT8 name, padded to 8 bytes
+    u32(body, static_cast<std::uint32_t>(name.size()));
+    body += name;
+    body.append((8 - name.size() % 8) % 8, '\0');
+    u32(body, 9);  // miDOUBLE data
+    u32(body, static_cast<std::uint32_t>(8 * values.size()));
+    for (double v : values) {
+      std::uint64_t bits;
+      std::memcpy(&bits, &v, 8);
+      u32(body, static_cast<std::uint32_t>(bits >> 32));
+      u32(body, static_cast<std::uint32_t>(bits & 0xffffffffu));
+    }
+    u32(file, 14);  // miMATRIX
+    u32(file, static_cast<std::uint32_t>(body.size()));
+    file += body;
+  };
+  variable("u", {1.5, -2.25, 3e-7, 4.0});
+  variable("y", {0.1, 0.2, 0.3, 1e300});
+  const fs::path p = tempDir() / "big_endian.mat";
+  {
+    std::ofstream out(p, std::ios::binary);
+    out << file;
+  }
+  const LogReadResult r = readLog(p.string());
+  ASSERT_TRUE(r.ok) << r.error.toString();
+  EXPECT_EQ(r.data.channel("u")->values, (std::vector<double>{1.5, -2.25, 3e-7, 4.0}));
+  EXPECT_EQ(r.data.channel("y")->values, (std::vector<double>{0.1, 0.2, 0.3, 1e300}));
   fs::remove_all(tempDir());
 }
