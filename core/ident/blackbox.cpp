@@ -1,6 +1,7 @@
 #include "core/ident/blackbox.h"
 
 #include "core/ident/levenberg_marquardt.h"
+#include "core/ident/poly_predictor.h"
 
 #include <algorithm>
 #include <chrono>
@@ -55,7 +56,8 @@ constexpr double kMaxIterativeWork = 2e9;
 
 // First sample at which every regressor holds data: the prediction-error criterion starts here.
 int criterionStart(const PolyOrders& o) {
-  return std::max({o.na, o.nb + o.nk - 1, o.nc, o.nd, o.nf});
+  return static_cast<int>(
+      PolyPredictor::criterionStart(o, std::numeric_limits<Eigen::Index>::max()));
 }
 }  // namespace
 
@@ -235,83 +237,6 @@ Eigen::MatrixXd regressors(const std::vector<Block>& blocks, Eigen::Index first,
 }
 
 
-bool isOne(const Poly& p) { return p.size() == 1 && p[0] == 1.0; }
-
-// Column `col` of psi = sign * x delayed by k samples (zeros shifted in).
-void setDelayed(Eigen::MatrixXd& psi, int col, const Eigen::VectorXd& x, int k, double sign) {
-  const Eigen::Index n = x.size(), len = std::max<Eigen::Index>(0, n - k);
-  psi.col(col).head(n - len).setZero();
-  psi.col(col).tail(len) = sign * x.head(len);
-}
-
-// The signals of the last evaluation without psi, so that the evaluation with psi at the
-// same parameters (the accepted step of the search) does not filter them again.
-struct ErrorCache {
-  Eigen::VectorXd theta, w, v, eps;  // eps before its first samples are zeroed
-};
-
-// psi (4.20) = -d eps / d theta for the general structure (4.8), obtained by filtering.
-void errorsAndPsi(const PolynomialModel& m, const Eigen::VectorXd& u, const Eigen::VectorXd& y,
-                  Eigen::VectorXd& eps, Eigen::MatrixXd* psi, bool skipStart = true,
-                  ErrorCache* cache = nullptr) {
-  const Poly one{1.0};
-  const auto& o = m.orders;
-  const bool white = isOne(m.c) && isOne(m.d);  // OE and ARX: no noise filter
-  Eigen::VectorXd w, v;
-  const Eigen::VectorXd theta = cache ? m.parameterVector() : Eigen::VectorXd();
-  if (cache && psi && cache->theta.size() == theta.size() && cache->theta == theta) {
-    w.swap(cache->w);
-    v.swap(cache->v);
-    eps.swap(cache->eps);
-    cache->theta.resize(0);
-  } else {
-    w = filter(m.b, m.f, u);
-    v = o.na ? filter(m.a, one, y) : y;
-    v -= w;
-    eps = white ? v : filter(m.d, m.c, v);
-    if (cache && !psi) {
-      cache->theta = theta;
-      cache->w = w;
-      cache->v = v;
-      cache->eps = eps;
-    }
-  }
-  // The criterion starts once every regressor holds data (as ARX does): the zero initial
-  // conditions would otherwise dominate the loss of a nearly noise-free system.
-  const Eigen::Index n0 =
-      skipStart ? std::min<Eigen::Index>(criterionStart(o), y.size()) : 0;
-  if (!psi) {
-    eps.head(n0).setZero();
-    return;
-  }
-  const Poly cf = polyMultiply(m.c, m.f);
-  psi->resize(y.size(), o.parameters());
-  int col = 0;
-  if (o.na) {
-    const Eigen::VectorXd yf = white ? y : filter(m.d, m.c, y);
-    for (int k = 1; k <= o.na; ++k) setDelayed(*psi, col++, yf, k, -1.0);
-  }
-  // B and F parts filter u and w through the same D/(C F).
-  Eigen::VectorXd uf, wf;
-  if (o.nf)
-    filter(m.d, cf, u, w, uf, wf);
-  else
-    uf = filter(m.d, cf, u);
-  for (int j = 0; j < o.nb; ++j) setDelayed(*psi, col++, uf, o.nk + j, 1.0);
-  if (o.nc) {
-    // eps before its first samples are left out of the criterion.
-    const Eigen::VectorXd ef = filter(one, m.c, eps);
-    for (int k = 1; k <= o.nc; ++k) setDelayed(*psi, col++, ef, k, 1.0);
-  }
-  if (o.nd) {
-    const Eigen::VectorXd vf = filter(one, m.c, v);
-    for (int k = 1; k <= o.nd; ++k) setDelayed(*psi, col++, vf, k, -1.0);
-  }
-  for (int k = 1; k <= o.nf; ++k) setDelayed(*psi, col++, wf, k, -1.0);
-  eps.head(n0).setZero();
-  psi->topRows(n0).setZero();
-}
-
 bool stabilize(PolynomialModel& m) {
   bool changed = false;
   changed |= reflectIntoUnitCircle(m.c);
@@ -410,10 +335,8 @@ PolynomialModel initialModel(const Eigen::VectorXd& u, const Eigen::VectorXd& y,
     if (a0.summary.ok()) {
       plain.a = a0.model.a;
       plain.b = a0.model.b;
-      Eigen::VectorXd em, ep;
-      errorsAndPsi(m, u, y, em, nullptr);
-      errorsAndPsi(plain, u, y, ep, nullptr);
-      const double lm = em.squaredNorm(), lp = ep.squaredNorm();
+      PolyPredictor predictor(u, y, o);
+      const double lm = predictor.run(m), lp = predictor.run(plain);
       if (!(lm <= lp)) return plain;
     }
     return m;
@@ -445,9 +368,7 @@ PolynomialModel initialModel(const Eigen::VectorXd& u, const Eigen::VectorXd& y,
 Eigen::VectorXd predictionErrors(const PolynomialModel& m, const Eigen::VectorXd& u,
                                  const Eigen::VectorXd& y) {
   checkData(u, y);
-  Eigen::VectorXd eps;
-  errorsAndPsi(m, u, y, eps, nullptr, false);
-  return eps;
+  return PolyPredictor(u, y, m.orders).errors(m);
 }
 
 PolyEstimate arx(const Eigen::VectorXd& u, const Eigen::VectorXd& y, int na, int nb, int nk,
@@ -539,28 +460,45 @@ PolyEstimate refinePolynomial(const Eigen::VectorXd& u, const Eigen::VectorXd& y
   }
   const std::vector<Segment> segments = segmentsOf(options.experimentLengths, n);
   PolynomialModel work = initial;
-  std::vector<ErrorCache> caches(segments.size());
-  // Several experiments: each one's errors weighted by sqrt(lambda / lambda_k) once a first fit
-  // has estimated its noise variance (empty: unweighted), as pem does.
+  // One predictor per experiment, each run from zero initial conditions at its own first
+  // sample over its own criterion samples; the records outlive the predictors.
+  std::vector<Eigen::VectorXd> us, ys;
+  us.reserve(segments.size());
+  ys.reserve(segments.size());
+  std::vector<PolyPredictor> predictors;
+  predictors.reserve(segments.size());
+  Eigen::Index used = 0;  // the rows in the criterion
+  for (const auto& g : segments) {
+    us.push_back(u.segment(g.from, g.n));
+    ys.push_back(y.segment(g.from, g.n));
+    predictors.emplace_back(us.back(), ys.back(), initial.orders);
+    used += std::max<Eigen::Index>(0, g.n - predictors.back().criterionStart());
+  }
+  // Several experiments: each one's squared errors weighted by lambda / lambda_k once a first
+  // fit has estimated its noise variance (empty: unweighted), as pem does.
   std::vector<double> weights;
   LeastSquaresProblem problem;
-  problem.evaluate = [&](const Eigen::VectorXd& th, Eigen::VectorXd& eps, Eigen::MatrixXd* psi) {
+  problem.samples = n;
+  problem.normalEquations = [&](const Eigen::VectorXd& th, double bound, double& sumSquares,
+                                Eigen::MatrixXd* R, Eigen::VectorXd* g) {
     work.setParameterVector(th);
-    if (segments.size() == 1) {
-      errorsAndPsi(work, u, y, eps, psi, true, &caches.front());
+    if (predictors.size() == 1) {
+      sumSquares = predictors.front().run(work, R, g, bound);
       return true;
     }
-    // Each experiment filtered from zero initial conditions at its own first sample.
-    eps.resize(n);
-    if (psi) psi->resize(n, p);
-    for (std::size_t k = 0; k < segments.size(); ++k) {
-      const Segment& g = segments[k];
-      Eigen::VectorXd e;
-      Eigen::MatrixXd ps;
-      errorsAndPsi(work, u.segment(g.from, g.n), y.segment(g.from, g.n), e, psi ? &ps : nullptr, true, &caches[k]);
+    sumSquares = 0.0;
+    if (R) R->setZero(p, p);
+    if (g) g->setZero(p);
+    Eigen::MatrixXd Rk;
+    Eigen::VectorXd gk;
+    for (std::size_t k = 0; k < predictors.size(); ++k) {
       const double w = weights.empty() ? 1.0 : weights[k];
-      eps.segment(g.from, g.n) = w * e;
-      if (psi) psi->middleRows(g.from, g.n) = w * ps;
+      const double sk = predictors[k].run(work, R ? &Rk : nullptr, g ? &gk : nullptr,
+                                          (bound - sumSquares) / w);
+      sumSquares += w * sk;
+      if (sumSquares > bound) return true;  // rejected anyway; R and g are not used
+      if (R) *R += w * Rk;
+      if (g) *g += w * gk;
     }
     return true;
   };
@@ -572,19 +510,20 @@ PolyEstimate refinePolynomial(const Eigen::VectorXd& u, const Eigen::VectorXd& y
   LeastSquaresSolution sol = levenbergMarquardt(problem, initial.parameterVector(),
                                                 options.maxIterations, options.relativeTolerance,
                                                 options.initialDamping, progress);
-  const Eigen::Index skip = criterionStart(initial.orders);
-  if (segments.size() > 1 && sol.summary.termination != Termination::Failed &&
+  if (predictors.size() > 1 && sol.summary.termination != Termination::Failed &&
       sol.summary.termination != Termination::Cancelled) {
     // Each experiment's noise variance from the first fit, then the weighted fit from there.
-    Eigen::Index all = 0;
-    for (const auto& g : segments) all += g.n - std::min<Eigen::Index>(skip, g.n);
-    const double pooled = sol.eps.squaredNorm() / static_cast<double>(std::max<Eigen::Index>(1, all));
-    for (const auto& g : segments) {
-      const Eigen::Index k = g.n - std::min<Eigen::Index>(skip, g.n);
-      const double own = sol.eps.segment(g.from, g.n).squaredNorm() / static_cast<double>(std::max<Eigen::Index>(1, k));
-      weights.push_back(own > 0.0 && pooled > 0.0 ? std::sqrt(pooled / own) : 1.0);
+    work.setParameterVector(sol.phi);
+    std::vector<double> own(predictors.size());
+    double total = 0.0;
+    for (std::size_t k = 0; k < predictors.size(); ++k) {
+      const double sk = predictors[k].run(work);
+      total += sk;
+      const Eigen::Index rows = segments[k].n - predictors[k].criterionStart();
+      own[k] = sk / static_cast<double>(std::max<Eigen::Index>(1, rows));
     }
-    for (auto& c : caches) c.theta.resize(0);
+    const double pooled = total / static_cast<double>(std::max<Eigen::Index>(1, used));
+    for (double o : own) weights.push_back(o > 0.0 && pooled > 0.0 ? pooled / o : 1.0);
     LeastSquaresSolution weighted = levenbergMarquardt(problem, sol.phi, options.maxIterations,
                                                        options.relativeTolerance, options.initialDamping);
     if (weighted.summary.termination != Termination::Failed) {
@@ -595,18 +534,8 @@ PolyEstimate refinePolynomial(const Eigen::VectorXd& u, const Eigen::VectorXd& y
   s = sol.summary;
   if (s.termination == Termination::Failed) return r;
   r.model.setParameterVector(sol.phi);
-  // The rows in the criterion: each experiment's from criterionStart on.
-  Eigen::Index used = 0;
-  for (const auto& g : segments) used += g.n - std::min<Eigen::Index>(skip, g.n);
-  Eigen::MatrixXd psiUsed(used, sol.psi.cols());
-  Eigen::Index at = 0;
-  for (const auto& g : segments) {
-    const Eigen::Index k = g.n - std::min<Eigen::Index>(skip, g.n);
-    psiUsed.middleRows(at, k) = sol.psi.middleRows(g.from + g.n - k, k);
-    at += k;
-  }
   r.model.noiseVariance = sol.sumSquares / static_cast<double>(used - p);
-  r.model.covariance = gaussNewtonCovariance(psiUsed, sol.sumSquares);
+  r.model.covariance = gaussNewtonCovariance(sol.R, used, sol.sumSquares);
   if (r.model.covariance.size() == 0)
     s.message += "; the Hessian is singular, so no covariance (the model is over-parameterized)";
   fillStatistics(s, sol.sumSquares, used, p);

@@ -16,9 +16,13 @@ void fillStatistics(EstimateSummary& s, double sumSq, Eigen::Index n, int p) {
 }
 
 Eigen::MatrixXd gaussNewtonCovariance(const Eigen::MatrixXd& psi, double sumSquares) {
-  const Eigen::Index n = psi.rows(), p = psi.cols();
+  if (psi.rows() <= psi.cols() || psi.cols() == 0) return {};
+  return gaussNewtonCovariance(Eigen::MatrixXd(psi.transpose() * psi), psi.rows(), sumSquares);
+}
+
+Eigen::MatrixXd gaussNewtonCovariance(const Eigen::MatrixXd& R, Eigen::Index n, double sumSquares) {
+  const Eigen::Index p = R.cols();
   if (n <= p || p == 0) return {};
-  const Eigen::MatrixXd R = psi.transpose() * psi;
   Eigen::LDLT<Eigen::MatrixXd> ldlt(R);
   if (ldlt.info() != Eigen::Success || !(ldlt.vectorD().array() > 1e-14 * R.diagonal().maxCoeff()).all())
     return {};
@@ -135,52 +139,71 @@ LeastSquaresSolution levenbergMarquardt(const LeastSquaresProblem& problem,
   auto& s = r.summary;
   r.phi = phi0;
   if (problem.project) problem.project(r.phi);
-  if (!problem.evaluate(r.phi, r.eps, &r.psi) || !r.eps.allFinite() || !r.psi.allFinite()) {
+  const bool normal = static_cast<bool>(problem.normalEquations);
+  // N times (4.21) and -N times (4.19) at r.phi from psi. Few parameters: one dot product per
+  // entry, which for tall, narrow psi beats the blocked matrix product.
+  Eigen::VectorXd g;
+  const auto reduce = [&] {
+    if (r.psi.cols() <= 16) {
+      r.R.noalias() = r.psi.transpose().lazyProduct(r.psi);
+      g.noalias() = r.psi.transpose().lazyProduct(r.eps);
+    } else {
+      r.R.noalias() = r.psi.transpose() * r.psi;
+      g.noalias() = r.psi.transpose() * r.eps;
+    }
+  };
+  const bool admissible =
+      normal ? problem.normalEquations(r.phi, INFINITY, r.sumSquares, &r.R, &g) &&
+                   std::isfinite(r.sumSquares) && r.R.allFinite() && g.allFinite()
+             : problem.evaluate(r.phi, r.eps, &r.psi) && r.eps.allFinite() && r.psi.allFinite();
+  if (!admissible) {
     s.termination = Termination::Failed;
     s.message = "the initial parameters give an unstable predictor or non-finite errors";
     return r;
   }
-  r.sumSquares = r.eps.squaredNorm();
-  const double n = static_cast<double>(r.eps.size());
+  if (!normal) r.sumSquares = r.eps.squaredNorm();
+  const double n = static_cast<double>(normal ? problem.samples : r.eps.size());
   s.lossHistory.push_back(r.sumSquares / n);
   double mu = damping;
   s.termination = Termination::MaxIterations;
   s.message = "reached the maximum number of iterations";
+  Eigen::VectorXd trialPhi, trialEps, trialG;
+  Eigen::MatrixXd trialR, Rl;
   for (int it = 0; it < maxIterations; ++it) {
     if (reportProgress(progress, static_cast<double>(it) / maxIterations, "iterating")) {
       s.termination = Termination::Cancelled;
       s.message = "cancelled by the user";
       break;
     }
-    // N times (4.21) and -N times (4.19). Few parameters: one dot product per entry, which
-    // for tall, narrow psi beats the blocked matrix product.
-    Eigen::MatrixXd R;
-    Eigen::VectorXd g;
-    if (r.psi.cols() <= 16) {
-      R.noalias() = r.psi.transpose().lazyProduct(r.psi);
-      g.noalias() = r.psi.transpose().lazyProduct(r.eps);
-    } else {
-      R.noalias() = r.psi.transpose() * r.psi;
-      g.noalias() = r.psi.transpose() * r.eps;
-    }
-    const double dmax = std::max(1e-300, R.diagonal().maxCoeff());
-    const Eigen::VectorXd scale = R.diagonal().cwiseMax(1e-12 * dmax);
-    bool accepted = false;
+    if (!normal) reduce();
+    const double dmax = std::max(1e-300, r.R.diagonal().maxCoeff());
+    const Eigen::VectorXd scale = r.R.diagonal().cwiseMax(1e-12 * dmax);
+    bool accepted = false, first = true;
     double newSum = r.sumSquares;
-    Eigen::VectorXd trialPhi, trialEps;
     while (mu < 1e12) {
-      Eigen::MatrixXd Rl = R;
+      Rl = r.R;
       Rl.diagonal() += mu * scale;
       trialPhi = r.phi + Rl.ldlt().solve(g);
       if (problem.project) problem.project(trialPhi);
-      if (problem.evaluate(trialPhi, trialEps, nullptr)) {
-        const double ss = trialEps.squaredNorm();
-        if (std::isfinite(ss) && ss < r.sumSquares) {
-          newSum = ss;
-          accepted = true;
-          mu = std::max(mu / 10.0, 1e-12);
-          break;
-        }
+      double ss = INFINITY;
+      if (normal) {
+        // The first trial of an iteration, usually accepted, brings R and g with its loss; a
+        // retry brings its loss alone, and R and g once it is accepted. Any trial may stop as
+        // soon as its loss exceeds the current one.
+        bool ok = problem.normalEquations(trialPhi, r.sumSquares, ss, first ? &trialR : nullptr,
+                                          first ? &trialG : nullptr);
+        if (ok && !first && ss < r.sumSquares)
+          ok = problem.normalEquations(trialPhi, INFINITY, ss, &trialR, &trialG);
+        if (!ok || !trialR.allFinite() || !trialG.allFinite()) ss = INFINITY;
+      } else if (problem.evaluate(trialPhi, trialEps, nullptr)) {
+        ss = trialEps.squaredNorm();
+      }
+      first = false;
+      if (std::isfinite(ss) && ss < r.sumSquares) {
+        newSum = ss;
+        accepted = true;
+        mu = std::max(mu / 10.0, 1e-12);
+        break;
       }
       mu *= 10.0;
     }
@@ -193,7 +216,12 @@ LeastSquaresSolution levenbergMarquardt(const LeastSquaresProblem& problem,
     const double rel = (r.sumSquares - newSum) / r.sumSquares;
     r.phi = trialPhi;
     r.sumSquares = newSum;
-    problem.evaluate(r.phi, r.eps, &r.psi);
+    if (normal) {
+      r.R.swap(trialR);
+      g.swap(trialG);
+    } else {
+      problem.evaluate(r.phi, r.eps, &r.psi);
+    }
     s.lossHistory.push_back(r.sumSquares / n);
     if (rel < relTol) {
       s.termination = Termination::Converged;
@@ -201,6 +229,7 @@ LeastSquaresSolution levenbergMarquardt(const LeastSquaresProblem& problem,
       break;
     }
   }
+  if (!normal) r.R.resize(0, 0);
   return r;
 }
 

@@ -17,11 +17,22 @@ struct LeastSquaresProblem {
       evaluate;
   // Maps a trial point into the admissible set (bounds, reflected roots); may be empty.
   std::function<void(Eigen::VectorXd& phi)> project;
+  // Optional, used instead of evaluate when set: the sum of squared errors at phi and, when R
+  // and g are non-null, the normal equations R = psi^T psi (N times (4.21)) and g = psi^T eps
+  // (-N times (4.19)), for problems that reduce psi as they form it (psi is then never
+  // stored). The evaluation may stop as soon as the sum exceeds `bound` and return that
+  // partial sum (R and g are then not set): such a step is rejected anyway. Returns false
+  // when phi is not admissible.
+  std::function<bool(const Eigen::VectorXd& phi, double bound, double& sumSquares,
+                     Eigen::MatrixXd* R, Eigen::VectorXd* g)>
+      normalEquations;
+  Eigen::Index samples = 0;  // N, the number of errors, when normalEquations is used
 };
 
 struct LeastSquaresSolution {
   Eigen::VectorXd phi, eps;
-  Eigen::MatrixXd psi;  // at phi
+  Eigen::MatrixXd psi;  // at phi; eps and psi stay empty when the problem gives normalEquations
+  Eigen::MatrixXd R;    // psi^T psi at phi, with normalEquations only
   double sumSquares = 0.0;
   EstimateSummary summary;  // termination, message, iterations, lossHistory (mean squares)
 };
@@ -34,6 +45,8 @@ LeastSquaresSolution levenbergMarquardt(const LeastSquaresProblem& problem,
 
 // Covariance lambda (psi^T psi)^{-1} with lambda = sumSquares / (N - p); empty when singular.
 Eigen::MatrixXd gaussNewtonCovariance(const Eigen::MatrixXd& psi, double sumSquares);
+// The same from R = psi^T psi of N rows.
+Eigen::MatrixXd gaussNewtonCovariance(const Eigen::MatrixXd& R, Eigen::Index n, double sumSquares);
 
 // Long-run covariance Q = Var(sum_i psi_i^T eps_i) of sums of regressors (columns of psi_i,
 // treated as given) times stationary, possibly coloured and mutually correlated errors eps_i:

@@ -8,6 +8,7 @@
 #include <stdexcept>
 
 #include "core/common/fft.h"
+#include "core/common/simd.h"
 
 namespace flexarm {
 
@@ -35,9 +36,40 @@ bool positiveOmega(const std::vector<double>& omega, std::string* why) {
 
 using Clock = std::chrono::steady_clock;
 
-// DFT X(k) = sum_t x(t) e^{-i 2 pi k t / N}, k = 0..N/2 (scaling cancels in the ratios).
-std::vector<std::complex<double>> rfft(const Eigen::VectorXd& x) {
-  return realDft(x.data(), static_cast<int>(x.size()));
+// out[k] = sum_{j < taps} w[j] p[k + j] for k < n, each sum in the order of j: the smoothing
+// (4.25) of a whole spectrum at once (p holds taps - 1 more values than out), eight bins at a
+// time in the lanes of vectors V. out may be p itself: a value is overwritten only after the
+// last sum that reads it.
+template <class V>
+inline __attribute__((always_inline)) void correlate(const double* p, const double* w, int taps,
+                                                     double* out, int n) {
+  constexpr int L = simd::kLanes<V>, Q = 8 / L;
+  int k = 0;
+  for (; k + 8 <= n; k += 8) {
+    V acc[Q];
+    for (int q = 0; q < Q; ++q) acc[q] = V{};
+    for (int j = 0; j < taps; ++j)
+      for (int q = 0; q < Q; ++q) {
+        V x;
+        simd::load(x, p + k + j + q * L);
+        acc[q] += w[j] * x;
+      }
+    for (int q = 0; q < Q; ++q) simd::store(out + k + q * L, acc[q]);
+  }
+  for (; k < n; ++k) {
+    double s = 0.0;
+    for (int j = 0; j < taps; ++j) s += w[j] * p[k + j];
+    out[k] = s;
+  }
+}
+
+FLEXARM_AVX2 void correlateAvx2(const double* p, const double* w, int taps, double* out, int n) {
+  correlate<simd::Lanes4>(p, w, taps, out, n);
+}
+
+void correlate(const double* p, const double* w, int taps, double* out, int n) {
+  if (simd::hasAvx2()) return correlateAvx2(p, w, taps, out, n);
+  correlate<simd::Lanes2>(p, w, taps, out, n);
 }
 
 bool checkSignals(const Eigen::VectorXd& u, const Eigen::VectorXd& y, double ts,
@@ -98,57 +130,80 @@ NonparametricEstimate etfe(const Eigen::VectorXd& u, const Eigen::VectorXd& y, d
   const auto t0 = Clock::now();
   NonparametricEstimate r;
   if (!checkSignals(u, y, ts, r, 8)) return r;
-  const auto U = rfft(u), Y = rfft(y);
   const int n = static_cast<int>(u.size());
+  // DFTs of u and y (4.24); their scaling cancels in the ratios.
+  std::vector<std::complex<double>> U(static_cast<std::size_t>(n / 2 + 1)), Y(U.size());
+  realDft(u.data(), n, U.data());
+  realDft(y.data(), n, Y.data());
   const int nb = n / 2;
   const double dw = 2.0 * M_PI / (n * ts);
-  std::vector<double> omega = options.omega;
-  if (omega.empty())
-    for (int k = 1; k <= nb; ++k) omega.push_back(k * dw);
-  const double width = std::max(1, options.smoothingWidth);
-  r.window = std::max(1, options.smoothingWidth);
-  // The Hann weights at whole-bin offsets, for frequencies on the DFT grid (the default).
-  const int half = static_cast<int>(std::ceil(width));
-  std::vector<double> gridWeight(2 * half + 1);
-  for (int j = -half; j <= half; ++j) {
-    const double x = j / width;
-    gridWeight[j + half] = std::abs(x) >= 1.0 ? 0.0 : 0.5 * (1.0 + std::cos(M_PI * x));
+  const int width = std::max(1, options.smoothingWidth);
+  r.window = width;
+  // The cross spectrum Y conj(U) and |U|^2 per bin (written out: std::complex's product
+  // checks for infinities on every call), with `pad` zeros at both ends.
+  const int pad = width - 1;
+  std::vector<double> cross(static_cast<std::size_t>(nb + 1 + 2 * pad), 0.0),
+      crossIm(cross.size(), 0.0), power(cross.size(), 0.0);
+  for (int k = 0; k <= nb; ++k) {
+    const double ur = U[k].real(), ui = U[k].imag(), yr = Y[k].real(), yi = Y[k].imag();
+    cross[k + pad] = yr * ur + yi * ui;
+    crossIm[k + pad] = yi * ur - yr * ui;
+    power[k + pad] = ur * ur + ui * ui;
   }
-  for (double w : omega) {
-    const double kc = w / dw;  // fractional bin
-    std::complex<double> num = 0.0;
-    double den = 0.0;
-    if (width <= 1.0) {
-      const int k = std::min(nb, std::max(0, static_cast<int>(std::lround(kc))));
-      num = Y[k] * std::conj(U[k]);
-      den = std::norm(U[k]);
-    } else {
-      // Hann window over frequency (4.25), half-width `width` bins, weighted by |U|^2.
-      const int lo = std::max(0, static_cast<int>(std::floor(kc - width)));
-      const int hi = std::min(nb, static_cast<int>(std::ceil(kc + width)));
-      const bool onGrid = std::abs(kc - std::round(kc)) < 1e-9;
-      const int kr = static_cast<int>(std::lround(kc));
-      for (int k = lo; k <= hi; ++k) {
-        const double x = (k - kc) / width;
-        if (std::abs(x) >= 1.0) continue;
-        const double a = onGrid && std::abs(k - kr) <= half ? gridWeight[k - kr + half]
-                                                            : 0.5 * (1.0 + std::cos(M_PI * x));
-        // Y conj(U) written out: std::complex's product checks for infinities on every call.
-        const double ur = U[k].real(), ui = U[k].imag(), yr = Y[k].real(), yi = Y[k].imag();
-        num += std::complex<double>(a * (yr * ur + yi * ui), a * (yi * ur - yr * ui));
-        den += a * (ur * ur + ui * ui);
-      }
+  const auto ratio = [](double re, double im, double den) {
+    return den > 0.0 ? std::complex<double>(re, im) / den : std::complex<double>(NAN, NAN);
+  };
+  auto& response = r.response;
+  if (options.omega.empty()) {
+    // Every DFT frequency k dw, k = 1..N/2: (4.25) with a Hann window of `width` bins is one
+    // correlation of each spectrum with the 2 width - 1 weights inside the window.
+    std::vector<double> weight;
+    for (int j = -pad; j <= pad; ++j)
+      weight.push_back(0.5 * (1.0 + std::cos(M_PI * (static_cast<double>(j) / width))));
+    // The smoothed spectra of bins 1..nb replace the raw ones in place, from index 1 on.
+    double *num = cross.data() + 1, *numIm = crossIm.data() + 1, *den = power.data() + 1;
+    const int taps = static_cast<int>(weight.size());
+    correlate(num, weight.data(), taps, num, nb);
+    correlate(numIm, weight.data(), taps, numIm, nb);
+    correlate(den, weight.data(), taps, den, nb);
+    response.omega.resize(static_cast<std::size_t>(nb));
+    response.value.resize(response.omega.size());
+    for (int k = 1; k <= nb; ++k) {
+      response.omega[k - 1] = k * dw;
+      response.value[k - 1] = ratio(num[k - 1], numIm[k - 1], den[k - 1]);
     }
-    r.response.omega.push_back(w);
-    r.response.value.push_back(den > 0.0 ? num / den
-                                         : std::complex<double>(NAN, NAN));
+  } else {
+    for (double w : options.omega) {
+      const double kc = w / dw;  // fractional bin
+      double re = 0.0, im = 0.0, den = 0.0;
+      if (width <= 1) {
+        const int k = std::min(nb, std::max(0, static_cast<int>(std::lround(kc)))) + pad;
+        re = cross[k];
+        im = crossIm[k];
+        den = power[k];
+      } else {
+        // Hann window over frequency (4.25), half-width `width` bins, weighted by |U|^2.
+        const int lo = std::max(0, static_cast<int>(std::floor(kc - width)));
+        const int hi = std::min(nb, static_cast<int>(std::ceil(kc + width)));
+        for (int k = lo; k <= hi; ++k) {
+          const double x = (k - kc) / width;
+          if (std::abs(x) >= 1.0) continue;
+          const double a = 0.5 * (1.0 + std::cos(M_PI * x));
+          re += a * cross[k + pad];
+          im += a * crossIm[k + pad];
+          den += a * power[k + pad];
+        }
+      }
+      response.omega.push_back(w);
+      response.value.push_back(ratio(re, im, den));
+    }
   }
-  finishFrequencyResponse(r.response, {});
+  finishFrequencyResponse(response, {});
   r.termination = Termination::Converged;
   r.message = options.smoothingWidth > 1
                   ? "ETFE smoothed over " + std::to_string(options.smoothingWidth) + " bins"
                   : "raw ETFE";
-  for (const auto& v : r.response.value)
+  for (const auto& v : response.value)
     if (!std::isfinite(v.real())) {
       r.message += "; the input has no energy at some frequencies, where G is undefined (NaN)";
       break;

@@ -73,15 +73,6 @@ Eigen::VectorXd filter(const Poly& num, const Poly& den, const Eigen::VectorXd& 
   return y;
 }
 
-void filter(const Poly& num, const Poly& den, const Eigen::VectorXd& x1,
-            const Eigen::VectorXd& x2, Eigen::VectorXd& y1, Eigen::VectorXd& y2) {
-  if (x1.size() != x2.size())
-    throw std::invalid_argument("filter: the two signals differ in length");
-  const Eigen::VectorXd* in[2] = {&x1, &x2};
-  Eigen::VectorXd* out[2] = {&y1, &y2};
-  filterMany<2>(num, den, in, out);
-}
-
 Eigen::VectorXd delayed(const Eigen::VectorXd& x, int k) {
   Eigen::VectorXd y = Eigen::VectorXd::Zero(x.size());
   if (k < x.size()) y.tail(x.size() - k) = x.head(x.size() - k);

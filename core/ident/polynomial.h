@@ -12,10 +12,6 @@ using Poly = std::vector<double>;
 
 // y = num(q)/den(q) x with zero initial conditions; den[0] must be non-zero.
 Eigen::VectorXd filter(const Poly& num, const Poly& den, const Eigen::VectorXd& x);
-// The same filter applied to two signals of equal length at once (faster than two calls,
-// with the same results); y1, y2 must not alias x1, x2.
-void filter(const Poly& num, const Poly& den, const Eigen::VectorXd& x1,
-            const Eigen::VectorXd& x2, Eigen::VectorXd& y1, Eigen::VectorXd& y2);
 
 // x delayed by k samples (zeros shifted in).
 Eigen::VectorXd delayed(const Eigen::VectorXd& x, int k);

@@ -46,7 +46,8 @@ struct Tag {
 
 class Level5 {
  public:
-  Level5(bool swap, std::uint64_t budget) : swap_(swap), inflateLeft_(budget) {}
+  Level5(bool swap, std::uint64_t budget, MatCheck& found)
+      : swap_(swap), inflateLeft_(budget), found_(found) {}
   std::string problem;
 
   std::uint32_t u32(const Byte* p) const {
@@ -79,8 +80,10 @@ class Level5 {
     return true;
   }
 
-  // The contents of one miMATRIX element, [p, end).
-  bool matrix(const Byte* p, const Byte* end, const std::string& where0, int depth) {
+  // The contents of one miMATRIX element, [p, end); a top-level one (out set) is described
+  // in *out as it is checked.
+  bool matrix(const Byte* p, const Byte* end, const std::string& where0, int depth,
+              MatVariable* out = nullptr) {
     if (p == end) return true;  // an empty array
     if (depth > kMaxDepth) return fail(where0 + ": cells or structs nested too deeply");
     Tag flags, dims, name;
@@ -98,6 +101,7 @@ class Level5 {
     for (std::uint64_t i = 0; i < dims.nbytes / 4; ++i) {
       const auto d = static_cast<std::int32_t>(u32(dims.data + 4 * i));
       if (d < 0) return fail(where0 + ": a negative dimension");
+      if (out) out->dims.push_back(static_cast<std::uint64_t>(d));
       count = d == 0 ? 0 : count * static_cast<std::uint64_t>(d);
       if (count > kMaxElements) return fail(where0 + ": the array claims more elements than the file can hold");
     }
@@ -109,6 +113,13 @@ class Level5 {
         name.nbytes ? "variable '" + std::string(reinterpret_cast<const char*>(name.data), name.nbytes) + "'"
                     : where0;
     p += name.total;
+    if (out) {
+      const auto* text = reinterpret_cast<const char*>(name.data);
+      out->name.assign(text, strnlen(text, name.nbytes));  // as matio reads it: up to a NUL
+      out->arrayClass = cls;
+      out->complex = complex;
+      out->elements = count;
+    }
     const auto left = static_cast<std::uint64_t>(end - p);
     switch (cls) {
       case 1: {  // cell: count nested arrays
@@ -147,6 +158,10 @@ class Level5 {
           if (count > data.nbytes / size)
             return fail(where + sprintfString(": the array claims %llu elements but its data hold %llu",
                                               count, data.nbytes / size));
+          if (out && part == 0) {
+            out->dataType = data.type;
+            out->data = data.data;
+          }
           p += data.total;
         }
         return true;
@@ -196,7 +211,11 @@ class Level5 {
       if (z.avail_out != 0 || (rc != Z_OK && rc != Z_STREAM_END && rc != Z_BUF_ERROR))
         return fail(where + ": a compressed variable is damaged or cut short");
     }
-    return matrix(body.get(), body.get() + inner, where, 0);
+    MatVariable v;
+    if (!matrix(body.get(), body.get() + inner, where, 0, &v)) return false;
+    keep(std::move(v), inner != 0);
+    found_.inflated.push_back(std::move(body));
+    return true;
   }
 
   bool file(const Byte* p, std::uint64_t n) {
@@ -210,7 +229,11 @@ class Level5 {
         return fail(where + sprintfString(" claims %llu bytes but the file has only %llu left "
                                           "(damaged or cut short)",
                                           nbytes, n - off - 8));
-      if (type == kMiMatrix && !matrix(p + off + 8, p + off + 8 + nbytes, where, 0)) return false;
+      if (type == kMiMatrix) {
+        MatVariable v;
+        if (!matrix(p + off + 8, p + off + 8 + nbytes, where, 0, &v)) return false;
+        keep(std::move(v), nbytes != 0);
+      }
       if (type == kMiCompressed && !compressed(p + off + 8, nbytes, where)) return false;
       off += 8 + nbytes;
     }
@@ -218,12 +241,17 @@ class Level5 {
   }
 
  private:
+  // A described variable joins the list (an empty miMATRIX element has nothing to describe).
+  void keep(MatVariable&& v, bool any) {
+    if (any) found_.variables.push_back(std::move(v));
+  }
   bool fail(const std::string& text) {
     problem = text;
     return false;
   }
   bool swap_;
   std::uint64_t inflateLeft_;
+  MatCheck& found_;
 };
 
 // Level 4: records of five int32 (type MOPT, rows, columns, imaginary flag, name length),
@@ -282,9 +310,14 @@ MatCheck checkMatFile(std::string_view bytes, std::uint64_t inflateBudget) {
     }
     if (version == 0x0100) {
       r.kind = MatKind::V5;
-      Level5 walker(swap, inflateBudget);
+      r.swapBytes = swap;
+      Level5 walker(swap, inflateBudget, r);
       r.ok = walker.file(p, n);
       r.problem = walker.problem;
+      if (!r.ok) {
+        r.variables.clear();
+        r.inflated.clear();
+      }
       return r;
     }
   }

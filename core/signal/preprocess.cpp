@@ -1,12 +1,12 @@
 #include "core/signal/preprocess.h"
 
-#include "core/common/fft.h"
-
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <complex>
 #include <stdexcept>
+
+#include "core/common/fft.h"
 
 namespace flexarm {
 namespace {
@@ -177,8 +177,8 @@ AmplitudeSpectrum amplitudeSpectrum(const std::vector<double>& x, double sampleT
   }
   const int bins = len / 2 + 1;
   std::vector<double> power(static_cast<std::size_t>(bins), 0.0);
-  RealFft fft(len);
-  double* in = fft.input();
+  std::vector<double> in(static_cast<std::size_t>(len));
+  std::vector<std::complex<double>> out(static_cast<std::size_t>(bins));
   const int step = std::max(1, len / 2);
   int segments = 0;
   for (int start = 0; start + len <= n; start += step) {
@@ -186,9 +186,13 @@ AmplitudeSpectrum amplitudeSpectrum(const std::vector<double>& x, double sampleT
     for (int i = 0; i < len; ++i) mean += x[static_cast<std::size_t>(start + i)];
     mean /= len;
     for (int i = 0; i < len; ++i)
-      in[i] = (x[static_cast<std::size_t>(start + i)] - mean) * window[static_cast<std::size_t>(i)];
-    const std::complex<double>* out = fft.transform();
-    for (int k = 0; k < bins; ++k) power[static_cast<std::size_t>(k)] += std::norm(out[k]);
+      in[static_cast<std::size_t>(i)] =
+          (x[static_cast<std::size_t>(start + i)] - mean) * window[static_cast<std::size_t>(i)];
+    realDft(in.data(), len, out.data());
+    for (int k = 0; k < bins; ++k) {
+      const auto& X = out[static_cast<std::size_t>(k)];
+      power[static_cast<std::size_t>(k)] += X.real() * X.real() + X.imag() * X.imag();
+    }
     ++segments;
   }
   s.frequencyHz.resize(static_cast<std::size_t>(bins));
