@@ -95,7 +95,7 @@ std::optional<Loop> loopOf(const FitOptions& o, const PreparedData& d, std::stri
 void keepEstimate(PemResult&& e, const FitOptions& o, FitResult& r) {
   (void)o;
   r.summary = e.summary;
-  for (const auto& p : e.parameters) r.parameters.push_back({p.name, p.unit, p.value, p.std, p.lower, p.upper, p.free});
+  for (const auto& p : e.parameters) r.parameters.push_back({p.name, p.unit, p.value, p.std, p.lower, p.upper, p.free, ""});
   r.physical = std::shared_ptr<const PhysicalModel>(static_cast<PhysicalModel*>(e.model.release()));
   r.K = e.K;
   r.covarianceKind = e.covarianceKind;
