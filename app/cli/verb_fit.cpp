@@ -48,16 +48,34 @@ std::vector<std::string> splitComma(const std::string& text) {
   return out;
 }
 
-// --free and --fix applied to the physical start model; false after printing a usage error.
-bool applyFreeAndFix(ArgParser& args, PhysicalModel& model, const std::string& pre, std::ostream& err) {
+// The effect value named `name` ("F_c", "beta", ...) of the fit's effects: (effect, index), or
+// (-1, -1) when none of them has it.
+std::pair<int, int> effectValue(const std::vector<FitEffect>& effects, const std::string& name) {
+  for (std::size_t e = 0; e < effects.size(); ++e) {
+    const auto& info = effectParameters(effects[e].effect.kind);
+    for (std::size_t k = 0; k < info.size(); ++k)
+      if (info[k].name == name) return {static_cast<int>(e), static_cast<int>(k)};
+  }
+  return {-1, -1};
+}
+
+// --free and --fix applied to the physical start model and its effects' values; false after
+// printing a usage error.
+bool applyFreeAndFix(ArgParser& args, PhysicalModel& model, std::vector<FitEffect>& effects, const std::string& pre,
+                     std::ostream& err) {
+  auto unknown = [&](const char* option, const std::string& n) {
+    err << pre << option << ": the " << model.structureName() << " model"
+        << (effects.empty() ? "" : " and its effects") << " have no parameter '" << n << "'\n";
+    return false;
+  };
   if (auto f = args.value("free")) {
     for (const auto& p : model.parameters()) model.setFree(p.name, false);
+    for (auto& e : effects) e.free = {false, false};
     for (const auto& n : splitComma(*f)) {
-      if (model.indexOf(n) < 0) {
-        err << pre << "--free: the " << model.structureName() << " model has no parameter '" << n << "'\n";
-        return false;
-      }
-      model.setFree(n, true);
+      const auto [e, k] = effectValue(effects, n);
+      if (e >= 0) effects[static_cast<std::size_t>(e)].free[static_cast<std::size_t>(k)] = true;
+      else if (model.indexOf(n) < 0) return unknown("--free", n);
+      else model.setFree(n, true);
     }
   }
   for (const auto& fx : args.values("fix")) {
@@ -73,10 +91,18 @@ bool applyFreeAndFix(ArgParser& args, PhysicalModel& model, const std::string& p
       return false;
     }
     const std::string name = fx.substr(0, eq);
-    if (model.indexOf(name) < 0) {
-      err << pre << "--fix: the " << model.structureName() << " model has no parameter '" << name << "'\n";
-      return false;
+    if (const auto [e, k] = effectValue(effects, name); e >= 0) {
+      FitEffect& f = effects[static_cast<std::size_t>(e)];
+      f.effect.values[static_cast<std::size_t>(k)] = v;
+      f.free[static_cast<std::size_t>(k)] = false;
+      std::string why;
+      if (!f.effect.isValid(&why)) {
+        err << pre << "--fix " << why << "\n";
+        return false;
+      }
+      continue;
     }
+    if (model.indexOf(name) < 0) return unknown("--fix", name);
     try {
       model.setParameter(name, v);
     } catch (const std::invalid_argument& e) {
@@ -217,7 +243,7 @@ bool parseModelSpec(const std::string& text, FitModelSpec& spec, std::string* wh
 
 std::vector<std::string> fitValuedOptionNames() {
   std::vector<std::string> v = logReadOptionNames();
-  for (const char* n : {"model", "free", "fix", "decimate", "range", "log", "validation-log",
+  for (const char* n : {"model", "effect", "free", "fix", "decimate", "range", "log", "validation-log",
                         "validation-range", "max-iterations", "starts", "seed", "closed-loop"})
     v.push_back(n);
   return v;
@@ -229,8 +255,24 @@ const char* fitOptionsHelp() {
   return "  --model SPEC          arx:NA,NB,NK | armax:NA,NB,NC,NK | oe:NB,NF,NK |\n"
          "                        bj:NB,NC,ND,NF,NK (orders of (4.8), delay NK), or a physical\n"
          "                        model two-mass|three-mass|four-mass|rigid (required)\n"
-         "  --free P1,P2          physical models: estimate only these parameters\n"
-         "  --fix P=V             physical models: hold P at V (repeatable)\n"
+         "  --effect NAME[:V1[,V2]] physical models: switch on a named effect (repeatable) and\n"
+         "                        fit its first value with the model's parameters (nonlinear\n"
+         "                        grey-box estimation): coulomb_friction:F_c,v_s (F_c tanh(\n"
+         "                        phi_m'/v_s) on the motor), nonlinear_spring:beta (gear spring\n"
+         "                        k delta (1 + beta delta^2)), backlash:b (dead zone of half-\n"
+         "                        width b, arm side), input_delay:T_d, torque_ripple:A,n\n"
+         "                        (A sin(n phi_m)); values default as `flexarm simulate --help`\n"
+         "                        lists them and are the start. The second value (v_s, n) is\n"
+         "                        held unless --free names it; --fix NAME=V holds any of them.\n"
+         "                        The plant is simulated by Runge-Kutta from the measured torque\n"
+         "                        (output error (5.7), each experiment from rigid-body motion at\n"
+         "                        its first sample's speed, the means kept), the gradient by\n"
+         "                        finite differences; standard deviations from the Gauss-Newton\n"
+         "                        Jacobian (4.37). Closed-loop logs take the direct fit. The\n"
+         "                        frequency response, notches and peaks are the linear part's\n"
+         "  --free P1,P2          physical models: estimate only these parameters (model or\n"
+         "                        effect parameters, e.g. J_m,k_g,beta)\n"
+         "  --fix P=V             physical models: hold P (model or effect) at V (repeatable)\n"
          "  --noise-model         physical models: innovations form, K estimated (else K = 0)\n"
          "  --starts N            physical models: N random starts besides the nominal one,\n"
          "                        plus two whose notches and peaks match the SPA estimate\n"
@@ -352,9 +394,23 @@ int runFitPipeline(ArgParser& args, const std::string& verb, FitResult& result, 
       return kExitUsage;
     }
   }
+  if (!physical && !args.values("effect").empty()) {
+    err << pre << "--effect applies to physical models only\n";
+    return kExitUsage;
+  }
+  for (const auto& spec : args.values("effect")) {
+    auto e = parseEffect(spec, &why);
+    if (!e) {
+      err << pre << "--effect " << spec << ": " << why << "\n";
+      return kExitUsage;
+    }
+    FitEffect f = FitEffect::defaults(e->kind);
+    f.effect = *e;
+    o.model.effects.push_back(f);
+  }
   if (physical) {
     auto start = std::shared_ptr<PhysicalModel>(makePhysicalModel(*modelText));
-    if (!applyFreeAndFix(args, *start, pre, err)) return kExitUsage;
+    if (!applyFreeAndFix(args, *start, o.model.effects, pre, err)) return kExitUsage;
     o.model.start = start;
   }
   auto readOptions = logReadOptions(args, err);
@@ -449,6 +505,17 @@ int runFit(const std::vector<std::string>& argv, std::ostream& out, std::ostream
     params[p.name] = p.value;
     stds[p.name] = p.std;
   }
+  // The effects with their estimated values: {"name", "spec" (for --effect), "parameters":
+  // {NAME: {"value", "std", "lower", "upper", "free", "unit"}}}.
+  nlohmann::json effects = nlohmann::json::array();
+  for (const auto& e : fit.effects) {
+    nlohmann::json values = nlohmann::json::object();
+    for (const auto& p : fit.parameters)
+      if (p.effect == toString(e.kind))
+        values[p.name] = {{"value", p.value}, {"std", p.std}, {"lower", p.lower},
+                          {"upper", p.upper}, {"free", p.free}, {"unit", p.unit}};
+    effects.push_back({{"name", toString(e.kind)}, {"spec", toString(e)}, {"parameters", values}});
+  }
   nlohmann::json controller = nullptr;
   if (fit.controller)
     controller = {{"rate_hz", fit.controller->rateHz},
@@ -461,6 +528,7 @@ int runFit(const std::vector<std::string>& argv, std::ostream& out, std::ostream
     nlohmann::json j = {{"model", fit.modelName()},
                         {"parameters", params},
                         {"std", stds},
+                        {"effects", effects},
                         {"fit_percent", optJson(fit.fitEstimation)},
                         {"fit_percent_validation", optJson(fit.fitValidation())},
                         {"fit_percent_experiments", experiments(fit.estimation, files.estimation, false)},
@@ -498,7 +566,8 @@ int runFit(const std::vector<std::string>& argv, std::ostream& out, std::ostream
   if (fit.method) out << "closed-loop method: " << fit.methodDescription << " (" << fit.methodReason << ")\n";
   if (fit.controller) out << "controller: " << fit.controllerSource << "\n";
   for (const auto& p : fit.parameters)
-    out << "  " << p.name << " = " << p.value << " +- " << p.std << (p.free ? "" : " (fixed)") << "\n";
+    out << "  " << p.name << " = " << p.value << " +- " << p.std << (p.free ? "" : " (fixed)")
+        << (p.effect.empty() ? "" : " " + p.unit + " (" + p.effect + ")") << "\n";
   out << "loss " << s.loss << ", FPE " << s.fpe;
   if (fit.fitEstimation) out << ", fit " << *fit.fitEstimation << " %";
   if (auto v = fit.fitValidation()) out << ", validation fit " << *v << " %";
