@@ -1,7 +1,9 @@
 #include "widgets/fit_panel.h"
 
+#include <QCheckBox>
 #include <QComboBox>
 #include <QFormLayout>
+#include <QGridLayout>
 #include <QGroupBox>
 #include <QHBoxLayout>
 #include <QHeaderView>
@@ -36,6 +38,15 @@ QString joined(const std::vector<double>& w) {
 
 QString number(double v) { return QString::number(v, 'g', 5); }
 
+// An effect at its defaults (the first value free), with the start model's own values when
+// it carries the effect.
+FitEffect startEffect(EffectKind kind, const std::vector<Effect>& own) {
+  FitEffect f = FitEffect::defaults(kind);
+  for (const auto& e : own)
+    if (e.kind == kind) f.effect = e;
+  return f;
+}
+
 }  // namespace
 
 FitPanel::FitPanel(Workspace* workspace, QWidget* parent)
@@ -64,6 +75,27 @@ FitPanel::FitPanel(Workspace* workspace, QWidget* parent)
     orders[i]->setToolTip(tr("Order %1 of (4.8)").arg(orderNames[i]));
     orderRow->addWidget(new QLabel(orderNames[i], this));
     orderRow->addWidget(orders[i]);
+  }
+  // The named effects a physical model can carry in the fit (extra_mass is a larger
+  // structure, chosen as the model).
+  effectsBox_ = new QWidget(this);
+  effectsBox_->setObjectName("fitEffectsBox");
+  auto* effectGrid = new QGridLayout(effectsBox_);
+  effectGrid->setContentsMargins(0, 0, 0, 0);
+  for (EffectKind k : allEffectKinds()) {
+    if (k == EffectKind::ExtraMass) continue;
+    auto* box = new QCheckBox(QString::fromStdString(toString(k)), effectsBox_);
+    box->setObjectName(QString("effect_%1_check").arg(toString(k)));
+    QStringList meaning;
+    for (const auto& p : effectParameters(k))
+      meaning << tr("%1 (%2): %3").arg(QString::fromStdString(p.name), QString::fromStdString(p.unit),
+                                       QString::fromStdString(p.meaning));
+    box->setToolTip(tr("Fit the model with this effect (nonlinear grey-box estimation, the plant "
+                       "simulated from the measured torque): ") + meaning.join("; "));
+    const int n = static_cast<int>(effectChecks_.size());
+    effectGrid->addWidget(box, n / 3, n % 3);
+    effectChecks_.emplace_back(k, box);
+    connect(box, &QCheckBox::toggled, this, [this] { refillEffectParameters(); });
   }
   free_->setObjectName("freeParameterList");
   free_->setMaximumHeight(90);
@@ -108,6 +140,7 @@ FitPanel::FitPanel(Workspace* workspace, QWidget* parent)
   auto* form = new QFormLayout;
   form->addRow(tr("Model"), model_);
   form->addRow(tr("Orders"), orderRow);
+  form->addRow(tr("Effects"), effectsBox_);
   form->addRow(tr("Free parameters"), free_);
   form->addRow(tr("Starts, bounds"), startsBounds_);
   form->addRow(tr("Ranges"), ranges_);
@@ -217,7 +250,9 @@ void FitPanel::refillModels() {
   model_->setCurrentIndex(k >= 0 ? k : 2);
   model_->blockSignals(false);
   const QStringList ticked = freeParameters();  // the user's choice survives a list change
+  const QStringList chosen = effects();
   refillParameters();
+  if (k >= 0) setEffects(chosen);
   if (k >= 0 && !ticked.isEmpty()) setFreeParameters(ticked);
   updateControls();
 }
@@ -261,8 +296,74 @@ void FitPanel::setClosedLoopMethod(ClosedLoopChoice m) {
 void FitPanel::setStarts(int randomStarts) { starts_->setValue(randomStarts); }
 void FitPanel::setStudyRuns(int runs) { studyRuns_->setValue(runs); }
 
+void FitPanel::setEffects(const QStringList& names) {
+  for (auto& [kind, box] : effectChecks_) {
+    box->blockSignals(true);
+    box->setChecked(names.contains(QString::fromStdString(toString(kind))));
+    box->blockSignals(false);
+  }
+  refillEffectParameters();
+}
+
+QStringList FitPanel::effects() const {
+  QStringList names;
+  for (const auto& [kind, box] : effectChecks_)
+    if (box->isChecked()) names << QString::fromStdString(toString(kind));
+  return names;
+}
+
+std::vector<Effect> FitPanel::startEffects() const {
+  const QString key = modelChoice();
+  if (!key.startsWith("list:")) return {};
+  const auto i = key.mid(5).toUInt();
+  return i < workspace_->models().size() ? workspace_->models()[i].effects : std::vector<Effect>{};
+}
+
+// The effects checked, their values the start model's own where it has them, free as the
+// parameter list says.
+std::vector<FitEffect> FitPanel::chosenEffects() const {
+  std::vector<FitEffect> out;
+  const std::vector<Effect> own = startEffects();
+  const QStringList ticked = freeParameters();
+  for (const auto& [kind, box] : effectChecks_) {
+    if (!box->isChecked()) continue;
+    FitEffect f = startEffect(kind, own);
+    const auto& info = effectParameters(kind);
+    for (std::size_t k = 0; k < info.size(); ++k)
+      f.free[k] = ticked.contains(QString("%1 (%2)").arg(QString::fromStdString(info[k].name), toString(kind)));
+    out.push_back(f);
+  }
+  return out;
+}
+
+// The checked effects' parameters at the end of the free-parameter list (a parameter keeps
+// its tick while its effect stays checked).
+void FitPanel::refillEffectParameters() {
+  const QStringList ticked = freeParameters();
+  for (int i = free_->count() - 1; i >= 0; --i)
+    if (free_->item(i)->data(Qt::UserRole).toBool()) delete free_->takeItem(i);
+  const std::vector<Effect> own = startEffects();
+  for (const auto& [kind, box] : effectChecks_) {
+    if (!box->isChecked()) continue;
+    const FitEffect f = startEffect(kind, own);
+    const auto& info = effectParameters(kind);
+    for (std::size_t k = 0; k < info.size(); ++k) {
+      const QString label = QString("%1 (%2)").arg(QString::fromStdString(info[k].name), toString(kind));
+      auto* item = new QListWidgetItem(label, free_);
+      item->setData(Qt::UserRole, true);
+      item->setFlags(Qt::ItemIsEnabled | Qt::ItemIsUserCheckable);
+      const bool wasListed = std::any_of(ticked.begin(), ticked.end(), [&](const QString& t) { return t == label; });
+      item->setCheckState(wasListed || f.free[k] ? Qt::Checked : Qt::Unchecked);
+      item->setToolTip(tr("%1 %2, start value: %3")
+                           .arg(f.effect.values[k])
+                           .arg(QString::fromStdString(info[k].unit), QString::fromStdString(info[k].meaning)));
+    }
+  }
+}
+
 void FitPanel::refillParameters() {
   free_->clear();
+  setEffects({});  // the start model's own effects, below
   const QString key = modelChoice();
   std::shared_ptr<const PhysicalModel> m;
   if (key.startsWith("list:")) {
@@ -278,6 +379,10 @@ void FitPanel::refillParameters() {
     item->setCheckState(p.free ? Qt::Checked : Qt::Unchecked);
     item->setToolTip(tr("%1 %2, start value").arg(p.value).arg(QString::fromStdString(p.unit)));
   }
+  QStringList own;
+  for (const auto& e : startEffects())
+    if (e.kind != EffectKind::ExtraMass) own << QString::fromStdString(toString(e.kind));
+  setEffects(own);
 }
 
 void FitPanel::updateControls() {
@@ -292,6 +397,7 @@ void FitPanel::updateControls() {
   nk_->setEnabled(s.has_value() && !busy);
   free_->setEnabled(!s && !busy);
   startsBounds_->setEnabled(!s && !busy);
+  effectsBox_->setEnabled(!s && !busy);
   noise_->setEnabled(!s && !busy);
   closedLoop_->setEnabled(!s && !busy && noise_->currentIndex() == 0);
   starts_->setEnabled(!s && !busy);
@@ -378,6 +484,7 @@ std::optional<FitOptions> FitPanel::options(QString* name) {
     for (const auto& p : base->parameters()) start->setFree(p.name, names.contains(QString::fromStdString(p.name)));
     o.model.kind = FitModelKind::Physical;
     o.model.start = start;
+    o.model.effects = chosenEffects();
     o.noiseModel = noise_->currentIndex() == 1 ? NoiseModel::Innovations : NoiseModel::OutputError;
     o.closedLoop = closedLoopChoiceFromString(closedLoop_->currentData().toString().toStdString())
                        .value_or(ClosedLoopChoice::Auto);
@@ -452,7 +559,10 @@ void FitPanel::onFinished() {
   table_->setRowCount(static_cast<int>(r.parameters.size()));
   for (int i = 0; i < static_cast<int>(r.parameters.size()); ++i) {
     const FitParameter& row = r.parameters[static_cast<std::size_t>(i)];
-    const QStringList cells = {QString::fromStdString(row.name),
+    const QString label = row.effect.empty() ? QString::fromStdString(row.name)
+                                             : QString("%1 (%2)").arg(QString::fromStdString(row.name),
+                                                                      QString::fromStdString(row.effect));
+    const QStringList cells = {label,
                                number(row.value),
                                row.free ? number(row.std) : tr("fixed"),
                                row.free ? number(row.lower) : QString(),
@@ -467,6 +577,7 @@ void FitPanel::onFinished() {
   ModelEntry entry;
   if (r.physical) {
     entry.model = r.physical;
+    entry.effects = r.effects;
     entry.covariance = r.covariance;
     entry.covarianceIndices = r.freeIndices;
     entry.name = out.name;

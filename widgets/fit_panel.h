@@ -1,6 +1,8 @@
 #pragma once
 // Fit panel: a black-box structure with its orders (4.8) or a physical model (from the shared
-// model list or a fresh structure) with its free parameters; the workspace's estimation and
+// model list or a fresh structure) with its free parameters and the named effects switched on
+// for it (nonlinear grey-box estimation; a list model brings its own, e.g. discovery's
+// augmented model), their parameters free or fixed; the workspace's estimation and
 // validation ranges; options (decimation, noise model, starts, iterations). Estimate runs the
 // prediction-error fit off the GUI thread with progress and Cancel and shows the results as
 // the seed's Tables 5.1 and 5.3-5.7: value +- std and the 99 % interval of every parameter,
@@ -16,6 +18,7 @@
 #include "core/ident/sensitivity.h"
 #include "widgets/workspace.h"
 
+class QCheckBox;
 class QComboBox;
 class QLabel;
 class QListWidget;
@@ -39,7 +42,14 @@ class FitPanel : public QWidget {
   bool setModelChoice(const QString& key);
   QString modelChoice() const;
   void setOrders(const PolyOrders& orders);
-  // Physical models: exactly these parameters are estimated.
+  // Physical models: the named effects (coulomb_friction, nonlinear_spring, backlash,
+  // input_delay, torque_ripple) switched on for the fit; their parameters join the free
+  // parameter list as "NAME (effect)", the first of each checked. A model from the list starts
+  // with its own effects and their values.
+  void setEffects(const QStringList& names);
+  QStringList effects() const;
+  // Physical models: exactly these parameters are estimated (effect parameters as listed,
+  // e.g. "beta (nonlinear_spring)").
   void setFreeParameters(const QStringList& names);
   QStringList freeParameters() const;
   void setDecimation(int factor);
@@ -87,6 +97,10 @@ class FitPanel : public QWidget {
   std::optional<FitOptions> options(QString* name);
   void refillModels();
   void refillParameters();
+  void refillEffectParameters();
+  std::vector<FitEffect> chosenEffects() const;
+  // The start model's own effects (a list entry's), else none.
+  std::vector<Effect> startEffects() const;
   void updateControls();
   void onFinished();
   void onStudyFinished();
@@ -104,6 +118,8 @@ class FitPanel : public QWidget {
   QSpinBox* nk_;
   QListWidget* free_;
   QLineEdit* startsBounds_;  // start values P=V and bounds P=LO:HI (FitOptions)
+  QWidget* effectsBox_;
+  std::vector<std::pair<EffectKind, QCheckBox*>> effectChecks_;
   QLabel* ranges_;
   QSpinBox* decimation_;
   QComboBox* noise_;

@@ -144,6 +144,11 @@ int runDiscover(const std::vector<std::string>& argv, std::ostream& out, std::os
                     c.significant ? "significant" : "-");
       out << line << "      " << c.reason << "\n";
     }
+    if (r.effect) {  // the augmented model as `flexarm fit` refines it
+      out << "Refine: flexarm fit " << args.positional()[0] << " --model " << *modelName;
+      for (const auto& e : r.augmentedEffects) out << " --effect " << toString(e);
+      out << "\n";
+    }
     out << "Seconds: " << r.seconds << "\n";
     return kExitOk;
   }
@@ -170,6 +175,9 @@ int runDiscover(const std::vector<std::string>& argv, std::ostream& out, std::os
   j["base"] = scoreJson(r.base, r.hasValidation);
   j["base"]["aic"] = r.baseAic;
   j["augmented"] = scoreJson(r.augmented, r.hasValidation);
+  // The augmented model's effects as `flexarm fit --effect` takes them.
+  j["augmented"]["effects"] = nlohmann::json::array();
+  for (const auto& e : r.augmentedEffects) j["augmented"]["effects"].push_back(toString(e));
   j["disagreement"] = {{"summary", r.disagreement.summary},
                        {"white", r.disagreement.tests.white},
                        {"independent", r.disagreement.tests.independent},

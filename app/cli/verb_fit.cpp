@@ -48,28 +48,49 @@ std::vector<std::string> splitComma(const std::string& text) {
   return out;
 }
 
-// The parameter names of model, for messages.
-std::string parameterNames(const PhysicalModel& model) {
+// The parameter names of model and its effects, for messages.
+std::string parameterNames(const PhysicalModel& model, const std::vector<FitEffect>& effects) {
   std::string out;
   for (const auto& p : model.parameters()) out += (out.empty() ? "" : ", ") + p.name;
+  for (const auto& e : effects)
+    for (const auto& info : effectParameters(e.effect.kind)) out += ", " + info.name;
   return out;
 }
 
+// The effect value named `name` ("F_c", "beta", ...) of the fit's effects: (effect, index), or
+// (-1, -1) when none of them has it.
+std::pair<int, int> effectValue(const std::vector<FitEffect>& effects, const std::string& name) {
+  for (std::size_t e = 0; e < effects.size(); ++e) {
+    const auto& info = effectParameters(effects[e].effect.kind);
+    for (std::size_t k = 0; k < info.size(); ++k)
+      if (info[k].name == name) return {static_cast<int>(e), static_cast<int>(k)};
+  }
+  return {-1, -1};
+}
+
 // --free, --fix, --start and --bound of a physical fit, in command-line order (a later --free
-// or --fix of a parameter overrides an earlier one): free flags on the start model, start
-// values and bounds into the options. False after printing a usage error.
+// or --fix of a parameter overrides an earlier one): free flags on the start model and its
+// effects, start values and bounds into the options; an effect's value given by --fix or
+// --start is set in the effect itself. False after printing a usage error.
 bool applyStartOptions(ArgParser& args, PhysicalModel& model, FitOptions& o, const std::string& pre,
                        std::ostream& err) {
+  auto& effects = o.model.effects;
   auto known = [&](const char* option, const std::string& name) {
     if (model.indexOf(name) >= 0) return true;
-    err << pre << "--" << option << ": the " << model.structureName() << " model has no parameter '" << name
-        << "' (its parameters: " << parameterNames(model) << ")\n";
+    err << pre << "--" << option << ": the " << model.structureName() << " model"
+        << (effects.empty() ? "" : " and its effects") << " have no parameter '" << name
+        << "' (its parameters: " << parameterNames(model, effects) << ")\n";
     return false;
   };
   for (const auto& [option, text] : args.sequence()) {
     if (option == "free") {
       for (const auto& p : model.parameters()) model.setFree(p.name, false);
+      for (auto& e : effects) e.free = {false, false};
       for (const auto& n : splitComma(text)) {
+        if (const auto [e, k] = effectValue(effects, n); e >= 0) {
+          effects[static_cast<std::size_t>(e)].free[static_cast<std::size_t>(k)] = true;
+          continue;
+        }
         if (!known("free", n)) return false;
         model.setFree(n, true);
       }
@@ -81,6 +102,17 @@ bool applyStartOptions(ArgParser& args, PhysicalModel& model, FitOptions& o, con
         return false;
       }
       const std::string name = v ? v->name : text;
+      if (const auto [e, k] = effectValue(effects, name); e >= 0) {
+        FitEffect& f = effects[static_cast<std::size_t>(e)];
+        if (v) f.effect.values[static_cast<std::size_t>(k)] = v->value;
+        if (option == "fix") f.free[static_cast<std::size_t>(k)] = false;
+        std::string why;
+        if (!f.effect.isValid(&why)) {
+          err << pre << "--" << option << " " << why << "\n";
+          return false;
+        }
+        continue;
+      }
       if (!known(option.c_str(), name)) return false;
       if (v) o.startValues.push_back(*v);
       if (option == "fix") model.setFree(name, false);
@@ -226,7 +258,7 @@ bool parseModelSpec(const std::string& text, FitModelSpec& spec, std::string* wh
 
 std::vector<std::string> fitValuedOptionNames() {
   std::vector<std::string> v = logReadOptionNames();
-  for (const char* n : {"model", "free", "fix", "start", "bound", "decimate", "range", "log", "validation-log",
+  for (const char* n : {"model", "effect", "free", "fix", "start", "bound", "decimate", "range", "log", "validation-log",
                         "validation-range", "max-iterations", "starts", "seed", "closed-loop"})
     v.push_back(n);
   return v;
@@ -238,8 +270,25 @@ const char* fitOptionsHelp() {
   return "  --model SPEC          arx:NA,NB,NK | armax:NA,NB,NC,NK | oe:NB,NF,NK |\n"
          "                        bj:NB,NC,ND,NF,NK (orders of (4.8), delay NK), or a physical\n"
          "                        model two-mass|three-mass|four-mass|rigid (required)\n"
-         "  --free P1,P2          physical models: estimate only these parameters\n"
-         "  --fix P[=V]           physical models: hold P (at V, else its start value; repeatable).\n"
+         "  --effect NAME[:V1[,V2]] physical models: switch on a named effect (repeatable) and\n"
+         "                        fit its first value with the model's parameters (nonlinear\n"
+         "                        grey-box estimation): coulomb_friction:F_c,v_s (F_c tanh(\n"
+         "                        phi_m'/v_s) on the motor), nonlinear_spring:beta (gear spring\n"
+         "                        k delta (1 + beta delta^2)), backlash:b (dead zone of half-\n"
+         "                        width b, arm side), input_delay:T_d, torque_ripple:A,n\n"
+         "                        (A sin(n phi_m)); values default as `flexarm simulate --help`\n"
+         "                        lists them and are the start. The second value (v_s, n) is\n"
+         "                        held unless --free names it; --fix NAME=V holds any of them.\n"
+         "                        The plant is simulated by Runge-Kutta from the measured torque\n"
+         "                        (output error (5.7), each experiment from rigid-body motion at\n"
+         "                        its first sample's speed, the means kept), the gradient by\n"
+         "                        finite differences; standard deviations from the Gauss-Newton\n"
+         "                        Jacobian (4.37). Closed-loop logs take the direct fit. The\n"
+         "                        frequency response, notches and peaks are the linear part's\n"
+         "  --free P1,P2          physical models: estimate only these parameters (model or\n"
+         "                        effect parameters, e.g. J_m,k_g,beta)\n"
+         "  --fix P[=V]           physical models: hold P, a model or effect parameter (at V,\n"
+         "                        else its start value; repeatable).\n"
          "                        --free and --fix are applied in order: the last one naming a\n"
          "                        parameter wins (--fix J_m=1e-3 --free J_m estimates J_m from\n"
          "                        1e-3)\n"
@@ -376,6 +425,20 @@ int runFitPipeline(ArgParser& args, const std::string& verb, FitResult& result, 
       return kExitUsage;
     }
   }
+  if (!physical && !args.values("effect").empty()) {
+    err << pre << "--effect applies to physical models only\n";
+    return kExitUsage;
+  }
+  for (const auto& spec : args.values("effect")) {
+    auto e = parseEffect(spec, &why);
+    if (!e) {
+      err << pre << "--effect " << spec << ": " << why << "\n";
+      return kExitUsage;
+    }
+    FitEffect f = FitEffect::defaults(e->kind);
+    f.effect = *e;
+    o.model.effects.push_back(f);
+  }
   if (physical) {
     auto start = std::shared_ptr<PhysicalModel>(makePhysicalModel(*modelText));
     if (!applyStartOptions(args, *start, o, pre, err)) return kExitUsage;
@@ -473,6 +536,17 @@ int runFit(const std::vector<std::string>& argv, std::ostream& out, std::ostream
     params[p.name] = p.value;
     stds[p.name] = p.std;
   }
+  // The effects with their estimated values: {"name", "spec" (for --effect), "parameters":
+  // {NAME: {"value", "std", "lower", "upper", "free", "unit"}}}.
+  nlohmann::json effects = nlohmann::json::array();
+  for (const auto& e : fit.effects) {
+    nlohmann::json values = nlohmann::json::object();
+    for (const auto& p : fit.parameters)
+      if (p.effect == toString(e.kind))
+        values[p.name] = {{"value", p.value}, {"std", p.std}, {"lower", p.lower},
+                          {"upper", p.upper}, {"free", p.free}, {"unit", p.unit}};
+    effects.push_back({{"name", toString(e.kind)}, {"spec", toString(e)}, {"parameters", values}});
+  }
   nlohmann::json controller = nullptr;
   if (fit.controller)
     controller = {{"rate_hz", fit.controller->rateHz},
@@ -485,6 +559,7 @@ int runFit(const std::vector<std::string>& argv, std::ostream& out, std::ostream
     nlohmann::json j = {{"model", fit.modelName()},
                         {"parameters", params},
                         {"std", stds},
+                        {"effects", effects},
                         {"fit_percent", optJson(fit.fitEstimation)},
                         {"fit_percent_validation", optJson(fit.fitValidation())},
                         {"fit_percent_experiments", experiments(fit.estimation, files.estimation, false)},
@@ -522,7 +597,8 @@ int runFit(const std::vector<std::string>& argv, std::ostream& out, std::ostream
   if (fit.method) out << "closed-loop method: " << fit.methodDescription << " (" << fit.methodReason << ")\n";
   if (fit.controller) out << "controller: " << fit.controllerSource << "\n";
   for (const auto& p : fit.parameters)
-    out << "  " << p.name << " = " << p.value << " +- " << p.std << (p.free ? "" : " (fixed)") << "\n";
+    out << "  " << p.name << " = " << p.value << " +- " << p.std << (p.free ? "" : " (fixed)")
+        << (p.effect.empty() ? "" : " " + p.unit + " (" + p.effect + ")") << "\n";
   out << "loss " << s.loss << ", FPE " << s.fpe;
   if (fit.fitEstimation) out << ", fit " << *fit.fitEstimation << " %";
   if (auto v = fit.fitValidation()) out << ", validation fit " << *v << " %";

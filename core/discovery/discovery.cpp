@@ -15,6 +15,7 @@
 #include "core/ident/evaluation.h"
 #include "core/ident/fit_data.h"
 #include "core/ident/levenberg_marquardt.h"
+#include "core/ident/nonlinear_pem.h"
 #include "core/models/analysis.h"
 #include "core/models/nonlinear_plant.h"
 #include "core/signal/preprocess.h"
@@ -58,13 +59,6 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-// One data set at the rate the fits run at.
-struct Series {
-  std::vector<double> u, phi, y;  // torque reference, measured angle, its derivative
-  double Ts = 0.0;
-  double startTime = 0.0;
-};
-
 // The data set through the fit pipeline's preparation (core/ident/fit_data.h), the same
 // steps every estimator runs: the channels (the input role, else the torque reference; the
 // motor angle as the output), decimation behind the anti-alias FIR with the input held as its
@@ -72,7 +66,7 @@ struct Series {
 // rate, what the plant integrates), the means kept (friction and backlash act on the real
 // velocity, the ripple on the real angle). The angle is differentiated here, at the fitting
 // rate, exactly as the predicted angle is.
-std::optional<Series> makeSeries(const IdData& data, double maxRateHz, std::string* why) {
+std::optional<NonlinearSeries> makeSeries(const IdData& data, double maxRateHz, std::string* why) {
   const Channel* in = data.input();
   if (!in) in = data.channel(columns::kTorqueRef);
   const Channel* angle = data.channel(columns::kMotorAngle);
@@ -94,7 +88,9 @@ std::optional<Series> makeSeries(const IdData& data, double maxRateHz, std::stri
     *why = p.message;
     return std::nullopt;
   }
-  Series s;
+  NonlinearSeries s;
+  s.resetAngle = true;
+  s.averageTorque = true;
   s.Ts = p.sampleTime;
   s.startTime = p.startTime;
   s.u.assign(p.u.data(), p.u.data() + p.u.size());
@@ -105,6 +101,7 @@ std::optional<Series> makeSeries(const IdData& data, double maxRateHz, std::stri
       return std::nullopt;
     }
   s.y = differentiate(s.phi, s.Ts);
+  s.initialSpeed = s.y[0];
   return s;
 }
 
@@ -116,224 +113,6 @@ double totalInertia(const PhysicalModel& m) {
     if (p.name.size() > 2 && p.name.compare(0, 2, "J_") == 0)
       J += p.name == "J_m" ? p.value : r * r * p.value;
   return J;
-}
-
-// The load observer of the predictor: a PI torque on the motor from the motor velocity
-// error. Its gain is one for every model compared in a run (the total inertia of the
-// engineer's base model over k_T, for a bandwidth of wo rad/s, damping ratio 1): were it
-// taken from each model's own inertias, a model could buy a faster observer by growing an
-// inertia the data do not see (an arm behind an open backlash gap), and fit anything.
-struct Observer {
-  double wo = 0.0;    // rad/s; 0: pure output error (simulation)
-  double gain = 0.0;  // torque reference per unit of motor acceleration error, kg m^2 / k_T
-};
-
-// The nonlinear predictor: the plant driven by u, with the arm-side load estimated by the
-// observer. Returns false when the simulation blows up.
-bool predictVelocity(const NonlinearPlant& plant, const Series& s, int substeps,
-                     const Observer& observer, std::vector<double>& yhat,
-                     std::vector<double>* deflection = nullptr) {
-  const std::size_t N = s.u.size();
-  std::vector<double> phiHat(N);
-  if (deflection) deflection->resize(N);
-  // Start in rigid-body motion at the measured speed (a data set cut from a longer log need
-  // not start at rest): phi_m' = y(0), every arm-side speed r y(0), the springs relaxed.
-  NonlinearPlant::State x{};
-  x[static_cast<std::size_t>(plant.motorAngleState())] = s.phi[0];
-  {
-    const auto names = plant.model().stateNames();
-    const double r = plant.model().value("r");
-    for (std::size_t i = 0; i < names.size() && i < x.size(); ++i)
-      if (!names[i].empty() && names[i].back() == '\'')
-        x[i] = names[i] == "phi_m'" ? s.y[0] : r * s.y[0];
-  }
-  const double Ts = s.Ts, delay = plant.inputDelay();
-  const double h = Ts / substeps;
-  const auto& u = s.u;
-  // The held torque, delayed, averaged over one Runge-Kutta step around each stage point:
-  // the response then moves smoothly with the delay (a plain held value would jump only when
-  // a sample edge crosses a stage point, giving a zero gradient), and the average of a held
-  // signal over a window is exact wherever the window holds no sample edge.
-  auto held = [&u, N](double k) { return k < 0.0 ? 0.0 : u[std::min(static_cast<std::size_t>(k), N - 1)]; };
-  // The observer's torque acts on the motor (in units of u, undelayed): the load it stands
-  // for reaches the motor through the gear at low frequency, and a motor-side correction
-  // keeps acting when backlash opens the gear (an arm-side one would then lose its grip).
-  double correction = 0.0;
-  auto torqueAt = [&held, &correction, Ts, h, delay](double t) {
-    const double a = (t - delay - 0.5 * h) / Ts, b = (t - delay + 0.5 * h) / Ts;
-    const double edge = std::floor(b);
-    if (edge <= a) return held(a) + correction;
-    return ((edge - a) * held(a) + (b - edge) * held(b)) / (b - a) + correction;
-  };
-  const double wo = observer.wo, gain = observer.gain;
-  const double kp = 2.0 * wo, ki = wo * wo;
-  double integral = 0.0;
-  const double limit = 1e6 + 1e3 * std::abs(s.phi[0]);
-  // The motor angle is measured: each sample's integration starts from the measured angle
-  // (it only positions the ripple A sin(n phi_m)); the predicted angle, whose derivative is
-  // the output, accumulates the simulated increments.
-  const std::size_t angle = static_cast<std::size_t>(plant.motorAngleState());
-  for (std::size_t k = 0; k < N; ++k) {
-    phiHat[k] = k == 0 ? s.phi[0] : phiHat[k - 1] + (plant.motorAngle(x) - s.phi[k - 1]);
-    if (!std::isfinite(phiHat[k]) || std::abs(phiHat[k]) > limit) return false;
-    x[angle] = s.phi[k];
-    if (deflection) (*deflection)[k] = plant.gearDeflection(x);
-    if (wo > 0.0 && k > 0) {
-      const double e = ((s.phi[k] - s.phi[k - 1]) - (phiHat[k] - phiHat[k - 1])) / Ts;
-      integral += e * Ts;
-      correction = gain * (kp * e + ki * integral);
-    }
-    const double t = static_cast<double>(k) * Ts;
-    for (int i = 0; i < substeps; ++i) plant.step(x, t + i * h, h, torqueAt, 0.0);
-  }
-  yhat = differentiate(phiHat, Ts);
-  return true;
-}
-
-// How one search coordinate maps to a physical value.
-enum class Map { Log, Scaled, NonNegative, Fraction };
-struct Coordinate {
-  bool base = true;  // a base parameter (index into the model) or an effect value
-  int index = 0;
-  Map map = Map::Log;
-  double scale = 1.0;
-  double minPhi = -300.0, maxPhi = 300.0;  // bounds of logarithmic coordinates
-  double toValue(double phi) const {
-    switch (map) {
-      case Map::Log: return std::exp(phi);
-      default: return phi * scale;
-    }
-  }
-  double toPhi(double v) const { return map == Map::Log ? std::log(v) : v / scale; }
-  void project(double& phi) const {
-    if (map == Map::NonNegative) phi = std::max(phi, 0.0);
-    if (map == Map::Fraction) phi = std::clamp(phi, 0.01 / scale, 0.95 / scale);
-    if (map == Map::Log) phi = std::clamp(phi, minPhi, maxPhi);
-  }
-  // Finite-difference step: small for the smooth base parameters, about 1 % of the effect's
-  // typical size for effect values (dead zones and delays move the response in small jumps
-  // at the integration grid, which a tiny step would see as a zero or a spike).
-  double step(double phi) const {
-    if (base) return map == Map::Log ? 1e-4 : 1e-4 * std::max(1.0, std::abs(phi));
-    return map == Map::Log ? 2e-3 : 1e-2 * std::max(1.0, std::abs(phi));
-  }
-  // d value / d phi, to carry covariances into physical units.
-  double slope(double phi) const { return map == Map::Log ? std::exp(phi) : scale; }
-};
-
-// A model structure plus one (or no) effect, parameterized by the coordinates.
-struct Problem {
-  const PhysicalModel* base = nullptr;
-  std::optional<EffectKind> kind;
-  Effect fixedEffect;  // values not in the coordinates (e.g. v_s, ripple n)
-  std::vector<Coordinate> coords;
-  const Series* series = nullptr;
-  int substeps = 4;
-  Observer observer;
-  const std::atomic<bool>* cancel = nullptr;
-
-  // Model and effect for a coordinate vector; throws std::invalid_argument when the values
-  // leave the model's bounds.
-  std::pair<std::unique_ptr<PhysicalModel>, std::vector<Effect>> build(
-      const Eigen::VectorXd& phi) const {
-    std::unique_ptr<PhysicalModel> m(static_cast<PhysicalModel*>(base->clone().release()));
-    Effect e = fixedEffect;
-    for (std::size_t i = 0; i < coords.size(); ++i) {
-      const auto& c = coords[i];
-      const double v = c.toValue(phi[static_cast<Eigen::Index>(i)]);
-      if (c.base)
-        m->setParameter(m->parameters()[static_cast<std::size_t>(c.index)].name, v);
-      else
-        e.values[static_cast<std::size_t>(c.index)] = v;
-    }
-    std::vector<Effect> effects;
-    if (kind) effects.push_back(e);
-    return {std::move(m), effects};
-  }
-
-  bool simulate(const Eigen::VectorXd& phi, const Series& s, std::vector<double>& yhat,
-                std::vector<double>* deflection = nullptr) const {
-    try {
-      auto built = build(phi);
-      const NonlinearPlant plant(*built.first, built.second);
-      return predictVelocity(plant, s, substeps, observer, yhat, deflection);
-    } catch (const std::invalid_argument&) {
-      return false;
-    }
-  }
-
-  bool evaluate(const Eigen::VectorXd& phi, Eigen::VectorXd& eps, Eigen::MatrixXd* psi) const {
-    if (cancel && cancel->load()) return false;
-    std::vector<double> yhat;
-    if (!simulate(phi, *series, yhat)) return false;
-    const Eigen::Index N = static_cast<Eigen::Index>(yhat.size());
-    eps.resize(N);
-    for (Eigen::Index k = 0; k < N; ++k) eps[k] = series->y[static_cast<std::size_t>(k)] - yhat[static_cast<std::size_t>(k)];
-    if (!psi) return true;
-    psi->resize(N, static_cast<Eigen::Index>(coords.size()));
-    std::vector<double> y2;
-    for (std::size_t j = 0; j < coords.size(); ++j) {
-      Eigen::VectorXd p2 = phi;
-      double d = coords[j].step(phi[static_cast<Eigen::Index>(j)]);
-      p2[static_cast<Eigen::Index>(j)] += d;
-      coords[j].project(p2[static_cast<Eigen::Index>(j)]);
-      d = p2[static_cast<Eigen::Index>(j)] - phi[static_cast<Eigen::Index>(j)];
-      if (d == 0.0 || !simulate(p2, *series, y2)) {
-        d = -coords[j].step(phi[static_cast<Eigen::Index>(j)]);
-        p2[static_cast<Eigen::Index>(j)] = phi[static_cast<Eigen::Index>(j)] + d;
-        if (!simulate(p2, *series, y2)) return false;
-      }
-      for (Eigen::Index k = 0; k < N; ++k)
-        (*psi)(k, static_cast<Eigen::Index>(j)) = (y2[static_cast<std::size_t>(k)] - yhat[static_cast<std::size_t>(k)]) / d;
-    }
-    return true;
-  }
-
-  LeastSquaresSolution solve(const Eigen::VectorXd& phi0, int iterations) const {
-    LeastSquaresProblem lsp;
-    lsp.evaluate = [this](const Eigen::VectorXd& phi, Eigen::VectorXd& eps, Eigen::MatrixXd* psi) {
-      return evaluate(phi, eps, psi);
-    };
-    lsp.project = [this](Eigen::VectorXd& phi) {
-      for (std::size_t i = 0; i < coords.size(); ++i) coords[i].project(phi[static_cast<Eigen::Index>(i)]);
-    };
-    const std::atomic<bool>* c = cancel;
-    return levenbergMarquardt(lsp, phi0, iterations, 1e-7, 1e-3,
-                              [c](double, const std::string&) {
-                                return c && c->load() ? ProgressAction::Abort : ProgressAction::Continue;
-                              });
-  }
-};
-
-// Coordinates of the free base parameters (logarithmic for positive ones).
-std::vector<Coordinate> baseCoordinates(const PhysicalModel& m) {
-  std::vector<Coordinate> out;
-  const auto& ps = m.parameters();
-  for (std::size_t i = 0; i < ps.size(); ++i) {
-    if (!ps[i].free) continue;
-    Coordinate c;
-    c.index = static_cast<int>(i);
-    if (ps[i].lower >= 0.0 && ps[i].value > 0.0) {
-      c.map = Map::Log;
-    } else {
-      c.map = Map::Scaled;
-      c.scale = std::max(std::abs(ps[i].value), 1e-6);
-    }
-    out.push_back(c);
-  }
-  return out;
-}
-
-Eigen::VectorXd coordinatesOf(const Problem& pr, const Effect& e) {
-  Eigen::VectorXd phi(static_cast<Eigen::Index>(pr.coords.size()));
-  const auto& ps = pr.base->parameters();
-  for (std::size_t i = 0; i < pr.coords.size(); ++i) {
-    const auto& c = pr.coords[i];
-    const double v = c.base ? ps[static_cast<std::size_t>(c.index)].value
-                            : e.values[static_cast<std::size_t>(c.index)];
-    phi[static_cast<Eigen::Index>(i)] = c.toPhi(v);
-  }
-  return phi;
 }
 
 // The 99th percentile of |a|.
@@ -421,11 +200,11 @@ struct FitOutcome {
   double inflation = 1.0;
 };
 
-FitOutcome finish(const Problem& pr, LeastSquaresSolution sol) {
+FitOutcome finish(const NonlinearProblem& pr, LeastSquaresSolution sol) {
   FitOutcome f;
   auto built = pr.build(sol.phi);
   f.model = std::move(built.first);
-  f.effect = built.second.empty() ? pr.fixedEffect : built.second.front();
+  f.effect = built.second.empty() ? Effect{} : built.second.front();
   if (sol.eps.size() > 0) {
     f.inflation = correlationInflation(sol.eps);
     f.covariance = gaussNewtonCovariance(sol.psi, sol.sumSquares);
@@ -457,24 +236,24 @@ struct CandidateWork {
 // linear refit has bent its parameters to imitate (a soft spring for a backlash gap) is
 // found again from the engineer's values.
 void fitCandidate(EffectKind kind, const PhysicalModel& base, const PhysicalModel& nominal,
-                  const Series& est, const Series* val, const DiscoveryOptions& o,
-                  int substeps, const Observer& observer, double residualPeakRadS,
+                  const NonlinearSeries& est, const NonlinearSeries* val, const DiscoveryOptions& o,
+                  int substeps, const LoadObserver& observer, double residualPeakRadS,
                   double baseResonance, double gapRange, const std::vector<double>& eBase,
                   const std::atomic<bool>& cancel, CandidateWork& w) {
-  Problem pr;
+  NonlinearProblem pr;
   pr.base = &base;
-  pr.kind = kind;
-  pr.fixedEffect = Effect::withDefaults(kind);
-  pr.series = &est;
+  pr.effects = {Effect::withDefaults(kind)};
+  pr.series = {&est};
   pr.substeps = substeps;
   pr.observer = observer;
   pr.cancel = &cancel;
   pr.coords = baseCoordinates(base);
   const auto& info = effectParameters(kind);
   // Effect coordinates, started well away from the defaults (half of them, or a grid).
-  auto addEffect = [&pr, &info](int index, Map map) {
-    Coordinate c;
+  auto addEffect = [&pr, &info](int index, CoordinateMap map) {
+    NonlinearCoordinate c;
     c.base = false;
+    c.rough = true;
     c.index = index;
     c.map = map;
     c.scale = std::abs(info[static_cast<std::size_t>(index)].defaultValue);
@@ -482,11 +261,11 @@ void fitCandidate(EffectKind kind, const PhysicalModel& base, const PhysicalMode
   };
   std::vector<Effect> starts;
   std::vector<const PhysicalModel*> startModels;  // base parameters of each start (default: base)
-  Effect e0 = pr.fixedEffect;
+  Effect e0 = pr.effects.front();
   int extraCount = 0;  // parameters chosen on a grid (count in the penalty)
   switch (kind) {
     case EffectKind::CoulombFriction:
-      addEffect(0, Map::NonNegative);
+      addEffect(0, CoordinateMap::NonNegative);
       e0.values[0] = 0.5 * info[0].defaultValue;
       starts.push_back(e0);
       break;
@@ -496,7 +275,7 @@ void fitCandidate(EffectKind kind, const PhysicalModel& base, const PhysicalMode
       // both the refitted base and the engineer's values; the best three grid points start
       // the screening fits. A gap wider than the travel is a motor that never meets the arm:
       // its loss is flat in b and its interval does not exclude zero.
-      addEffect(0, Map::Log);
+      addEffect(0, CoordinateMap::Log);
       const double range = std::max(gapRange, 1e-3 * info[0].defaultValue);
       pr.coords.back().minPhi = std::log(1e-3 * range);
       pr.coords.back().maxPhi = std::log(range);
@@ -510,12 +289,12 @@ void fitCandidate(EffectKind kind, const PhysicalModel& base, const PhysicalMode
       const int points = 32;
       auto gapAt = [range, points](double i) { return range * std::pow(10.0, -2.0 + 2.0 * i / (points - 1)); };
       for (const PhysicalModel* m : {&base, &nominal}) {
-        Problem gp = pr;
+        NonlinearProblem gp = pr;
         gp.base = m;
         auto lossAt = [&gp, &e0, &est, &yhat](double gap) {
           Effect e = e0;
           e.values[0] = gap;
-          return gp.simulate(coordinatesOf(gp, e), est, yhat) ? rms(est.y, yhat) : INFINITY;
+          return gp.simulate(gp.coordinatesOf({e}), est, yhat) ? rms(est.y, yhat) : INFINITY;
         };
         double bestLoss = INFINITY;
         int best = -1;
@@ -560,14 +339,14 @@ void fitCandidate(EffectKind kind, const PhysicalModel& base, const PhysicalMode
     case EffectKind::NonlinearSpring:
     case EffectKind::InputDelay:
       // Responses far from linear in the value: a few starts over a decade.
-      addEffect(0, Map::NonNegative);
+      addEffect(0, CoordinateMap::NonNegative);
       for (double f : {0.2, 0.5, 1.2}) {
         e0.values[0] = f * info[0].defaultValue;
         starts.push_back(e0);
       }
       break;
     case EffectKind::TorqueRipple: {
-      addEffect(0, Map::NonNegative);
+      addEffect(0, CoordinateMap::NonNegative);
       extraCount = 1;
       e0.values[0] = 0.5 * info[0].defaultValue;
       for (int n = 1; n <= 12; ++n) {
@@ -578,13 +357,13 @@ void fitCandidate(EffectKind kind, const PhysicalModel& base, const PhysicalMode
       break;
     }
     case EffectKind::ExtraMass: {
-      addEffect(0, Map::Log);
+      addEffect(0, CoordinateMap::Log);
       // The new mode lies within a band around the base model's resonance that the data
       // inform (0.25 to 6 times it): far below it a mass on a very soft spring would stand
       // for a motor running free of the arm, which is not a mass the arm has.
       pr.coords.back().minPhi = std::log(0.25 * baseResonance);
       pr.coords.back().maxPhi = std::log(6.0 * baseResonance);
-      addEffect(1, Map::Fraction);
+      addEffect(1, CoordinateMap::Fraction);
       std::vector<double> omegas = {0.5 * baseResonance, 0.8 * baseResonance,
                                     1.3 * baseResonance, 2.0 * baseResonance};
       if (residualPeakRadS > 1.2 * baseResonance) omegas.push_back(residualPeakRadS);
@@ -605,13 +384,13 @@ void fitCandidate(EffectKind kind, const PhysicalModel& base, const PhysicalMode
     for (std::size_t i = 0; i < starts.size(); ++i) {
       if (cancel.load()) break;
       const Effect& s = starts[i];
-      Problem sp = pr;
+      NonlinearProblem sp = pr;
       if (i < startModels.size()) sp.base = startModels[i];
-      sp.fixedEffect = s;
+      sp.effects = {s};
       if (kind == EffectKind::TorqueRipple) {
         sp.coords.erase(sp.coords.begin(), sp.coords.end() - 1);  // A only
       }
-      auto sol = sp.solve(coordinatesOf(sp, s), 3);
+      auto sol = sp.solve(sp.coordinatesOf({s}), 3);
       if (sol.eps.size() && sol.sumSquares < bestSum) {
         bestSum = sol.sumSquares;
         auto built = sp.build(sol.phi);
@@ -620,9 +399,9 @@ void fitCandidate(EffectKind kind, const PhysicalModel& base, const PhysicalMode
       }
     }
   }
-  pr.fixedEffect = bestStart;
+  pr.effects = {bestStart};
   const Eigen::VectorXd phi0 =
-      bestSol.phi.size() ? bestSol.phi : coordinatesOf(pr, bestStart);
+      bestSol.phi.size() ? bestSol.phi : pr.coordinatesOf({bestStart});
   FitOutcome f = finish(pr, pr.solve(phi0, o.candidateIterations));
   CandidateFit& c = w.fit;
   c.kind = kind;
@@ -727,7 +506,7 @@ DiscoveryResult discoverMissingEffect(const PhysicalModel& base, const IdData& e
   };
   auto est = makeSeries(estimation, o.maxRateHz, &why);
   if (!est) return done(Termination::Failed, "estimation data: " + why);
-  std::optional<Series> val;
+  std::optional<NonlinearSeries> val;
   if (validation) {
     val = makeSeries(*validation, o.maxRateHz, &why);
     if (!val) return done(Termination::Failed, "validation data: " + why);
@@ -736,10 +515,9 @@ DiscoveryResult discoverMissingEffect(const PhysicalModel& base, const IdData& e
   }
   R.sampleTime = est->Ts;
   R.hasValidation = val.has_value();
-  const Series* valp = val ? &*val : nullptr;
-  const int substeps = o.substeps > 0 ? o.substeps
-                                      : std::max(2, static_cast<int>(std::ceil(est->Ts / 2.5e-4 - 1e-9)));
-  const Observer observer{2.0 * M_PI * o.observerBandwidthHz,
+  const NonlinearSeries* valp = val ? &*val : nullptr;
+  const int substeps = o.substeps > 0 ? o.substeps : defaultSubsteps(est->Ts);
+  const LoadObserver observer{2.0 * M_PI * o.observerBandwidthHz,
                           totalInertia(base) / base.value("k_T")};
   std::atomic<bool> cancel{false};
   std::mutex progressMutex;
@@ -752,15 +530,15 @@ DiscoveryResult discoverMissingEffect(const PhysicalModel& base, const IdData& e
   report(0.0, "fitting the base model");
   std::unique_ptr<PhysicalModel> baseCopy(static_cast<PhysicalModel*>(base.clone().release()));
   baseCopy->setOptions(ModelOptions{});
-  Problem bp;
+  NonlinearProblem bp;
   bp.base = baseCopy.get();
-  bp.series = &*est;
+  bp.series = {&*est};
   bp.substeps = substeps;
   bp.observer = observer;
   bp.cancel = &cancel;
   bp.coords = baseCoordinates(*baseCopy);
   if (bp.coords.empty()) return done(Termination::Failed, "the base model has no free parameter");
-  FitOutcome bf = finish(bp, bp.solve(coordinatesOf(bp, Effect{}), o.baseIterations));
+  FitOutcome bf = finish(bp, bp.solve(bp.coordinatesOf({}), o.baseIterations));
   if (cancel.load()) return done(Termination::Cancelled, "cancelled by the user");
   if (!bf.sol.summary.ok() || bf.sol.eps.size() == 0)
     return done(Termination::Failed, "the base model could not be fitted: " + bf.sol.summary.message);
@@ -770,10 +548,10 @@ DiscoveryResult discoverMissingEffect(const PhysicalModel& base, const IdData& e
   const std::size_t N = est->y.size();
   std::vector<double> yBase, deflection, yBaseVal;
   {
-    Problem fixedBase = bp;
+    NonlinearProblem fixedBase = bp;
     fixedBase.base = baseFit.get();
-    fixedBase.simulate(coordinatesOf(fixedBase, Effect{}), *est, yBase, &deflection);
-    if (valp) fixedBase.simulate(coordinatesOf(fixedBase, Effect{}), *valp, yBaseVal);
+    fixedBase.simulate(fixedBase.coordinatesOf({}), *est, yBase, &deflection);
+    if (valp) fixedBase.simulate(fixedBase.coordinatesOf({}), *valp, yBaseVal);
   }
   std::vector<double> eBase(N);
   for (std::size_t k = 0; k < N; ++k) eBase[k] = est->y[k] - yBase[k];

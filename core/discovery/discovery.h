@@ -13,7 +13,9 @@
 // velocity error, bandwidth of about 1 Hz) keeps the simulation on the measured operating
 // point, so that friction and backlash are evaluated where the arm really was; the ripple is
 // positioned by the measured motor angle. The parameters minimize V_N = (1/N) sum eps^2 (4.6)
-// by Levenberg-Marquardt (4.17)-(4.21) with a finite-difference gradient psi.
+// by Levenberg-Marquardt (4.17)-(4.21) with a finite-difference gradient psi: the nonlinear
+// grey-box estimator of core/ident/nonlinear_pem.h, the same one `flexarm fit --effect` runs.
+// The augmented model (base plus effect) is what the fit pipeline refines (FitModelSpec).
 #include <memory>
 #include <optional>
 #include <string>

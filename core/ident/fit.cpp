@@ -52,6 +52,23 @@ bool FitModelSpec::isValid(std::string* why) const {
       if (!start) return fail("a physical fit needs its start model");
       bool anyFree = false;
       for (const auto& p : start->parameters()) anyFree = anyFree || p.free;
+      std::vector<bool> seen(allEffectKinds().size(), false);
+      for (const auto& f : effects) {
+        std::string reason;
+        if (!f.effect.isValid(&reason)) return fail(reason);
+        const std::string name = toString(f.effect.kind);
+        if (f.effect.kind == EffectKind::ExtraMass)
+          return fail("extra_mass changes the structure; fit the larger structure instead");
+        if (seen[static_cast<std::size_t>(f.effect.kind)]) return fail("the effect " + name + " is given twice");
+        seen[static_cast<std::size_t>(f.effect.kind)] = true;
+        if ((f.effect.kind == EffectKind::Backlash || f.effect.kind == EffectKind::NonlinearSpring) &&
+            (start->topology().gearStiffness.empty() || start->structureName() == "two-mass-theta"))
+          return fail(name + " needs a model with a gear spring (two-mass, three-mass or four-mass), not " +
+                      start->structureName());
+        for (std::size_t k = 0; k < effectParameters(f.effect.kind).size(); ++k) anyFree = anyFree || f.free[k];
+      }
+      if (!effects.empty() && start->options().armAcceleration)
+        return fail("a fit with effects takes one output (the motor velocity or angle), not the arm acceleration");
       if (!anyFree) return fail("a physical fit needs at least one free parameter");
       return true;
     }
@@ -70,7 +87,11 @@ bool FitModelSpec::isValid(std::string* why) const {
 
 std::string FitModelSpec::name() const {
   switch (kind) {
-    case FitModelKind::Physical: return start ? start->structureName() : "physical";
+    case FitModelKind::Physical: {
+      std::string n = start ? start->structureName() : "physical";
+      for (const auto& f : effects) n += std::string(" + ") + toString(f.effect.kind);
+      return n;
+    }
     case FitModelKind::BlackBox: return PolynomialModel::zero(structure, orders, 1.0).name();
     case FitModelKind::Spa: return "spa";
     case FitModelKind::Etfe: return "etfe";
@@ -114,6 +135,11 @@ bool FitOptions::isValidExceptData(std::string* why) const {
                   " closed-loop fit is output error; it excludes the innovations form");
     if (closedLoop == ClosedLoopChoice::Indirect && decimation > 1)
       return fail("the indirect closed-loop fit runs at the controller's rate; it excludes decimation");
+    if (model.nonlinear() && noiseModel != NoiseModel::OutputError)
+      return fail("a fit with effects is output error (5.7); it excludes the innovations form");
+    if (model.nonlinear() && closedLoop != ClosedLoopChoice::Auto && closedLoop != ClosedLoopChoice::Direct)
+      return fail(std::string("a fit with effects simulates the plant from the measured torque (the direct fit); "
+                              "it excludes the ") + toString(closedLoop) + " closed-loop fit");
     if (controller && !controller->isValid(why)) return false;
     if (!controllerIdent.isValid(why)) return false;
     try {
@@ -233,7 +259,7 @@ bool fitBlackBox(const FitOptions& o, FitResult& r, const ProgressCallback& prog
   for (std::size_t i = 0; i < names.size(); ++i) {
     const auto k = static_cast<Eigen::Index>(i);
     const double s = sd.size() > k ? sd[k] : 0.0;
-    r.parameters.push_back({names[i], "", th[k], s, th[k] - z * s, th[k] + z * s, true});
+    r.parameters.push_back({names[i], "", th[k], s, th[k] - z * s, th[k] + z * s, true, ""});
   }
   r.polynomial = std::make_shared<PolynomialModel>(std::move(e.model));
   return true;
@@ -359,7 +385,8 @@ FitResult fitModel(const FitOptions& options, const ProgressCallback& progress) 
   // is the logged torque's mean over the sample period (fit_data.h).
   if (options.model.kind == FitModelKind::Physical)
     d.decimatedInput = FitDataOptions::DecimatedInput::HeldMean;
-  d.removeMeans = options.removeMeans;
+  // The effects act on the real torque, velocity and angle: their means stay.
+  d.removeMeans = options.removeMeans && !options.model.nonlinear();
   r.badData = !prepareEstimation(options, d, r) || !prepareValidation(options, d, r);
   if (r.badData) return finish(r.termination, r.message);
   const bool nonparametric = options.model.kind == FitModelKind::Spa || options.model.kind == FitModelKind::Etfe;
@@ -376,7 +403,11 @@ FitResult fitModel(const FitOptions& options, const ProgressCallback& progress) 
   try {
     switch (options.model.kind) {
       case FitModelKind::Physical:
-        if (!fit_detail::fitPhysical(options, r, progress)) return finish(r.termination, r.message);
+        if (options.model.nonlinear()) {
+          fit_detail::fitNonlinear(options, r, progress);
+        } else if (!fit_detail::fitPhysical(options, r, progress)) {
+          return finish(r.termination, r.message);
+        }
         break;
       case FitModelKind::BlackBox: {
         std::string tooMuch;

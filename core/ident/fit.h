@@ -30,6 +30,7 @@
 #include "core/ident/closed_loop_pem.h"
 #include "core/ident/controller_ident.h"
 #include "core/ident/fit_data.h"
+#include "core/ident/nonlinear_pem.h"
 #include "core/ident/nonparametric.h"
 #include "core/ident/pem.h"
 #include "core/ident/residuals.h"
@@ -46,14 +47,23 @@ struct FitModelSpec {
   FitModelKind kind = FitModelKind::BlackBox;
   // Physical: the start model (structure, output, start values, free flags).
   std::shared_ptr<const PhysicalModel> start;
+  // Physical: named effects (core/models/effects.h) switched on in the start model, their
+  // values free or fixed. Any effect makes the fit the nonlinear grey-box estimator
+  // (core/ident/nonlinear_pem.h): the plant simulated by Runge-Kutta from the measured torque,
+  // output error (5.7), each experiment from rigid-body motion at its first sample's speed,
+  // the direct fit of closed-loop logs, the means of the data kept (friction acts on the real
+  // velocity); not with the innovations form or the arm acceleration output. The response,
+  // notches and peaks are the linear part's.
+  std::vector<FitEffect> effects;
   // Black-box: the structure (4.8) and its orders.
   PolyStructure structure = PolyStructure::Oe;
   PolyOrders orders;
   // Spa: the lag window M; Etfe: the smoothing width; 0: the default.
   int windowWidth = 0;
   bool isValid(std::string* why) const;
-  // "three-mass", "oe[2 2 1]", "spa", "etfe".
+  // "three-mass", "three-mass + coulomb_friction", "oe[2 2 1]", "spa", "etfe".
   std::string name() const;
+  bool nonlinear() const { return kind == FitModelKind::Physical && !effects.empty(); }
   // The output the model gives is the motor velocity (Section 5.2), so a logged motor angle
   // is differentiated first.
   bool wantsVelocity() const;
@@ -149,6 +159,7 @@ struct FitParameter {
   std::string name, unit;
   double value = 0.0, std = 0.0, lower = 0.0, upper = 0.0;  // interval at FitOptions::level
   bool free = false;
+  std::string effect;  // the effect it belongs to ("coulomb_friction"); empty: the model's
 };
 
 // The evaluation on one experiment. Validation: data with the estimation data's means, fit %
@@ -192,8 +203,12 @@ struct FitResult {
 
   EstimateSummary summary;
   std::shared_ptr<const PhysicalModel> physical;  // physical estimate (the start's output)
+  std::vector<Effect> effects;                    // the effects' estimated values
   Eigen::VectorXd K;                              // innovations gain (empty: output error)
   Eigen::MatrixXd covariance;                     // of physical->parameters()[freeIndices]
+  // With effects: the covariance of every free parameter, the model's (freeIndices order)
+  // then the effects' free values (in FitModelSpec::effects order).
+  Eigen::MatrixXd fullCovariance;
   std::vector<int> freeIndices;
   CovarianceKind covarianceKind = CovarianceKind::White;
   std::shared_ptr<const PolynomialModel> polynomial;  // black-box estimate

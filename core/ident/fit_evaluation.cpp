@@ -18,15 +18,26 @@ const char* const kDecimatedCoverage = "175 of 400";
 const char* const kDecimatedBias = "4-6 % low";
 const char* const kDirectCoverage = "8 of 30";
 
-// Output simulated from zero initial state: the ZOH simulation of a physical model (5.3) or
-// B/(A F) u of a black-box one.
-Eigen::VectorXd simulated(const FitResult& r, const Eigen::VectorXd& u) {
+// Output simulated over range of d: the ZOH simulation of a physical model (5.3) or B/(A F) u
+// of a black-box one from zero initial state; a physical model with effects by the nonlinear
+// estimator's simulation (from rigid-body motion at the range's first speed). Empty when the
+// nonlinear simulation blows up.
+Eigen::VectorXd simulated(const FitOptions& o, const FitResult& r, const PreparedData& d, SampleRange range) {
+  const auto b = static_cast<Eigen::Index>(range.begin), n = static_cast<Eigen::Index>(range.size());
+  if (r.physical && !r.effects.empty()) {
+    const Eigen::VectorXd y = simulateNonlinear(*r.physical, r.effects, nonlinearSeries(r, d, range), nonlinearOptions(o));
+    return y.size() ? y : Eigen::VectorXd::Constant(n, NAN);
+  }
+  const Eigen::VectorXd u = d.u.segment(b, n);
   return r.physical ? simulate(*r.physical, u, r.data.sampleTime) : simulate(*r.polynomial, u);
 }
 
 // Prediction errors for the residual tests: output errors y - G u of a physical model (one-step
-// errors of its innovations form when K is estimated), one-step errors (4.5) of a black-box one.
-Eigen::VectorXd residualsOf(const FitResult& r, const PreparedData& d) {
+// errors of its innovations form when K is estimated; with effects, of the nonlinear
+// simulation), one-step errors (4.5) of a black-box one.
+Eigen::VectorXd residualsOf(const FitOptions& o, const FitResult& r, const PreparedData& d) {
+  if (r.physical && !r.effects.empty())
+    return d.y - simulated(o, r, d, SampleRange{0, static_cast<std::size_t>(d.u.size())});
   return r.physical ? predictionErrors(*r.physical, r.K, d.u, d.y, d.sampleTime)
                     : predictionErrors(*r.polynomial, d.u, d.y);
 }
@@ -77,9 +88,10 @@ void evaluate(const FitOptions& o, FitResult& r) {
     double errors = 0.0, deviations = 0.0;
     for (auto& e : r.estimation) {
       const Eigen::VectorXd yEst = e.data.estimationOutput();
-      const Eigen::VectorXd ySim = simulated(r, e.data.estimationInput());
+      const Eigen::VectorXd ySim = simulated(o, r, e.data, e.data.estimation);
       const double fe = fitPercent(yEst, ySim);
-      e.simulated = simulated(r, e.data.u);  // from the log's first sample
+      const SampleRange whole{0, static_cast<std::size_t>(e.data.u.size())};
+      e.simulated = simulated(o, r, e.data, whole);  // from the log's first sample
       if (std::isfinite(fe)) e.fitPercent = fe;
       else finite = false;
       errors += (yEst - ySim).squaredNorm();
@@ -91,7 +103,7 @@ void evaluate(const FitOptions& o, FitResult& r) {
     finite = finite && std::isfinite(fe);
     if (finite) r.fitEstimation = fe;
     for (auto& v : r.validation) {
-      v.simulated = simulated(r, v.data.u);
+      v.simulated = simulated(o, r, v.data, SampleRange{0, static_cast<std::size_t>(v.data.u.size())});
       const double fv = fitPercent(v.data.y, v.simulated, static_cast<Eigen::Index>(v.data.validation.begin),
                                    static_cast<Eigen::Index>(v.data.validation.end));
       if (std::isfinite(fv)) v.fitPercent = fv;
@@ -111,7 +123,7 @@ void evaluate(const FitOptions& o, FitResult& r) {
     ro.level = 0.99;
     const auto b = static_cast<Eigen::Index>(range.begin), n = static_cast<Eigen::Index>(range.size());
     if (n >= 2 * ro.maxLag + 10) {
-      const Eigen::VectorXd eps = residualsOf(r, on);
+      const Eigen::VectorXd eps = residualsOf(o, r, on);
       if (eps.segment(b, n).allFinite()) {
         r.residuals = residualAnalysis(eps.segment(b, n), on.u.segment(b, n), ro);
         r.residualsOnValidation = !r.validation.empty();
@@ -129,7 +141,7 @@ void evaluate(const FitOptions& o, FitResult& r) {
   }
   if (nonparametric && !r.nonparametric.warning.empty()) r.warnings.push_back(r.nonparametric.warning);
   if (r.method == ClosedLoopMethod::Direct && d.closedLoop &&
-      (o.closedLoop == ClosedLoopChoice::Direct ||
+      (o.closedLoop == ClosedLoopChoice::Direct || o.model.nonlinear() ||
        (r.estimation.size() > 1 && o.noiseModel == NoiseModel::OutputError)))
     r.warnings.push_back(std::string("the log was recorded in closed loop: only models with a flexible, "
                                      "independently parameterized noise model (BJ) are free of bias (4.43); "

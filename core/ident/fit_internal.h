@@ -17,6 +17,20 @@ JoinedEstimation joinedEstimation(const FitResult& result);
 // parameter rows; on a data failure sets termination and message and returns false.
 bool fitPhysical(const FitOptions& options, FitResult& result, const ProgressCallback& progress);
 
+// A warning for each free parameter of result that ended on one of its bounds (start: the
+// model the search started from, whose bounds it kept).
+void boundWarnings(const PhysicalModel& start, FitResult& result);
+
+// Steps 2-4 for physical models with effects: the nonlinear grey-box estimator over every
+// estimation experiment (nonlinear_pem.h). Fills the estimate, its effects and parameter rows.
+void fitNonlinear(const FitOptions& options, FitResult& result, const ProgressCallback& progress);
+
+// One experiment of prepared data over range as the nonlinear estimator sees it: the output
+// the model gives (velocity or angle), the logged angle when there is one, and a start in
+// rigid-body motion at the speed of the range's first sample.
+NonlinearSeries nonlinearSeries(const FitResult& result, const PreparedData& data, SampleRange range);
+NonlinearPemOptions nonlinearOptions(const FitOptions& options);
+
 // Step 5: fit % on every experiment, residual tests, response, notches and peaks, warnings.
 void evaluate(const FitOptions& options, FitResult& result);
 

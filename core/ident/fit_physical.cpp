@@ -99,6 +99,26 @@ std::string number(double v) {
   return buf;
 }
 
+void keepEstimate(PemResult&& e, const FitOptions& o, FitResult& r) {
+  (void)o;
+  r.summary = e.summary;
+  if (e.skippedStarts > 0)
+    r.warnings.push_back(std::to_string(e.skippedStarts) + " of " + std::to_string(e.starts) +
+                         " starts were skipped for numerical trouble (" + e.skipReason + ")");
+  for (const auto& p : e.parameters)
+    r.parameters.push_back({p.name, p.unit, p.value, p.std, p.lower, p.upper, p.free, ""});
+  r.physical = std::shared_ptr<const PhysicalModel>(static_cast<PhysicalModel*>(e.model.release()));
+  r.K = e.K;
+  r.covarianceKind = e.covarianceKind;
+  const auto pf = static_cast<Eigen::Index>(e.freeIndices.size());
+  if (pf > 0 && e.covariance.rows() >= pf) {
+    r.covariance = e.covariance.topLeftCorner(pf, pf);
+    r.freeIndices = e.freeIndices;
+  }
+}
+
+}  // namespace
+
 // A warning for each free parameter that ended on one of its bounds (start: the model the
 // search started from, whose bounds it kept).
 void boundWarnings(const PhysicalModel& start, FitResult& r) {
@@ -120,25 +140,6 @@ void boundWarnings(const PhysicalModel& start, FitResult& r) {
                          "widen the bound to let it go further)");
   }
 }
-
-void keepEstimate(PemResult&& e, const FitOptions& o, FitResult& r) {
-  (void)o;
-  r.summary = e.summary;
-  if (e.skippedStarts > 0)
-    r.warnings.push_back(std::to_string(e.skippedStarts) + " of " + std::to_string(e.starts) +
-                         " starts were skipped for numerical trouble (" + e.skipReason + ")");
-  for (const auto& p : e.parameters) r.parameters.push_back({p.name, p.unit, p.value, p.std, p.lower, p.upper, p.free});
-  r.physical = std::shared_ptr<const PhysicalModel>(static_cast<PhysicalModel*>(e.model.release()));
-  r.K = e.K;
-  r.covarianceKind = e.covarianceKind;
-  const auto pf = static_cast<Eigen::Index>(e.freeIndices.size());
-  if (pf > 0 && e.covariance.rows() >= pf) {
-    r.covariance = e.covariance.topLeftCorner(pf, pf);
-    r.freeIndices = e.freeIndices;
-  }
-}
-
-}  // namespace
 
 bool fitPhysical(const FitOptions& o, FitResult& r, const ProgressCallback& progress) {
   const PreparedData& d = r.data;

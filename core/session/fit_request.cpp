@@ -45,7 +45,14 @@ json fitRequestToJson(const FitRequest& r) {
             {"validation_s", secondsRangeToJson(r.validation)}};
   if (r.physical()) {
     j["kind"] = toString(FitModelKind::Physical);
-    j["start"] = modelToJson(r.name, *o.model.start, {});
+    std::vector<Effect> effects;
+    json free = json::array();
+    for (const auto& f : o.model.effects) {
+      effects.push_back(f.effect);
+      free.push_back({f.free[0], f.free[1]});
+    }
+    j["start"] = modelToJson(r.name, *o.model.start, effects);
+    if (!effects.empty()) j["effects_free"] = free;
     j["noise_model"] = toString(o.noiseModel);
     j["closed_loop"] = toString(o.closedLoop);
     j["random_starts"] = o.randomStarts;
@@ -91,6 +98,22 @@ std::optional<FitRequest> fitRequestFromJson(const json& j, std::string* why) {
     auto spec = modelFromJson(j["start"], &reason);
     if (!spec) return fail(where + reason);
     o.model.start = spec->model;
+    // The start model's effects, each value free or fixed as "effects_free" says (absent: the
+    // first value free, the others fixed).
+    const json* free = j.contains("effects_free") ? &j["effects_free"] : nullptr;
+    if (free && (!free->is_array() || free->size() != spec->effects.size()))
+      return fail(where + "effects_free must list one pair of flags per effect of the start model");
+    for (std::size_t i = 0; i < spec->effects.size(); ++i) {
+      FitEffect f = FitEffect::defaults(spec->effects[i].kind);
+      f.effect = spec->effects[i];
+      if (free) {
+        const json& flags = (*free)[i];
+        if (!flags.is_array() || flags.size() != 2 || !flags[0].is_boolean() || !flags[1].is_boolean())
+          return fail(where + "effects_free must list one pair of flags per effect of the start model");
+        f.free = {flags[0].get<bool>(), flags[1].get<bool>()};
+      }
+      o.model.effects.push_back(f);
+    }
     if (j.contains("noise_model")) {
       auto m = j["noise_model"].is_string() ? noiseModelFromString(j["noise_model"].get<std::string>())
                                             : std::nullopt;

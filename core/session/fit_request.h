@@ -34,7 +34,8 @@ struct FitRequest {
 FitOptions fitOptionsOf(const FitRequest& request, std::shared_ptr<const IdData> data);
 
 // {"name", "kind": "physical" | "black-box", "decimation", "max_iterations", "estimation_s",
-// "validation_s", physical: "start" (a model), "noise_model", "closed_loop" ("auto", "direct",
+// "validation_s", physical: "start" (a model with its effects), "effects_free" (per effect,
+// [first value free, second value free]; absent without effects), "noise_model", "closed_loop" ("auto", "direct",
 // "two-stage", "indirect"; absent in sessions written before it: "direct"), "random_starts",
 // "seed", optional "start_values" {name: value} and "bounds" {name: [lower, upper], null an
 // open end}; black-box: "structure", "orders"}.

@@ -156,7 +156,13 @@ class FitsPart : public SessionPart {
       std::string free;
       for (const auto& p : o.model.start->parameters())
         if (p.free) free += (free.empty() ? "" : ", ") + p.name + " from " + formatSignificant(p.value);
-      structure = o.model.start->structureName() + " grey-box model (5.3), prediction-error fit (5.7) in " +
+      for (const auto& f : o.model.effects)
+        for (std::size_t k = 0; k < effectParameters(f.effect.kind).size(); ++k)
+          if (f.free[k])
+            free += (free.empty() ? "" : ", ") + effectParameters(f.effect.kind)[k].name + " (" +
+                    toString(f.effect.kind) + ") from " + formatSignificant(f.effect.values[k]);
+      structure = o.model.name() + (o.model.nonlinear() ? " nonlinear" : "") +
+                  " grey-box model (5.3), prediction-error fit (5.7) in " +
                   (o.noiseModel == NoiseModel::OutputError ? "output-error form (K = 0)"
                                                            : "innovations form (K estimated)") +
                   "; free parameters (start values) " + free + "; the others held as listed" +
@@ -194,11 +200,12 @@ class FitsPart : public SessionPart {
                        {"Parameter", "Value", "+- std", "99 % lower", "99 % upper", "Unit"}, {}};
     json values = json::object(), stds = json::object();
     for (const auto& p : run.parameters) {
+      const std::string label = p.effect.empty() ? p.name : p.name + " (" + p.effect + ")";
       if (p.free)
-        params.rows.push_back({p.name, formatSignificant(p.value, 6), formatSignificant(p.std, 3),
+        params.rows.push_back({label, formatSignificant(p.value, 6), formatSignificant(p.std, 3),
                                formatSignificant(p.lower, 6), formatSignificant(p.upper, 6), p.unit});
       else
-        params.rows.push_back({p.name, formatSignificant(p.value, 6), "fixed", "", "", p.unit});
+        params.rows.push_back({label, formatSignificant(p.value, 6), "fixed", "", "", p.unit});
       values[p.name] = p.value;
       stds[p.name] = p.std;
     }

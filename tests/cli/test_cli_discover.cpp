@@ -34,6 +34,9 @@ TEST(CliDiscover, NamesTheRippleOfTheSampleLogWithItsEvidence) {
   EXPECT_GT(a["std"].get<double>(), 0.0);
   EXPECT_LE(std::abs(a["value"].get<double>() - A), 3.0 * a["std"].get<double>()) << a;
   EXPECT_EQ(j["effect_parameters"]["n"]["value"].get<double>(), 6.0);
+  // The augmented model's effect as `flexarm fit --effect` refines it.
+  ASSERT_EQ(j["augmented"]["effects"].size(), 1u);
+  EXPECT_EQ(j["augmented"]["effects"][0].get<std::string>().rfind("torque_ripple:", 0), 0u);
   ASSERT_EQ(j["candidates"].size(), 2u);
   for (const auto& c : j["candidates"]) {
     for (const char* key : {"effect", "loss_est", "rms_val", "aic", "significant"})

@@ -4,6 +4,7 @@
 // Compare fits, the residual tests, Cancel and the sensitivity study; screenshots of every
 // panel.
 #include <QApplication>
+#include <QCheckBox>
 #include <QComboBox>
 #include <QDockWidget>
 #include <QLineEdit>
@@ -22,6 +23,7 @@
 #include "app/main_window.h"
 #include "app/session_controller.h"
 #include "core/models/physical_models.h"
+#include "core/session/fit_request.h"
 #include "widget_test_support.h"
 #include "widgets/arm/vtk_view.h"
 #include "widgets/bode_panel.h"
@@ -391,6 +393,64 @@ class IdentificationTest : public QObject {
     showDock("fitDock");
     test::saveShot(fit->grab().toImage(), "fit_panel_study");
     test::saveShot(window_->grab().toImage(), "main_window_identification");
+  }
+
+  // Effects in the Fit panel: checking one adds its parameters to the free list, the estimate
+  // lists them with std devs and joins the model list with its effects; a list model brings
+  // its own effects (e.g. discovery's augmented model) for the fit to refine.
+  void effectsAreFittedWithTheModel() {
+    FitPanel* fit = window_->fitPanel();
+    showDock("fitDock");
+    QVERIFY(fit->setModelChoice("three-mass"));
+    auto* coulomb = fit->findChild<QCheckBox*>("effect_coulomb_friction_check");
+    QVERIFY(coulomb && coulomb->isEnabled());
+    coulomb->setChecked(true);
+    QCOMPARE(fit->effects(), QStringList{"coulomb_friction"});
+    auto* list = fit->findChild<QListWidget*>("freeParameterList");
+    QVERIFY(!list->findItems("F_c (coulomb_friction)", Qt::MatchExactly).isEmpty());
+    QCOMPARE(list->findItems("v_s (coulomb_friction)", Qt::MatchExactly).front()->checkState(), Qt::Unchecked);
+    fit->setFreeParameters({"J_m", "J_a", "k_g", "k_a", "F_c (coulomb_friction)"});
+    fit->setDecimation(10);
+    fit->setClosedLoopMethod(ClosedLoopChoice::Auto);
+    QVERIFY2(clickEstimate(fit), qPrintable(fit->summaryText()));
+    QTableWidget* t = fit->resultsTable();
+    QCOMPARE(t->rowCount(), static_cast<int>(makeModel("three-mass")->parameters().size()) + 2);
+    bool found = false;
+    for (int r = 0; r < t->rowCount(); ++r)
+      if (t->item(r, 0)->text() == "F_c (coulomb_friction)") {
+        found = true;
+        QVERIFY2(t->item(r, 2)->text().toDouble() > 0.0, qPrintable(t->item(r, 2)->text()));
+      }
+    QVERIFY(found);
+    QVERIFY2(fit->summaryText().contains("linear part"), qPrintable(fit->summaryText()));
+    const ModelEntry& estimate = window_->workspace()->models().back();
+    QCOMPARE(estimate.effects.size(), std::size_t{1});
+    QCOMPARE(estimate.effects[0].kind, EffectKind::CoulombFriction);
+    QVERIFY(estimate.fitRequest && estimate.fitRequest->options.model.effects.size() == 1);
+    // The panel at the size of a small laptop screen.
+    const QSize before = window_->size();
+    window_->resize(1366, 768);
+    QTest::qWait(200);
+    test::saveShot(window_->grab().toImage(), "fit_panel_effects_1366x768");
+    test::saveShot(fit->grab().toImage(), "fit_panel_effects");
+    window_->resize(before);
+
+    // A model of the list with its own effect: checked, its value the start.
+    ModelEntry withBacklash;
+    withBacklash.name = "two-mass with backlash";
+    withBacklash.model = makeModel("two-mass");
+    Effect b = Effect::withDefaults(EffectKind::Backlash);
+    b.values[0] = 3e-4;
+    withBacklash.effects = {b};
+    const int at = window_->workspace()->addModel(withBacklash);
+    QVERIFY(fit->setModelChoice(QString("list:%1").arg(at)));
+    QCOMPARE(fit->effects(), QStringList{"backlash"});
+    const auto items = list->findItems("b (backlash)", Qt::MatchExactly);
+    QCOMPARE(items.size(), 1);
+    QVERIFY(items.front()->toolTip().contains("0.0003"));
+    coulomb->setChecked(false);
+    QVERIFY(fit->setModelChoice("three-mass"));
+    QVERIFY(fit->effects().isEmpty());
   }
 
   void cleanupTestCase() { delete window_; }

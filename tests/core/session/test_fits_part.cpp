@@ -15,6 +15,7 @@
 #include "core/session/fit_request.h"
 #include "core/session/replay.h"
 #include "core/session/session.h"
+#include "tests/core/ident/nonlinear_logs.h"
 
 using namespace flexarm;
 using nlohmann::json;
@@ -326,4 +327,47 @@ TEST(FitsPart, IndirectRequestRecoversTheChirpTruthInsideItsIntervals) {
   const FitResult refused = runFitRequest(*back, decimate(read.data, d4));
   EXPECT_EQ(refused.termination, Termination::Failed);
   EXPECT_NE(refused.message.find("controller's rate"), std::string::npos) << refused.message;
+}
+
+// A physical fit with effects: the request keeps the start model's effects, their values and
+// which are free through its JSON form, and its replay on the log is the fit pipeline's
+// nonlinear fit, number for number; a malformed effects_free is refused with a sentence.
+TEST(FitRequest, EffectsRoundTripAndReplayAsTheFit) {
+  FitRequest p = physicalRequest(makeModel("three-mass"));
+  p.name = "three-mass + effects estimate";
+  FitEffect spring = FitEffect::defaults(EffectKind::NonlinearSpring);
+  spring.effect.values[0] = 1.5e6;
+  FitEffect coulomb = FitEffect::defaults(EffectKind::CoulombFriction);
+  coulomb.effect.values = {0.03, 0.2};
+  coulomb.free = {true, true};
+  p.options.model.effects = {spring, coulomb};
+  p.options.maxIterations = 6;
+  std::string why;
+  auto back = fitRequestFromJson(json::parse(fitRequestToJson(p).dump()), &why);
+  ASSERT_TRUE(back) << why;
+  ASSERT_EQ(back->options.model.effects.size(), 2u);
+  for (std::size_t i = 0; i < 2; ++i) {
+    const FitEffect& a = p.options.model.effects[i];
+    const FitEffect& b = back->options.model.effects[i];
+    EXPECT_EQ(a.effect.kind, b.effect.kind);
+    EXPECT_EQ(a.effect.values, b.effect.values);
+    EXPECT_EQ(a.free, b.free);
+  }
+  const IdData data = flexarm::testing::nonlinearLog(1200, 0, 21);
+  const FitResult replayed = runFitRequest(*back, data);
+  const std::shared_ptr<const IdData> view(&data, [](const IdData*) {});
+  const FitResult direct = fitModel(fitOptionsOf(p, view));
+  ASSERT_TRUE(replayed.ok()) << replayed.message;
+  ASSERT_EQ(replayed.parameters.size(), direct.parameters.size());
+  for (std::size_t i = 0; i < direct.parameters.size(); ++i) {
+    EXPECT_EQ(replayed.parameters[i].value, direct.parameters[i].value) << direct.parameters[i].name;
+    EXPECT_EQ(replayed.parameters[i].effect, direct.parameters[i].effect);
+  }
+  ASSERT_EQ(replayed.effects.size(), 2u);
+  EXPECT_EQ(replayed.effects[1].kind, EffectKind::CoulombFriction);
+
+  json bad = fitRequestToJson(p);
+  bad["effects_free"] = json::array({json::array({true, true})});
+  EXPECT_FALSE(fitRequestFromJson(bad, &why));
+  EXPECT_NE(why.find("effects_free"), std::string::npos) << why;
 }
