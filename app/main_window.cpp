@@ -113,7 +113,7 @@ MainWindow::MainWindow(QWidget* parent)
     : QMainWindow(parent), workspace_(new Workspace(this)), playhead_(new Playhead(this)),
       logPanel_(new LogPanel(workspace_, this)) {
   setObjectName("mainWindow");
-  setWindowTitle("FlexArm");
+  setWindowTitle("FlexArm[*]");
   setAcceptDrops(true);
   setCentralWidget(logPanel_);
   createMenus();
@@ -295,7 +295,11 @@ void MainWindow::openDialog() {
   const QString path = QFileDialog::getOpenFileName(
       this, tr("Open robot log"), settings.value("lastDir").toString(),
       tr("Robot logs (*.csv *.dat *.txt *.mat);;All files (*)"));
-  if (!path.isEmpty()) openFile(path);
+  if (!path.isEmpty()) requestOpenFile(path);
+}
+
+void MainWindow::requestOpenFile(const QString& path) {
+  if (session_->confirmReplace(tr("opening %1").arg(QFileInfo(path).fileName()))) openFile(path);
 }
 
 void MainWindow::openFile(const QString& path) {
@@ -357,7 +361,7 @@ void MainWindow::onReadFinished() {
   workspace_->setLog(std::move(r.data), readingPath_, readingOptions_);
   addRecent(readingPath_);
   QSettings().setValue("lastDir", QFileInfo(readingPath_).absolutePath());
-  setWindowTitle(QString("FlexArm - %1").arg(QFileInfo(readingPath_).fileName()));
+  setWindowTitle(QString("FlexArm - %1[*]").arg(QFileInfo(readingPath_).fileName()));
   statusBar()->showMessage(tr("Opened %1: %2 channels, %3 samples at %4 Hz (%5 s)")
                                .arg(QFileInfo(readingPath_).fileName())
                                .arg(channels)
@@ -434,7 +438,7 @@ void MainWindow::rebuildRecentMenu() {
   const QStringList list = recentFiles();
   for (int i = 0; i < list.size(); ++i) {
     QAction* a = recentMenu_->addAction(QString("&%1 %2").arg(i + 1).arg(QFileInfo(list[i]).fileName()),
-                                        this, [this, p = list[i]] { openFile(p); });
+                                        this, [this, p = list[i]] { requestOpenFile(p); });
     a->setToolTip(list[i]);
     if (i < 9) a->setShortcut(QKeySequence(QString("Alt+Shift+%1").arg(i + 1)));
   }
@@ -442,6 +446,10 @@ void MainWindow::rebuildRecentMenu() {
 }
 
 void MainWindow::closeEvent(QCloseEvent* e) {
+  if (!session_->confirmReplace(tr("closing the window"))) {
+    e->ignore();
+    return;
+  }
   QSettings settings;
   settings.setValue("window/geometry", saveGeometry());
   settings.setValue("window/state", saveState());
@@ -467,7 +475,7 @@ void MainWindow::dropEvent(QDropEvent* e) {
   const auto urls = e->mimeData()->urls();
   if (urls.isEmpty() || !urls.first().isLocalFile()) return;
   e->acceptProposedAction();
-  openFile(urls.first().toLocalFile());
+  requestOpenFile(urls.first().toLocalFile());
 }
 
 }  // namespace flexarm

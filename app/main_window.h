@@ -44,6 +44,9 @@ class MainWindow : public QMainWindow {
   void openFile(const QString& path);
   void openFile(const QString& path, const LogReadOptions& options);
   bool isOpening() const { return reader_.isRunning(); }
+  // Opens a log as File -> Open, a recent file or a drop does: with unsaved changes it first
+  // asks Save / Discard / Cancel (SessionController::confirmReplace); Cancel keeps everything.
+  void requestOpenFile(const QString& path);
 
   Workspace* workspace() const { return workspace_; }
   LogPanel* logPanel() const { return logPanel_; }

@@ -12,6 +12,7 @@
 #include <QMenuBar>
 #include <QMessageBox>
 #include <QProgressDialog>
+#include <QPushButton>
 #include <QSettings>
 #include <QStatusBar>
 #include <QTimer>
@@ -21,7 +22,12 @@
 #include "app/main_window.h"
 #include "app/report_writer.h"
 #include "app/session_parts.h"
+#include "widgets/diagnosis_panel.h"
+#include "widgets/discovery_panel.h"
+#include "widgets/fit_panel.h"
 #include "widgets/preprocess_panel.h"
+#include "widgets/recursive_panel.h"
+#include "core/session/fit_request.h"
 #include "core/session/sha256.h"
 #include "widgets/workspace.h"
 
@@ -44,12 +50,31 @@ SessionController::SessionController(MainWindow* window, Workspace* workspace)
     if (restoring_) return;
     std::string why;
     logSha256_ = sha256OfFile(workspace_->logPath().toStdString(), &why).value_or("");
+    workspace_->setLogSha256(logSha256_);
     loaded_ = Session{};  // a log opened by hand starts a new session
     path_.clear();
+    setDirty(false);  // nothing of the new workspace is unsaved yet
   });
-  for (auto signal : {&Workspace::logChanged, &Workspace::currentChanged, &Workspace::rangesChanged})
-    connect(workspace_, signal, this, &SessionController::markDirty);
-  connect(workspace_, &Workspace::modelsChanged, this, &SessionController::markDirty);
+  // Preprocessing, ranges and model edits go through the undo stack: its clean state is the
+  // saved one. A panel's new result (discovery, diagnosis, recursive run) is recorded with
+  // the data it ran on and marks the workspace changed.
+  connect(workspace_->undoStack(), &QUndoStack::cleanChanged, this, [this] { setDirty(dirty_); });
+  connect(window_->discoveryPanel(), &DiscoveryPanel::finished, this, [this] {
+    recordProvenance(*window_, "discovery");
+    markDirty();
+  });
+  connect(window_->diagnosisPanel(), &DiagnosisPanel::finished, this, [this] {
+    recordProvenance(*window_, "diagnosis");
+    markDirty();
+  });
+  connect(window_, &MainWindow::logOpened, this, &SessionController::offerRecompute);
+  connect(window_->fitPanel(), &FitPanel::estimated, this, [this] {
+    if (!recomputeQueue_.isEmpty()) recomputeNext();
+  });
+  connect(window_->recursivePanel(), &RecursivePanel::runFinished, this, [this] {
+    recordProvenance(*window_, "recursive");
+    markDirty();
+  });
   autosaveTimer_->setInterval(kAutosaveMs);
   connect(autosaveTimer_, &QTimer::timeout, this, &SessionController::autosave);
   autosaveTimer_->start();
@@ -84,6 +109,8 @@ void SessionController::addMenuActions() {
   add(tr("&Save session"), "Ctrl+S", &SessionController::saveCurrent)->setObjectName("saveSessionAction");
   add(tr("Save session &as..."), "Ctrl+Shift+S", &SessionController::saveAs);
   add(tr("Export re&port (PDF, HTML)..."), "Ctrl+Shift+E", &SessionController::exportDialog);
+  add(tr("Recompute estimates on the open &data"), "", &SessionController::recomputeStale)
+      ->setObjectName("recomputeAction");
   rebuildRecent();
 }
 
@@ -149,7 +176,7 @@ bool SessionController::save(const QString& path, QString* why) {
   loaded_.logs = s.logs;
   loaded_.parts = s.parts;
   path_ = path;
-  dirty_ = false;
+  setDirty(false);
   workspace_->undoStack()->setClean();
   QFile::remove(autosavePath());
   addRecent(path);
@@ -182,7 +209,7 @@ void SessionController::openDialog() {
   const QString path = QFileDialog::getOpenFileName(window_, tr("Open session"),
                                                     QSettings().value("lastDir").toString(),
                                                     tr("FlexArm sessions (*.json);;All files (*)"));
-  if (!path.isEmpty()) open(path);
+  if (!path.isEmpty()) requestOpen(path);
 }
 
 void SessionController::open(const QString& path) {
@@ -236,6 +263,7 @@ void SessionController::onOpened() {
   PreparedLog& log = o.prepared.logs.front();
   restoring_ = true;
   workspace_->setLog(std::move(log.raw), QString::fromStdString(log.path), s.logs.front().read);
+  workspace_->setLogSha256(log.sha256);
   if (s.preprocessed) {
     IdData processed = std::move(log.data);
     processed.estimationRange.reset();
@@ -260,12 +288,12 @@ void SessionController::onOpened() {
   loaded_ = s;
   recovering_ = recovered;
   path_ = recovered ? QString() : openingPath_;
-  dirty_ = recovered;
+  setDirty(recovered);
   if (!recovered) {
     addRecent(openingPath_);
     QSettings().setValue("lastDir", QFileInfo(openingPath_).absolutePath());
   }
-  window_->setWindowTitle(QString("FlexArm - %1").arg(recovered ? tr("recovered session")
+  window_->setWindowTitle(QString("FlexArm - %1[*]").arg(recovered ? tr("recovered session")
                                                                 : QFileInfo(openingPath_).fileName()));
   QString status = recovered ? tr("Recovered the autosaved session: save it with Ctrl+S")
                              : tr("Opened session %1").arg(QFileInfo(openingPath_).fileName());
@@ -345,7 +373,7 @@ QString SessionController::autosavePath() const {
 }
 
 bool SessionController::autosave() {
-  if (!dirty_ || !workspace_->hasLog() || restoring_) return false;
+  if (!isDirty() || !workspace_->hasLog() || restoring_) return false;
   std::string why;
   return saveSession(capture(autosavePath()), autosavePath().toStdString(), &why);
 }
@@ -371,7 +399,99 @@ void SessionController::offerRecovery() {
 }
 
 void SessionController::markDirty() {
-  if (!restoring_) dirty_ = true;
+  if (!restoring_) setDirty(true);
+}
+
+void SessionController::setDirty(bool dirty) {
+  dirty_ = dirty;
+  window_->setWindowModified(isDirty());
+}
+
+bool SessionController::isDirty() const { return dirty_ || !workspace_->undoStack()->isClean(); }
+
+bool SessionController::confirmReplace(const QString& what) {
+  if (!isDirty() || !workspace_->hasLog()) return true;
+  ReplaceDecision d = ReplaceDecision::Cancel;
+  if (decide_) {
+    d = decide_(what);
+  } else {
+    QMessageBox box(QMessageBox::Warning, tr("Unsaved changes"),
+                    tr("The workspace has changes that are not saved (preprocessing, ranges, "
+                       "models or designs). Save them before %1?").arg(what),
+                    QMessageBox::Save | QMessageBox::Discard | QMessageBox::Cancel, window_);
+    box.setObjectName("replaceBox");
+    box.setDefaultButton(QMessageBox::Save);
+    const int answer = box.exec();
+    d = answer == QMessageBox::Save      ? ReplaceDecision::Save
+        : answer == QMessageBox::Discard ? ReplaceDecision::Discard
+                                         : ReplaceDecision::Cancel;
+  }
+  if (d == ReplaceDecision::Cancel) {
+    window_->statusBar()->showMessage(tr("Kept the workspace: nothing was replaced"), 5000);
+    return false;
+  }
+  if (d == ReplaceDecision::Discard) return true;
+  if (path_.isEmpty() || recovering_) saveAs();
+  else saveCurrent();
+  return !isDirty();  // saved; a failed or cancelled save keeps everything
+}
+
+QList<QPair<QString, QString>> SessionController::staleEstimates() const {
+  QList<QPair<QString, QString>> stale;
+  if (!workspace_->hasLog()) return stale;
+  const Provenance open = workspace_->dataProvenance();
+  for (const auto& m : workspace_->models()) {
+    if (!m.fitRequest || !m.fitRequest->provenance) continue;
+    const std::string other = dataMismatch(*m.fitRequest->provenance, open);
+    if (!other.empty()) stale.append({m.name, QString::fromStdString(other)});
+  }
+  return stale;
+}
+
+void SessionController::offerRecompute() {
+  const auto stale = staleEstimates();
+  if (stale.isEmpty()) return;
+  QString text = stale.size() == 1 ? tr("An estimate of the model list was computed on other data:")
+                                   : tr("%1 estimates of the model list were computed on other data:")
+                                         .arg(stale.size());
+  for (const auto& [name, why] : stale) text += "\n\n" + name + ": " + why + ".";
+  auto* box = new QMessageBox(QMessageBox::Question, tr("Estimates of other data"),
+                              text + tr("\n\nRecompute them on the open data? The estimates "
+                                        "shown now stay in the list as they are."),
+                              QMessageBox::NoButton, window_);
+  box->setObjectName("recomputeBox");
+  box->addButton(tr("Recompute"), QMessageBox::AcceptRole)->setObjectName("recomputeButton");
+  box->addButton(tr("Keep as they are"), QMessageBox::RejectRole);
+  box->setAttribute(Qt::WA_DeleteOnClose);
+  connect(box, &QMessageBox::accepted, this, &SessionController::recomputeStale);
+  box->open();
+  emit recomputeOffered(static_cast<int>(stale.size()));
+}
+
+void SessionController::recomputeStale() {
+  recomputeQueue_.clear();
+  for (const auto& item : staleEstimates()) recomputeQueue_.append(item.first);
+  if (recomputeQueue_.isEmpty()) {
+    window_->statusBar()->showMessage(tr("Every estimate was computed on the open data"), 5000);
+    return;
+  }
+  recomputeNext();
+}
+
+void SessionController::recomputeNext() {
+  while (!recomputeQueue_.isEmpty()) {
+    const QString name = recomputeQueue_.takeFirst();
+    for (const auto& m : workspace_->models()) {
+      if (m.name != name || !m.fitRequest) continue;
+      const FitRequest request = *m.fitRequest;  // the list changes when the fit lands
+      window_->statusBar()->showMessage(tr("Recomputing %1 on the open data...").arg(name));
+      if (window_->fitPanel()->recompute(request)) return;  // the next starts when it ends
+    }
+  }
+}
+
+void SessionController::requestOpen(const QString& path) {
+  if (confirmReplace(tr("opening the session %1").arg(QFileInfo(path).fileName()))) open(path);
 }
 
 QStringList SessionController::recentSessions() const { return recentList("sessions/recent"); }
@@ -385,7 +505,7 @@ void SessionController::rebuildRecent() {
   recentMenu_->clear();
   const QStringList list = recentSessions();
   for (const QString& p : list)
-    recentMenu_->addAction(QFileInfo(p).fileName(), this, [this, p] { open(p); })->setToolTip(p);
+    recentMenu_->addAction(QFileInfo(p).fileName(), this, [this, p] { requestOpen(p); })->setToolTip(p);
   recentMenu_->setEnabled(!list.isEmpty());
 }
 

@@ -8,6 +8,7 @@
 #include <QObject>
 #include <QString>
 #include <QStringList>
+#include <functional>
 
 #include "core/session/replay.h"
 #include "core/session/session.h"
@@ -20,6 +21,9 @@ namespace flexarm {
 
 class MainWindow;
 class Workspace;
+
+// The answer to "save the changes before X replaces them?".
+enum class ReplaceDecision { Save, Discard, Cancel };
 
 class SessionController : public QObject {
   Q_OBJECT
@@ -44,7 +48,27 @@ class SessionController : public QObject {
   // The file of the session's log `name` (paths resolved against the session); empty when the
   // session has no such log. Parts restoring a session use it for the logs they name.
   QString sessionLogPath(const std::string& name) const;
-  bool isDirty() const { return dirty_; }
+  // Any change to the workspace since it was opened or saved: preprocessing, ranges, models,
+  // designs. The window title shows it with "*".
+  // Changes that go through the undo stack count until undone back to the saved state.
+  bool isDirty() const;
+  // Before something replaces the workspace (`what`: "opening chirp.csv", "closing the window"):
+  // with unsaved changes asks Save / Discard / Cancel. True when the caller may go on (saved
+  // or discarded), false to keep everything (Cancel, or saving failed or was cancelled).
+  bool confirmReplace(const QString& what);
+  // Who answers confirmReplace's question; unset: a modal QMessageBox ("replaceBox"). Tests
+  // answer without a dialog.
+  void setReplaceDecision(std::function<ReplaceDecision(const QString& what)> decide) {
+    decide_ = std::move(decide);
+  }
+  // Opens a session after confirmReplace (the File menu's path).
+  void requestOpen(const QString& path);
+  // Estimates of the model list computed on other data than the open ones, each with the
+  // sentence saying so ("computed on X; the open log is Y").
+  QList<QPair<QString, QString>> staleEstimates() const;
+  // Runs every stale estimate's fit again on the open data, one after another through the
+  // Fit panel (off the GUI thread, progress and Cancel); each joins the list under a new name.
+  void recomputeStale();
   QStringList recentSessions() const;
   QString autosavePath() const;
   // Writes the autosave file now when there is unsaved work; true when written.
@@ -59,6 +83,8 @@ class SessionController : public QObject {
   void reportFailed(const QString& message);
   // After a start that found an autosave: the recovery question is showing.
   void recoveryOffered(const QString& autosavePath);
+  // After a log was opened with estimates of other data in the list: the offer is showing.
+  void recomputeOffered(int stale);
 
  private:
   struct Opened {
@@ -77,6 +103,9 @@ class SessionController : public QObject {
   void rebuildRecent();
   void offerRecovery();
   void markDirty();
+  void setDirty(bool dirty);
+  void offerRecompute();
+  void recomputeNext();
   void fail(const QString& title, const QString& message);
 
   MainWindow* window_;
@@ -85,7 +114,9 @@ class SessionController : public QObject {
   QString openingPath_, reportPath_;
   bool recovering_ = false;
   bool restoring_ = false;
-  bool dirty_ = false;
+  bool dirty_ = false;        // changes outside the undo stack (a panel's new result)
+  std::function<ReplaceDecision(const QString&)> decide_;
+  QList<QString> recomputeQueue_;  // names of estimates still to recompute
   std::string logSha256_;    // of the log when it was opened
   Session loaded_;           // the last opened session (its extra logs and parts are kept)
   Session opened_;           // the session being restored (its parts read its logs)

@@ -24,11 +24,32 @@ namespace {
 
 using nlohmann::json;
 
+// The data of the result a panel made last, as the window recorded it (recordProvenance).
+QByteArray provenanceProperty(const char* key) { return QByteArray("flexarmProvenance_") + key; }
+
+json withProvenance(json section, const MainWindow& w, const char* key) {
+  const QByteArray p = w.property(provenanceProperty(key).constData()).toByteArray();
+  if (!p.isEmpty() && section.is_object() && !section.contains("provenance"))
+    section["provenance"] = json::parse(p.toStdString(), nullptr, false);
+  return section;
+}
+
+// A restored section's provenance becomes the window's record, so saving again keeps it.
+void keepProvenance(const json& section, MainWindow& w, const char* key) {
+  w.setProperty(provenanceProperty(key).constData(), section.is_object() && section.contains("provenance")
+                                             ? QByteArray::fromStdString(section["provenance"].dump())
+                                             : QByteArray());
+}
+
 json captureModels(const MainWindow& w) {
   json list = json::array();
   // Physical models only: black-box estimates are recomputed from the data, not stored yet.
-  for (const auto& m : w.workspace()->models())
-    if (m.model) list.push_back(modelToJson(m.name.toStdString(), *m.model, m.effects));
+  for (const auto& m : w.workspace()->models()) {
+    if (!m.model) continue;
+    json j = modelToJson(m.name.toStdString(), *m.model, m.effects);
+    if (m.fitRequest && m.fitRequest->provenance) j["provenance"] = provenanceToJson(*m.fitRequest->provenance);
+    list.push_back(j);
+  }
   return list;
 }
 
@@ -115,19 +136,22 @@ constexpr const char* kKeptDiscovery = "flexarmKeptDiscovery";
 json captureDiscovery(const MainWindow& w) {
   const DiscoveryPanel* panel = w.discoveryPanel();
   if (panel && panel->lastRequest() && panel->result())
-    return {{"request", discoveryRequestToJson(*panel->lastRequest())},
-            {"result", discoveryResultToJson(*panel->result())}};
+    return withProvenance({{"request", discoveryRequestToJson(*panel->lastRequest())},
+                           {"result", discoveryResultToJson(*panel->result())}},
+                          w, "discovery");
   const QByteArray kept = w.property(kKeptDiscovery).toByteArray();
   return kept.isEmpty() ? json(nullptr) : json::parse(kept.toStdString(), nullptr, false);
 }
 
 void resetDiscovery(MainWindow& w) {
   w.setProperty(kKeptDiscovery, QByteArray());
+  keepProvenance(nullptr, w, "discovery");
   if (w.discoveryPanel()) w.discoveryPanel()->clearResult();
 }
 
 void restoreDiscovery(const json& section, MainWindow& w) {
   resetDiscovery(w);
+  keepProvenance(section, w, "discovery");
   std::string why;
   auto request = discoveryRequestFromJson(section["request"], &why);
   std::optional<DiscoveryResult> result;
@@ -170,8 +194,10 @@ json captureDiagnosis(const MainWindow& w) {
   const auto request = panel->sessionRequest(kDiagnosisReference);
   if (!request) return nullptr;
   json section = {{"request", diagnosisRequestToJson(*request)}};
-  if (const DiagnosisRun* run = panel->lastRun(); run && run->ok())
+  if (const DiagnosisRun* run = panel->lastRun(); run && run->ok()) {
     section["result"] = diagnosisResultJson(run->result);
+    section = withProvenance(section, w, "diagnosis");
+  }
   return section;
 }
 
@@ -186,6 +212,7 @@ std::vector<LogReference> diagnosisLogs(const MainWindow& w) {
 }
 
 void restoreDiagnosis(const json& section, MainWindow& w) {
+  keepProvenance(section, w, "diagnosis");
   std::string why;
   const auto request = diagnosisRequestFromJson(section["request"], &why);
   if (!request || !w.diagnosisPanel()) return;
@@ -196,6 +223,7 @@ void restoreDiagnosis(const json& section, MainWindow& w) {
 }
 
 void resetDiagnosis(MainWindow& w) {
+  keepProvenance(nullptr, w, "diagnosis");
   if (w.diagnosisPanel()) w.diagnosisPanel()->clearResult();
 }
 
@@ -214,18 +242,20 @@ json captureRecursive(const MainWindow& w) {
       if (run->result) entry["result"] = recursiveResultToJson(*run->result);
       runs.push_back(entry);
     }
-  if (!runs.empty()) return {{"runs", runs}};
+  if (!runs.empty()) return withProvenance({{"runs", runs}}, w, "recursive");
   const QByteArray kept = w.property(kKeptRecursive).toByteArray();
   return kept.isEmpty() ? json(nullptr) : json::parse(kept.toStdString(), nullptr, false);
 }
 
 void resetRecursive(MainWindow& w) {
   w.setProperty(kKeptRecursive, QByteArray());
+  keepProvenance(nullptr, w, "recursive");
   if (w.recursivePanel()) w.recursivePanel()->clearRuns();
 }
 
 void restoreRecursive(const json& section, MainWindow& w) {
   resetRecursive(w);
+  keepProvenance(section, w, "recursive");
   w.setProperty(kKeptRecursive, QByteArray::fromStdString(section.dump()));
   std::string why;
   if (!section["runs"].empty() && w.recursivePanel())
@@ -246,6 +276,11 @@ void restoreView(const json& section, MainWindow& w) {
 }
 
 }  // namespace
+
+void recordProvenance(MainWindow& window, const char* key) {
+  window.setProperty(provenanceProperty(key).constData(),
+                     QByteArray::fromStdString(provenanceToJson(window.workspace()->dataProvenance()).dump()));
+}
 
 const std::vector<WindowSessionPart>& windowSessionParts() {
   // In the order of core sessionParts(); later capabilities add their pair here.

@@ -516,19 +516,42 @@ void FitPanel::estimate() {
     emit estimated(false);
     return;
   }
+  start(*o, name);
+}
+
+bool FitPanel::recompute(const FitRequest& request) {
+  if (isBusy()) return false;
+  FitOptions o = request.options;
+  useWorkspaceData(*workspace_, o);
+  std::string why;
+  if (!o.isValid(&why)) {
+    summary_->setPlainText(tr("%1 cannot be recomputed on the open data: %2")
+                               .arg(QString::fromStdString(request.name), QString::fromStdString(why)));
+    return false;
+  }
+  const QString name = QString::fromStdString(request.physical() ? o.model.start->structureName() : request.name);
+  start(o, name);
+  return true;
+}
+
+void FitPanel::start(const FitOptions& o, const QString& name) {
   // The request as a session stores it: the same options and ranges, without the data.
   auto record = std::make_shared<FitRequest>();
-  record->options = *o;
+  record->options = o;
   record->options.estimation.clear();
   record->options.validation.clear();
-  record->estimation = o->estimation.front().range;
-  if (!o->validation.empty()) record->validation = o->validation.front().range;
+  record->estimation = o.estimation.front().range;
+  if (!o.validation.empty()) record->validation = o.validation.front().range;
+  // The data it runs on, with the ranges the fit itself uses.
+  record->provenance = workspace_->dataProvenance();
+  record->provenance->estimation = record->estimation;
+  record->provenance->validation = record->validation;
   table_->setRowCount(0);
-  summary_->setPlainText(tr("Estimating %1...").arg(QString::fromStdString(o->model.name())));
+  summary_->setPlainText(tr("Estimating %1...").arg(QString::fromStdString(o.model.name())));
   startProgress();
   const auto progress = progressCallback();
   // The one fit pipeline (core/ident/fit.h), as `flexarm fit` and a session's replay run it.
-  watcher_.setFuture(QtConcurrent::run([options = *o, record, name, progress]() {
+  watcher_.setFuture(QtConcurrent::run([options = o, record, name, progress]() {
     Outcome out;
     out.request = record;
     out.name = name;
@@ -607,17 +630,15 @@ void FitPanel::onFinished() {
   lines << fits;
   lines << tr("Notches: %1. Peaks: %2.").arg(joined(r.notches), joined(r.peaks));
   for (const auto& w : r.warnings) lines << tr("Note: %1.").arg(QString::fromStdString(w));
-  // The estimate joins the shared list under a name not yet used.
-  QString name = entry.name + tr(" estimate");
-  int k = 1;
-  auto taken = [this](const QString& n) {
-    for (const auto& m : workspace_->models())
-      if (m.name == n) return true;
-    return false;
-  };
-  while (taken(name)) name = entry.name + tr(" estimate %1").arg(++k);
+  // The estimate joins the shared list under a name no other entry has, naming its data:
+  // "three-mass estimate 2 (chirp.csv 0.5-12 s)".
+  std::vector<std::string> taken;
+  for (const auto& m : workspace_->models()) taken.push_back(m.name.toStdString());
+  const QString name = QString::fromStdString(
+      uniqueResultName((entry.name + tr(" estimate")).toStdString(), *out.request->provenance, taken));
   entry.name = name;
   out.request->name = name.toStdString();
+  out.request->stored = storedFitOf(r);
   entry.fitRequest = out.request;
   lines << tr("Added to the model list as \"%1\".").arg(name);
   summary_->setPlainText(lines.join("\n"));

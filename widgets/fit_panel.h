@@ -70,6 +70,11 @@ class FitPanel : public QWidget {
 
  public slots:
   void estimate();
+  // Runs a stored fit again (its model, start values, free parameters and options) on the
+  // open data with the workspace's ranges, off the GUI thread with progress and Cancel; the
+  // estimate joins the list under a new name, the stored one stays as it was. False when
+  // busy or the request cannot run on these data (the summary says why).
+  bool recompute(const FitRequest& request);
   void runStudy();
   void cancel();
 
@@ -105,6 +110,8 @@ class FitPanel : public QWidget {
   void onFinished();
   void onStudyFinished();
   void showRanges();
+  // Runs the fit pipeline on options in the background; name is the model's base name.
+  void start(const FitOptions& options, const QString& name);
   void startProgress();
   ProgressCallback progressCallback() const;
 

@@ -1,5 +1,7 @@
 #include "widgets/workspace.h"
 
+#include <QFileInfo>
+
 #include <QUndoCommand>
 #include <QUndoStack>
 #include <algorithm>
@@ -117,11 +119,23 @@ void Workspace::setLog(IdData data, const QString& path, const LogReadOptions& r
   processed_.reset();
   options_ = PreprocessOptions{};
   path_ = path;
+  sha256_.clear();
   read_ = read;
   undo_->clear();
   emit logChanged();
   emit currentChanged();
   emit rangesChanged();
+}
+
+Provenance Workspace::dataProvenance() const {
+  Provenance p;
+  p.log = QFileInfo(path_).fileName().toStdString();
+  p.sha256 = sha256_;
+  if (processed_) p.preprocessing = describePreprocessing(options_);
+  p.estimation = estimation_;
+  p.validation = validation_;
+  p.when = utcNow();
+  return p;
 }
 
 void Workspace::setPreprocessed(IdData data, const PreprocessOptions& options) {

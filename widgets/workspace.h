@@ -11,6 +11,7 @@
 #include "core/io/log_io.h"
 #include "core/models/effects.h"
 #include "core/models/physical_models.h"
+#include "core/session/provenance.h"
 #include "core/signal/id_data.h"
 #include "core/signal/preprocess.h"
 #include "core/signal/seconds_range.h"
@@ -56,6 +57,12 @@ class Workspace : public QObject {
   QString logPath() const { return path_; }
   const LogReadOptions& logReadOptions() const { return read_; }
   const IdData* raw() const { return raw_.get(); }
+  // The SHA-256 of the log file as opened (set by whoever formed it; empty until then).
+  void setLogSha256(const std::string& sum) { sha256_ = sum; }
+  const std::string& logSha256() const { return sha256_; }
+  // The data a result computed now is computed on: the log's file name and checksum, the
+  // preprocessing steps, the ranges, the time (core/session/provenance.h).
+  Provenance dataProvenance() const;
 
   // The preprocessed data if preprocessing was applied, otherwise the raw log; null when
   // there is no log or its time stamps are irregular (it must be resampled first).
@@ -104,6 +111,7 @@ class Workspace : public QObject {
   std::shared_ptr<IdData> raw_, processed_;
   PreprocessOptions options_;
   QString path_;
+  std::string sha256_;
   LogReadOptions read_;
   std::optional<TimeRange> estimation_, validation_;
   std::vector<ModelEntry> models_;

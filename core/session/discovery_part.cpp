@@ -233,6 +233,24 @@ class DiscoveryPart : public SessionPart {
     report.sections.push_back(s);
   }
 
+  // Discovery run on other data: the stored result, not a run on the open log.
+  void replayStored(const json& section, const std::string& mismatch, Report& report) const override {
+    ReportSection s;
+    s.title = "Discovery: the missing effect";
+    s.paragraphs.push_back("Not recomputed on the open data: this discovery was " + mismatch +
+                           ". The verdict below is the one stored when it ran.");
+    std::string why;
+    std::optional<DiscoveryResult> stored;
+    if (section.contains("result") && section["result"].is_object())
+      stored = discoveryResultFromJson(section["result"], &why);
+    if (stored) fillSection(*stored, s);
+    else s.paragraphs.push_back("The session stored no result of this run.");
+    s.values["recomputed"] = false;
+    s.values["computed_on"] = section["provenance"];
+    report.sections.push_back(s);
+    report.warnings.push_back("discovery was " + mismatch);
+  }
+
  private:
   static void fillSection(const DiscoveryResult& r, ReportSection& s) {
     const std::string effect = r.effect ? toString(*r.effect) : "none";

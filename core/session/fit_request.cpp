@@ -3,6 +3,7 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "core/session/json_fields.h"
 #include "core/session/model_json.h"
 
 namespace flexarm {
@@ -30,6 +31,72 @@ FitOptions fitOptionsOf(const FitRequest& request, std::shared_ptr<const IdData>
   o.validation.clear();
   if (request.validation) o.validation.push_back(FitExperiment{data, request.validation});
   return o;
+}
+
+StoredFit storedFitOf(const FitResult& result) {
+  StoredFit s;
+  s.parameters = result.parameters;
+  s.loss = result.summary.loss;
+  s.fitEstimation = result.fitEstimation;
+  s.fitValidation = result.fitValidation();
+  s.notches = result.notches;
+  s.peaks = result.peaks;
+  return s;
+}
+
+json storedFitToJson(const StoredFit& fit) {
+  json params = json::array();
+  for (const auto& p : fit.parameters) {
+    json q = {{"name", p.name}, {"unit", p.unit}, {"value", jsonNumber(p.value)}, {"std", jsonNumber(p.std)},
+              {"lower", jsonNumber(p.lower)}, {"upper", jsonNumber(p.upper)}, {"free", p.free}};
+    if (!p.effect.empty()) q["effect"] = p.effect;
+    params.push_back(q);
+  }
+  json j = {{"parameters", params}, {"loss", jsonNumber(fit.loss)},
+            {"notches_rad_s", fit.notches}, {"peaks_rad_s", fit.peaks}};
+  if (fit.fitEstimation) j["fit_estimation_percent"] = jsonNumber(*fit.fitEstimation);
+  if (fit.fitValidation) j["fit_validation_percent"] = jsonNumber(*fit.fitValidation);
+  return j;
+}
+
+std::optional<StoredFit> storedFitFromJson(const json& j, std::string* why) {
+  const std::string where = "result: ";
+  auto fail = [&](const std::string& w) -> std::optional<StoredFit> {
+    if (why) *why = where + w;
+    return std::nullopt;
+  };
+  if (!j.is_object()) return fail("must be an object");
+  StoredFit s;
+  if (!j.contains("parameters") || !j["parameters"].is_array()) return fail("parameters must be a list");
+  if (j["parameters"].size() > 1000) return fail("more than 1000 parameters");
+  for (const auto& p : j["parameters"]) {
+    FitParameter q;
+    if (!readText(p, "name", q.name, true, why, where) || !readText(p, "unit", q.unit, false, why, where) ||
+        !readNumber(p, "value", q.value, true, why, where) || !readNumber(p, "std", q.std, false, why, where) ||
+        !readNumber(p, "lower", q.lower, false, why, where) ||
+        !readNumber(p, "upper", q.upper, false, why, where) || !readFlag(p, "free", q.free, why, where) ||
+        !readText(p, "effect", q.effect, false, why, where))
+      return std::nullopt;
+    s.parameters.push_back(q);
+  }
+  if (!readNumber(j, "loss", s.loss, false, why, where)) return std::nullopt;
+  for (auto [key, target] : {std::pair{"fit_estimation_percent", &s.fitEstimation},
+                             std::pair{"fit_validation_percent", &s.fitValidation}}) {
+    if (!j.contains(key)) continue;
+    double v = 0.0;
+    if (!readNumber(j, key, v, true, why, where)) return std::nullopt;
+    *target = v;
+  }
+  for (auto [key, target] : {std::pair{"notches_rad_s", &s.notches}, std::pair{"peaks_rad_s", &s.peaks}}) {
+    if (!j.contains(key)) continue;
+    const json& list = j[key];
+    if (!list.is_array() || list.size() > 1000) return fail(std::string(key) + " must be a list of frequencies");
+    for (const auto& w : list) {
+      if (!w.is_number()) return fail(std::string(key) + " must be a list of frequencies");
+      target->push_back(w.get<double>());
+    }
+  }
+  return s;
 }
 
 bool FitRequest::isValid(std::string* why) const {
@@ -70,6 +137,8 @@ json fitRequestToJson(const FitRequest& r) {
     j["structure"] = toString(o.model.structure);
     j["orders"] = {{"na", q.na}, {"nb", q.nb}, {"nc", q.nc}, {"nd", q.nd}, {"nf", q.nf}, {"nk", q.nk}};
   }
+  if (r.provenance) j["provenance"] = provenanceToJson(*r.provenance);
+  if (r.stored) j["result"] = storedFitToJson(*r.stored);
   return j;
 }
 
@@ -168,6 +237,14 @@ std::optional<FitRequest> fitRequestFromJson(const json& j, std::string* why) {
       if (!readInt(q, names[i], 0, 200, *fields[i], &reason)) return fail(where + reason);
   } else {
     return fail(where + "kind must be \"physical\" or \"black-box\", not \"" + kind + "\"");
+  }
+  if (j.contains("provenance")) {
+    r.provenance = provenanceFromJson(j["provenance"], &reason);
+    if (!r.provenance) return fail(where + reason);
+  }
+  if (j.contains("result")) {
+    r.stored = storedFitFromJson(j["result"], &reason);
+    if (!r.stored) return fail(where + reason);
   }
   if (!r.isValid(&reason)) return fail(where + reason);
   return r;

@@ -11,11 +11,27 @@
 
 #include "core/common/progress.h"
 #include "core/ident/fit.h"
+#include "core/session/provenance.h"
 #include "core/session/session.h"
 #include "core/session/session_part.h"
 #include "core/signal/id_data.h"
 
 namespace flexarm {
+
+// What a fit computed, kept with its request so that a report on other data shows these
+// numbers instead of recomputing: the parameter table, loss, fit % and notches and peaks.
+struct StoredFit {
+  std::vector<FitParameter> parameters;
+  double loss = 0.0;
+  std::optional<double> fitEstimation, fitValidation;
+  std::vector<double> notches, peaks;
+};
+StoredFit storedFitOf(const FitResult& result);
+// {"parameters": [{"name", "unit", "value", "std", "lower", "upper", "free", "effect" (an
+// effect's parameter only)}], "loss",
+// "fit_estimation_percent", "fit_validation_percent", "notches_rad_s", "peaks_rad_s"}.
+nlohmann::json storedFitToJson(const StoredFit& fit);
+std::optional<StoredFit> storedFitFromJson(const nlohmann::json& j, std::string* why);
 
 struct FitRequest {
   std::string name;  // the model list entry the fit produced, e.g. "three-mass estimate"
@@ -24,6 +40,9 @@ struct FitRequest {
   // The ranges the fit used (seconds); unset: the session's ranges, else the whole log / no
   // validation.
   std::optional<SecondsRange> estimation, validation;
+  // The data the fit ran on and what it computed; absent in sessions written before them.
+  std::optional<Provenance> provenance;
+  std::optional<StoredFit> stored;
 
   bool physical() const { return options.model.kind == FitModelKind::Physical; }
   bool isValid(std::string* why) const;
@@ -38,7 +57,8 @@ FitOptions fitOptionsOf(const FitRequest& request, std::shared_ptr<const IdData>
 // [first value free, second value free]; absent without effects), "noise_model", "closed_loop" ("auto", "direct",
 // "two-stage", "indirect"; absent in sessions written before it: "direct"), "random_starts",
 // "seed", optional "start_values" {name: value} and "bounds" {name: [lower, upper], null an
-// open end}; black-box: "structure", "orders"}.
+// open end}; black-box: "structure", "orders"; "provenance" and "result" (StoredFit) when
+// known}.
 nlohmann::json fitRequestToJson(const FitRequest& request);
 // The request described by j; nullopt with a sentence for a malformed one.
 std::optional<FitRequest> fitRequestFromJson(const nlohmann::json& j, std::string* why);

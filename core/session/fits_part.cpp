@@ -52,6 +52,24 @@ std::vector<ReportPlot> bodeWithBand(const FrequencyResponse& r, const std::stri
   return {mag, ph};
 }
 
+// The parameter table of a fit (value, std and interval of the free ones; "fixed" for the
+// others); values and stds by name for the section's JSON.
+ReportTable parameterTable(const std::string& caption, const std::vector<FitParameter>& parameters,
+                           json& values, json& stds) {
+  ReportTable t{caption, {"Parameter", "Value", "+- std", "99 % lower", "99 % upper", "Unit"}, {}};
+  for (const auto& p : parameters) {
+    const std::string label = p.effect.empty() ? p.name : p.name + " (" + p.effect + ")";
+    if (p.free)
+      t.rows.push_back({label, formatSignificant(p.value, 6), formatSignificant(p.std, 3),
+                        formatSignificant(p.lower, 6), formatSignificant(p.upper, 6), p.unit});
+    else
+      t.rows.push_back({label, formatSignificant(p.value, 6), "fixed", "", "", p.unit});
+    values[p.name] = p.value;
+    stds[p.name] = p.std;
+  }
+  return t;
+}
+
 ReportSeries stepSeries(const std::string& name, const std::vector<int>& lags,
                         const std::vector<double>& v, bool dashed) {
   ReportSeries s{name, {}, v, dashed};
@@ -101,7 +119,19 @@ class FitsPart : public SessionPart {
       std::string why;
       auto request = fitRequestFromJson(j, &why);
       if (!request) continue;  // validated on load
-      report.sections.push_back(fitSection(*request, context));
+      if (const std::string other = mismatchWithOpen(request->provenance, context); !other.empty()) {
+        report.sections.push_back(storedSection(*request, other));
+        report.warnings.push_back("fit " + request->name + " was " + other);
+        continue;
+      }
+      ReportSection s = fitSection(*request, context);
+      if (request->provenance)
+        s.paragraphs.insert(s.paragraphs.begin(), "Computed on " + longDescription(*request->provenance) +
+                                                      (request->provenance->when.empty()
+                                                           ? ""
+                                                           : " at " + request->provenance->when) +
+                                                      "; recomputed here on the same data.");
+      report.sections.push_back(s);
     }
   }
 
@@ -144,6 +174,37 @@ class FitsPart : public SessionPart {
     return s;
   }
 
+  // A fit made on other data than the open ones: what it computed then, never a recompute.
+  static ReportSection storedSection(const FitRequest& r, const std::string& mismatch) {
+    ReportSection s;
+    s.title = "Fit " + r.name;
+    s.paragraphs.push_back("Not recomputed on the open data: this fit was " + mismatch +
+                           ". The numbers below are those stored when it was computed.");
+    s.values = {{"name", r.name}, {"recomputed", false}, {"computed_on", provenanceToJson(*r.provenance)}};
+    if (!r.stored) {
+      s.paragraphs.push_back("The session stored no numbers of this fit: open its log to recompute it.");
+      return s;
+    }
+    const StoredFit& f = *r.stored;
+    json values = json::object(), stds = json::object();
+    s.tables.push_back(parameterTable("Estimated parameters as stored (value +- std, 99 % interval)",
+                                      f.parameters, values, stds));
+    ReportTable quality{"Loss and fit % (5.2) as stored", {"Quantity", "Value"}, {}};
+    quality.rows.push_back({"loss V_N (4.6)", formatSignificant(f.loss, 6)});
+    if (f.fitEstimation) quality.rows.push_back({"fit % on the estimation range", formatFixed(*f.fitEstimation, 2)});
+    if (f.fitValidation) quality.rows.push_back({"fit % on the validation range", formatFixed(*f.fitValidation, 2)});
+    s.tables.push_back(quality);
+    s.paragraphs.push_back("Notches: " + joinedFrequencies(f.notches) + ". Peaks: " + joinedFrequencies(f.peaks) + ".");
+    s.values["parameters"] = values;
+    s.values["std"] = stds;
+    s.values["loss"] = f.loss;
+    if (f.fitEstimation) s.values["fit_estimation_percent"] = *f.fitEstimation;
+    if (f.fitValidation) s.values["fit_validation_percent"] = *f.fitValidation;
+    s.values["notches_rad_s"] = f.notches;
+    s.values["peaks_rad_s"] = f.peaks;
+    return s;
+  }
+
   static ReportSection fitSection(const FitRequest& request, const ReplayContext& context) {
     ReportSection s;
     s.title = "Fit " + request.name;
@@ -181,7 +242,7 @@ class FitsPart : public SessionPart {
       s.paragraphs.push_back(std::string("No fit: ") + e.what() + ".");
       return s;
     }
-    s.values = {{"name", r.name}, {"termination", toString(run.termination)}};
+    s.values = {{"name", r.name}, {"termination", toString(run.termination)}, {"recomputed", true}};
     if (!run.ok()) {
       s.paragraphs.push_back("No fit: " + run.message + ".");
       return s;
@@ -196,20 +257,9 @@ class FitsPart : public SessionPart {
     if (!run.controllerSource.empty()) s.paragraphs.push_back("Controller: " + run.controllerSource + ".");
     for (const auto& w : run.warnings) s.paragraphs.push_back("Note: " + w + ".");
 
-    ReportTable params{"Estimated parameters (value +- std, 99 % interval)",
-                       {"Parameter", "Value", "+- std", "99 % lower", "99 % upper", "Unit"}, {}};
     json values = json::object(), stds = json::object();
-    for (const auto& p : run.parameters) {
-      const std::string label = p.effect.empty() ? p.name : p.name + " (" + p.effect + ")";
-      if (p.free)
-        params.rows.push_back({label, formatSignificant(p.value, 6), formatSignificant(p.std, 3),
-                               formatSignificant(p.lower, 6), formatSignificant(p.upper, 6), p.unit});
-      else
-        params.rows.push_back({label, formatSignificant(p.value, 6), "fixed", "", "", p.unit});
-      values[p.name] = p.value;
-      stds[p.name] = p.std;
-    }
-    s.tables.push_back(params);
+    s.tables.push_back(
+        parameterTable("Estimated parameters (value +- std, 99 % interval)", run.parameters, values, stds));
 
     ReportTable quality{"Loss and fit % (5.2)", {"Quantity", "Value"}, {}};
     quality.rows.push_back({"loss V_N (4.6)", formatSignificant(run.summary.loss, 6)});

@@ -187,7 +187,9 @@ ReplayResult replaySession(const Session& session, const std::string& sessionPat
     logs.emplace_back(l.name, &l.data);
     rawLogs.emplace_back(l.name, &l.raw);
   }
-  ReplayContext context{session, prepared.logs.front().data, logs, options.progress, &rawLogs};
+  const Provenance open =
+      sessionDataProvenance(session, prepared.logs.front().path, prepared.logs.front().sha256);
+  ReplayContext context{session, prepared.logs.front().data, logs, options.progress, &rawLogs, &open};
   const auto& parts = sessionParts();
   for (std::size_t i = 0; i < parts.size(); ++i) {
     const std::string key = parts[i]->key();
@@ -201,7 +203,14 @@ ReplayResult replaySession(const Session& session, const std::string& sessionPat
       return options.progress ? options.progress(lo + (hi - lo) * std::clamp(f, 0.0, 1.0), stage)
                               : ProgressAction::Continue;
     };
-    parts[i]->replay(session.parts[key], partContext, r.report);
+    // A part that records the data of its result (section "provenance") is not recomputed on
+    // other data: it shows what it stored and says on which data that was.
+    const nlohmann::json& section = session.parts[key];
+    if (const std::string other = mismatchWithOpen(provenanceIn(section), context); !other.empty()) {
+      parts[i]->replayStored(section, other, r.report);
+      continue;
+    }
+    parts[i]->replay(section, partContext, r.report);
   }
   return finish(Termination::Converged, "replayed " + std::to_string(r.report.sections.size()) +
                                             " report sections");

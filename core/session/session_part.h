@@ -11,6 +11,7 @@
 #include <nlohmann/json.hpp>
 
 #include "core/common/progress.h"
+#include "core/session/provenance.h"
 #include "core/session/report.h"
 #include "core/session/session.h"
 #include "core/signal/id_data.h"
@@ -31,7 +32,14 @@ struct ReplayContext {
   // Every log as read, before preprocessing and without ranges (by name); null when the
   // caller has none.
   const std::vector<std::pair<std::string, const IdData*>>* rawLogs = nullptr;
+  // The data the session analyses now (its first log as read, preprocessing, ranges); null
+  // when the caller has none. A result computed on other data is not recomputed on these.
+  const Provenance* open = nullptr;
 };
+
+// The sentence saying a result's data differ from the open data (dataMismatch), or empty when
+// they are the same, the result has no provenance or the context has no open data.
+std::string mismatchWithOpen(const std::optional<Provenance>& result, const ReplayContext& context);
 
 // The log a part names (empty: the session's first) among the context's logs as read (raw) or
 // as preprocessed; nullptr with a sentence when there is none.
@@ -49,6 +57,11 @@ class SessionPart {
   // failures go into the report as sentences; nothing throws for bad data.
   virtual void replay(const nlohmann::json& section, const ReplayContext& context,
                       Report& report) const = 0;
+  // A section whose "provenance" names other data than the open ones: the part shows what
+  // was stored, with the mismatch sentence, and recomputes nothing. The default says only
+  // that the part was computed on other data.
+  virtual void replayStored(const nlohmann::json& section, const std::string& mismatch,
+                            Report& report) const;
 };
 
 // Every known part, in report order.

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <complex>
+#include <cctype>
 #include <set>
 
 #include "core/models/analysis.h"
@@ -28,6 +29,13 @@ constexpr double kPi = 3.14159265358979323846;
 // The model list: each model's parameters (value, unit, free flag), effects, notch and peak
 // frequencies (5.4), Bode plot, and its simulation fit % (5.2) on the estimation and
 // validation ranges, simulated open loop from the log's torque reference with the effects.
+// The data an estimate of the list was computed on, for its section.
+void estimatedOnNote(ReportSection& s, const Provenance& p) {
+  s.paragraphs.insert(s.paragraphs.begin() + 1, "Estimated on " + longDescription(p) +
+                                                    (p.when.empty() ? "" : " at " + p.when) + ".");
+  s.values["estimated_on"] = provenanceToJson(p);
+}
+
 class ModelsPart : public SessionPart {
  public:
   std::string key() const override { return "models"; }
@@ -59,6 +67,18 @@ class ModelsPart : public SessionPart {
       auto spec = modelFromJson(m, &why);
       if (!spec) continue;  // validated on load
       report.sections.push_back(modelSection(*spec, context.data));
+      // An estimate made on other data: its values are as estimated, the fit % is of the
+      // open log, and the report says so.
+      const auto provenance = provenanceIn(m);
+      if (const std::string other = mismatchWithOpen(provenance, context); !other.empty()) {
+        ReportSection& s = report.sections.back();
+        s.paragraphs.insert(s.paragraphs.begin() + 1,
+                            "Estimated on other data: " + other +
+                                ". The simulation fit % below is of this model on the open log.");
+        s.values["estimated_on"] = provenanceToJson(*provenance);
+      } else if (provenance) {
+        estimatedOnNote(report.sections.back(), *provenance);
+      }
     }
   }
 
@@ -193,6 +213,23 @@ const std::vector<std::shared_ptr<const SessionPart>>& sessionParts() {
       std::make_shared<ViewPart>(),
   };
   return kParts;
+}
+
+std::string mismatchWithOpen(const std::optional<Provenance>& result, const ReplayContext& context) {
+  if (!result || !context.open) return {};
+  return dataMismatch(*result, *context.open);
+}
+
+void SessionPart::replayStored(const nlohmann::json& section, const std::string& mismatch, Report& report) const {
+  ReportSection s;
+  std::string title = key();
+  if (!title.empty()) title[0] = static_cast<char>(std::toupper(static_cast<unsigned char>(title[0])));
+  s.title = title + " (computed on other data)";
+  s.paragraphs.push_back("Not recomputed on the open data: " + mismatch +
+                         ". Open that log, or recompute in the window, to see its results.");
+  s.values = {{"recomputed", false}, {"computed_on", section["provenance"]}};
+  report.sections.push_back(s);
+  report.warnings.push_back(key() + ": " + mismatch);
 }
 
 const IdData* findLog(const ReplayContext& context, const std::string& name, bool raw, std::string* why) {
