@@ -4,6 +4,7 @@
 // Compare fits, the residual tests, Cancel and the sensitivity study; screenshots of every
 // panel.
 #include <QApplication>
+#include <cmath>
 #include <QComboBox>
 #include <QDockWidget>
 #include <QListWidget>
@@ -307,6 +308,13 @@ class IdentificationTest : public QObject {
     QVERIFY2(fits.back() > 30.0, qPrintable(cmp->fitText()));
     QVERIFY2(cmp->fitText().contains("(at 200 Hz)"), qPrintable(cmp->fitText()));
     QVERIFY2(cmp->fitText().contains("validation"), qPrintable(cmp->fitText()));
+    // Both fit percentages, named: the seed's (5.2) and MATLAB compare's NRMSE of the same errors.
+    const auto nrmse = cmp->fitsNrmse();
+    QCOMPARE(nrmse.size(), fits.size());
+    for (std::size_t i = 0; i < fits.size(); ++i)
+      QVERIFY2(std::abs(nrmse[i] - 100.0 * (1.0 - std::sqrt(1.0 - fits[i] / 100.0))) < 1e-9,
+               qPrintable(cmp->fitText()));
+    QVERIFY2(cmp->fitText().contains("% (5.2), ") && cmp->fitText().contains("% NRMSE"), qPrintable(cmp->fitText()));
     QCOMPARE(cmp->plot()->graphCount(), static_cast<int>(fits.size()) + 1);
     test::saveShot(cmp->grab().toImage(), "compare_panel");
   }
