@@ -138,8 +138,8 @@ TEST(Analysis, NotchesAndPeaksAreExtremaOfTheMagnitude) {
     const NotchesPeaks g = magnitudeExtrema(w, m, 1.0, mag);
     ASSERT_EQ(g.notches.size(), 1u) << points;
     ASSERT_EQ(g.peaks.size(), 1u) << points;
-    EXPECT_NEAR(g.notches[0] / np.notches[0], 1.0, 1e-8) << points;
-    EXPECT_NEAR(g.peaks[0] / np.peaks[0], 1.0, 1e-8) << points;
+    EXPECT_NEAR(g.notches[0] / np.notches[0], 1.0, 1e-6) << points;
+    EXPECT_NEAR(g.peaks[0] / np.peaks[0], 1.0, 1e-6) << points;  // a flat maximum: sqrt(eps)
   }
 }
 
