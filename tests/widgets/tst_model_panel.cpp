@@ -123,10 +123,15 @@ class ModelPanelTest : public QObject {
   }
 
   void extraMassAddsAResonance() {
-    const int peaksBefore = panel_->frequencyText().section("peaks", 1).count(',') + 1;
+    // The extra mass (250 rad/s, 0.3 of the arm) adds a pole pair and moves the notch and the
+    // peak; its own resonance is less than 1 dB deep in |G(i w)|, so it adds no peak to the
+    // magnitude's extrema (FlexArm's definition of notches and peaks).
+    const QString before = panel_->frequencyText();
+    const int pointsBefore = panel_->poleZero()->pointCount();
     QVERIFY(panel_->setEffect(EffectKind::ExtraMass, true));
-    const int peaksAfter = panel_->frequencyText().section("peaks", 1).count(',') + 1;
-    QCOMPARE(peaksAfter, peaksBefore + 1);
+    const QString after = panel_->frequencyText();
+    QVERIFY2(panel_->poleZero()->pointCount() > pointsBefore, qPrintable(after));
+    QVERIFY2(firstNotch(after) < firstNotch(before) - 1.0, qPrintable(before + " -> " + after));
     window_->workspace()->undoStack()->undo();
   }
 
