@@ -266,7 +266,7 @@ void ModelPanel::refreshModel() {
     bode_->addCurve(curve);
     poleZero_->addSet(entry.name, QColor(31, 119, 180), poles(sys), zeros(sys));
     const NotchesPeaks np = notchesAndPeaks(sys);
-    frequencies_->setText(tr("Notches %1 rad/s; peaks %2 rad/s (minima and maxima of |G(i w)|)")
+    frequencies_->setText(tr("Notches %1 rad/s; peaks %2 rad/s")
                               .arg(frequenciesText(np.notches))
                               .arg(frequenciesText(np.peaks)));
   } catch (const std::exception& e) {
