@@ -12,6 +12,7 @@
 #include <QDropEvent>
 #include <QFileDialog>
 #include <QFileInfo>
+#include <QInputDialog>
 #include <QFormLayout>
 #include <QLabel>
 #include <QMenuBar>
@@ -88,7 +89,7 @@ bool askTableMapping(QWidget* parent, const QString& path, LogReadOptions& o) {
   auto* ts = new QDoubleSpinBox;
   ts->setDecimals(6);
   ts->setRange(1e-6, 1e6);
-  ts->setValue(o.sampleTime);
+  ts->setValue(o.sampleTime > 0.0 ? o.sampleTime : 1.0);
   ts->setSuffix(" s");
   form->addRow(QObject::tr("Input u column"), in);
   form->addRow(QObject::tr("Output y column"), out);
@@ -346,6 +347,23 @@ void MainWindow::onReadFinished() {
   LogReadResult r = reader_.result();
   if (!r.ok && r.irregularTime && !readingOptions_.keepIrregularTime) {
     offerResampling(QString::fromStdString(r.error.toString()));
+    return;
+  }
+  if (!r.ok && r.needsSampleTime && !(readingOptions_.sampleTime > 0.0)) {
+    // The file stores no time: ask for the sample time instead of guessing one.
+    bool given = false;
+    const double ts = QInputDialog::getDouble(
+        this, tr("Sample time"),
+        tr("%1 stores no time. Seconds between samples (e.g. 0.0005 for 2 kHz):")
+            .arg(QFileInfo(readingPath_).fileName()),
+        0.001, 1e-6, 1e6, 6, &given);
+    if (given) {
+      LogReadOptions options = readingOptions_;
+      options.sampleTime = ts;
+      openFile(readingPath_, options);
+    } else {
+      statusBar()->showMessage(tr("Opening %1 cancelled").arg(readingPath_), 5000);
+    }
     return;
   }
   if (!r.ok) {

@@ -67,7 +67,8 @@ BodePanel::BodePanel(Workspace* workspace, QWidget* parent)
   window_->setObjectName("bodeWindowSpin");
   window_->setRange(0, 20000);
   window_->setValue(400);
-  window_->setToolTip(tr("SPA lag window width M in samples (0: min(N/10, 30)); ETFE uses "
+  window_->setToolTip(tr("SPA lag window width M in samples (0: chosen from the data, 1 s of lags and at most "
+                         "N/10, SITB's min(N/10, 30) for slow data; the result says which); ETFE uses "
                          "M/50 bins of smoothing"));
   export_->setObjectName("bodeExportButton");
   note_->setObjectName("bodeNote");

@@ -83,6 +83,7 @@ QString ComparePanel::fitText() const { return fit_->text(); }
 void ComparePanel::refresh() {
   plot_->clearGraphs();
   fits_.clear();
+  fitsNrmse_.clear();
   const auto& list = workspace_->models();
   // Models give the motor velocity (the fit pipeline's black-box estimates too, Section 5.2),
   // unless a physical model's output is the motor angle.
@@ -142,19 +143,23 @@ void ComparePanel::refresh() {
     }
     if (!sim || !sim->allFinite()) {
       fits_.push_back(std::nan(""));
+      fitsNrmse_.push_back(std::nan(""));
       lines << tr("%1: not simulated (%2)").arg(list[i].name, reason.isEmpty() ? tr("unstable") : reason);
       continue;
     }
     const SampleRange r = rangeOf(*data);
-    const double fit = fitPercent(data->y, *sim, static_cast<Eigen::Index>(r.begin),
-                                  static_cast<Eigen::Index>(r.end));
-    fits_.push_back(fit);
-    addGraph(*data, *sim, tr("%1: %2 %").arg(list[i].name).arg(fit, 0, 'f', 1), QPen(color, 1.2));
-    lines << tr("%1: fit %2 %%3").arg(list[i].name).arg(fit, 0, 'f', 1)
+    const FitPercents fit = fitPercents(data->y, *sim, static_cast<Eigen::Index>(r.begin),
+                                        static_cast<Eigen::Index>(r.end));
+    fits_.push_back(fit.seed52);
+    fitsNrmse_.push_back(fit.nrmse);
+    addGraph(*data, *sim, tr("%1: %2 % (5.2)").arg(list[i].name).arg(fit.seed52, 0, 'f', 1), QPen(color, 1.2));
+    lines << tr("%1: fit %2 % (5.2), %3 % NRMSE%4").arg(list[i].name).arg(fit.seed52, 0, 'f', 1)
+                 .arg(fit.nrmse, 0, 'f', 1)
                  .arg(factor > 1 ? tr(" (at %1 Hz)").arg(1.0 / data->sampleTime, 0, 'g', 4) : QString());
   }
   addGraph(*base, base->y, tr("measured"), QPen(QColor(20, 20, 20), 1.0));  // on top
-  lines.prepend(tr("Fit (5.2) of the simulated output on the %1 data (%2):")
+  lines.prepend(tr("Fit of the simulated output on the %1 data (%2), as the seed's (5.2) "
+                    "1 - sum e^2/sum (y - mean y)^2 and as MATLAB compare's NRMSE 1 - |e|/|y - mean y|:")
                     .arg(noValidation ? tr("estimation (no validation range set)")
                                       : kind == RangeKind::Validation ? tr("validation") : tr("estimation"),
                          QString::fromStdString(base->note())));

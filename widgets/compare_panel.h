@@ -26,7 +26,9 @@ class ComparePanel : public QWidget {
   void setModelShown(int index, bool shown);
   void setRangeKind(RangeKind kind);
   // Fit % of each checked model in list order (NaN where it could not be simulated).
+  // Each checked model's fit % on the range shown: the seed's (5.2) and the NRMSE fit.
   std::vector<double> fits() const { return fits_; }
+  std::vector<double> fitsNrmse() const { return fitsNrmse_; }
   QString fitText() const;
   QCustomPlot* plot() const { return plot_; }
   // Shows the window's playhead in the plot; a click there moves it.
@@ -45,7 +47,7 @@ class ComparePanel : public QWidget {
   QCustomPlot* plot_;
   QLabel* fit_;
   PlayheadCursor* cursor_;
-  std::vector<double> fits_;
+  std::vector<double> fits_, fitsNrmse_;
 };
 
 }  // namespace flexarm

@@ -463,13 +463,13 @@ void DiscoveryPanel::showComparison() {
   const DiscoveryResult& r = *result_;
   // A stored summary shows the augmented scores at once: its model is not in the list.
   const bool after = added_ || (r.effect && r.estimation.time.empty());
-  QString text = tr("Base: fit %1 % (estimation)").arg(r.base.fitPercent, 0, 'f', 1);
+  QString text = tr("Base: fit (5.2) %1 % (estimation)").arg(r.base.fitPercent, 0, 'f', 1);
   if (r.hasValidation)
     text += tr(", %1 % (validation), residual RMS %2 rad/s")
                 .arg(r.base.fitPercentValidation, 0, 'f', 1)
                 .arg(num(r.base.rmsValidation));
   if (after) {
-    text += tr(".   Augmented: fit %1 % (estimation)").arg(r.augmented.fitPercent, 0, 'f', 1);
+    text += tr(".   Augmented: fit (5.2) %1 % (estimation)").arg(r.augmented.fitPercent, 0, 'f', 1);
     if (r.hasValidation)
       text += tr(", %1 % (validation), residual RMS %2 rad/s (%3 % lower)")
                   .arg(r.augmented.fitPercentValidation, 0, 'f', 1)

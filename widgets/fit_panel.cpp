@@ -622,13 +622,21 @@ void FitPanel::onFinished() {
                  .arg(QString::fromStdString(r.methodDescription), QString::fromStdString(r.methodReason));
   if (!r.controllerSource.empty()) lines << tr("Controller: %1.").arg(QString::fromStdString(r.controllerSource));
   lines << tr("Loss %1, FPE %2, AIC %3.").arg(number(s.loss), number(s.fpe), number(s.aic));
-  QString fits = r.fitEstimation ? tr("Fit %1 % on the estimation data").arg(*r.fitEstimation, 0, 'f', 1)
+  // Both fit percentages, named: the seed's (5.2) and the NRMSE fit MATLAB's compare prints.
+  QString fits = r.fitEstimation ? tr("Fit %1 % (5.2), %2 % NRMSE on the estimation data")
+                                       .arg(*r.fitEstimation, 0, 'f', 1)
+                                       .arg(r.fitEstimationNrmse.value_or(NAN), 0, 'f', 1)
                                  : tr("No fit % (the simulated output diverges)");
-  if (auto v = r.fitValidation()) fits += tr(", %1 % on the validation data.").arg(*v, 0, 'f', 1);
+  if (auto v = r.fitValidation())
+    fits += tr(", %1 % (5.2), %2 % NRMSE on the validation data.")
+                .arg(*v, 0, 'f', 1)
+                .arg(r.fitValidationNrmse().value_or(NAN), 0, 'f', 1);
   else if (r.validation.empty()) fits += tr("; no validation range set.");
   else fits += ".";
   lines << fits;
-  lines << tr("Notches: %1. Peaks: %2.").arg(joined(r.notches), joined(r.peaks));
+  lines << tr("Notches: %1. Peaks: %2. (rad/s: the minima and maxima of |G(i w)|, what a click on "
+              "the Bode plot reads, as flexarm model and the reports give them)")
+               .arg(joined(r.notches), joined(r.peaks));
   for (const auto& w : r.warnings) lines << tr("Note: %1.").arg(QString::fromStdString(w));
   // The estimate joins the shared list under a name no other entry has, naming its data:
   // "three-mass estimate 2 (chirp.csv 0.5-12 s)".

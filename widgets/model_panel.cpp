@@ -28,11 +28,18 @@
 namespace flexarm {
 namespace {
 
-QString modesText(const std::vector<Mode>& modes) {
+QString frequenciesText(const std::vector<double>& w) {
   QStringList parts;
-  for (const auto& m : modes) parts << QString::number(m.frequency, 'f', 1);
+  for (double x : w) parts << QString::number(x, 'f', 1);
   return parts.isEmpty() ? QString("-") : parts.join(", ");
 }
+
+// FlexArm's one definition of notches and peaks (core/models/analysis.h), said where they show.
+const char* const kNotchPeakDefinition =
+    "Notches and peaks: the frequencies of the minima and maxima of |G(i w)| (the motor velocity "
+    "per torque), what a click on the Bode plot reads; the same numbers as flexarm model, "
+    "flexarm fit and the reports. For a lightly damped pair they lie near the imaginary part of "
+    "the zero or pole, (5.4).";
 
 }  // namespace
 
@@ -83,6 +90,7 @@ ModelPanel::ModelPanel(Workspace* workspace, QWidget* parent)
   description_->setWordWrap(true);
   frequencies_->setObjectName("frequencyLabel");
   frequencies_->setWordWrap(true);
+  frequencies_->setToolTip(tr(kNotchPeakDefinition));
   fit_->setObjectName("fitLabel");
   simulate_->setObjectName("simulateButton");
   compare_->setObjectName("comparePlot");
@@ -257,9 +265,10 @@ void ModelPanel::refreshModel() {
     curve.response = frequencyResponse(sys, w);
     bode_->addCurve(curve);
     poleZero_->addSet(entry.name, QColor(31, 119, 180), poles(sys), zeros(sys));
+    const NotchesPeaks np = notchesAndPeaks(sys);
     frequencies_->setText(tr("Notches %1 rad/s; peaks %2 rad/s")
-                              .arg(modesText(notchFrequencies(sys)))
-                              .arg(modesText(peakFrequencies(sys))));
+                              .arg(frequenciesText(np.notches))
+                              .arg(frequenciesText(np.peaks)));
   } catch (const std::exception& e) {
     frequencies_->setText(tr("Cannot analyse the model: %1").arg(e.what()));
   }

@@ -19,9 +19,13 @@ const char* logReadOptionsHelp() {
          "  --input-column N      headerless table: column of the input u (default 1)\n"
          "  --output-column N     headerless table: column of the output y (default 2)\n"
          "  --time-column N       headerless table: column of the time (default none)\n"
-         "  --sample-time T       seconds between samples when there is no time (default 1)\n"
-         "  --input-name NAME     channel name for the input (default u)\n"
-         "  --output-name NAME    channel name for the output (default y)\n"
+         "  --sample-time T       seconds between samples when the file stores no time; a\n"
+         "                        .mat file without time_s (or a scalar Ts, dt) needs it, a\n"
+         "                        table without a time column takes 1 s and says so\n"
+         "  --input-name NAME     channel name for the input (default u; .mat: the variable's\n"
+         "                        name, and a variable NAME is the input)\n"
+         "  --output-name NAME    channel name for the output (default y; .mat: the\n"
+         "                        variable's name, and a variable NAME is the output)\n"
          "  --input-var NAME      .mat: variable holding the input\n"
          "  --output-var NAME     .mat: variable holding the output\n";
 }

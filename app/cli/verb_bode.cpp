@@ -20,6 +20,9 @@ const char* kBodeHelp =
     "magnitude, magnitude_db, phase_deg, magnitude_lower, magnitude_upper, phase_lower_deg,\n"
     "phase_upper_deg (band columns empty where there is no covariance, e.g. ETFE).\n\n"
     "  --model spa[:M]       non-parametric SPA (4.28), Hann lag window of width M\n"
+    "                        (default: chosen from the data, 1 s of lags and at most N/10,\n"
+    "                        SITB's min(N/10, 30) when 1 s is under 30 samples; the note\n"
+    "                        and JSON message say which and why)\n"
     "  --model etfe[:W]      ETFE (4.24) smoothed over W bins (4.25)\n"
     "  --out FILE            the CSV file to write (required)\n"
     "  --level P             confidence level of the bands (default 0.99)\n"
@@ -89,10 +92,9 @@ int runBode(const std::vector<std::string>& argv, std::ostream& out, std::ostrea
     err << "flexarm bode: " << why << "\n";
     return kExitBadInput;
   }
-  const bool nonparametric = fit.model.kind == FitModelKind::Spa || fit.model.kind == FitModelKind::Etfe;
   const std::string name = fit.modelName();
-  // Non-parametric curves ripple: only extrema 3 dB deep count there.
-  const auto np = notchesAndPeaks(fr, nonparametric ? 3.0 : 1.0);
+  // The fit's rule (non-parametric curves ripple: only extrema 3 dB deep count there).
+  const auto np = fitNotchesAndPeaks(fit, fr, FitOptions{}.notchDepthDb);
   if (args.flag("json")) {
     nlohmann::json j = {{"model", name},
                         {"output", *outPath},
@@ -102,17 +104,21 @@ int runBode(const std::vector<std::string>& argv, std::ostream& out, std::ostrea
                         {"notches_rad_s", np.notches},
                         {"peaks_rad_s", np.peaks},
                         {"warning", fit.nonparametric.warning},
+                        {"message", fit.summary.message},
+                        {"lag_window", fit.model.kind == FitModelKind::Spa ? nlohmann::json(fit.nonparametric.window)
+                                                                             : nlohmann::json(nullptr)},
                         {"omitted_frequencies", omitted}};
     out << j.dump(2) << "\n";
   } else {
     out << "wrote " << *outPath << ": " << fr.omega.size() << " frequencies of " << name
         << (fr.hasBands() ? " with bands" : "") << "\n";
+    if (fit.model.kind == FitModelKind::Spa) out << "note: " << fit.summary.message << "\n";
     if (!fit.nonparametric.warning.empty())
       out << "warning: " << fit.nonparametric.warning << "\n";
     if (omitted > 0)
       out << "note: left out " << omitted << " of " << points
-          << " frequencies where the smoothed input spectrum is not positive (the input has "
-             "no power there)\n";
+          << " frequencies where the smoothed input spectrum is not positive or below 1e-2 of "
+             "its peak (the input has almost no power there)\n";
   }
   return kExitOk;
 }

@@ -15,7 +15,9 @@ const char* kDiscoverHelp =
     "                        [--effects A,B,...] [--threads N] [--json]\n\n"
     "Finds the effect the physical model misses. The base model (chapter 3: (3.13) or (3.21),\n"
     "nominal parameters as the start) is fitted to the motor velocity differentiated from the\n"
-    "motor angle (Section 5.2) by prediction error, simulating the model from the torque\n"
+    "motor angle (Section 5.2; a log whose output is the motor velocity, motor_velocity_rad_s\n"
+    "or an output in rad/s, is integrated to an angle from zero and differentiated the same\n"
+    "way) by prediction error, simulating the model from the torque\n"
     "reference at the data's rate with a slow load observer. Each candidate effect\n"
     "(coulomb_friction, backlash, nonlinear_spring, input_delay, torque_ripple, extra_mass) is\n"
     "added as a physical term and refitted with the base parameters. An effect is named only\n"
@@ -31,18 +33,23 @@ const char* kDiscoverHelp =
     "JSON fields: effect (a name or \"none\"), tied, effect_parameters {name: {value, std,\n"
     "unit, lower, upper}}, evidence, candidates [{effect, loss_est, rms_val, aic, f, f_threshold,\n"
     "significant, reason, parameters}], base and augmented {fit_percent,\n"
-    "fit_percent_validation, rms_estimation, rms_validation}, disagreement (summary,\n"
+    "fit_percent_validation (the seed's (5.2)), fit_percent_nrmse,\n"
+    "fit_percent_validation_nrmse (MATLAB compare's NRMSE fit), rms_estimation,\n"
+    "rms_validation}, disagreement (summary,\n"
     "whiteness and independence tests), sample_time, seconds.\n";
 
 nlohmann::json scoreJson(const DiscoveryScore& s, bool hasValidation) {
   nlohmann::json j;
   j["fit_percent"] = s.fitPercent;
+  j["fit_percent_nrmse"] = s.fitPercentNrmse;
   j["rms_estimation"] = s.rmsEstimation;
   if (hasValidation) {
     j["fit_percent_validation"] = s.fitPercentValidation;
+    j["fit_percent_validation_nrmse"] = s.fitPercentValidationNrmse;
     j["rms_validation"] = s.rmsValidation;
   } else {
     j["fit_percent_validation"] = nullptr;
+    j["fit_percent_validation_nrmse"] = nullptr;
     j["rms_validation"] = nullptr;
   }
   return j;

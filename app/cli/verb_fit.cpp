@@ -358,9 +358,16 @@ const char* fitOptionsHelp() {
          "  --json                print the result as JSON\n"
          "Physical, black-box and non-parametric models give the motor velocity: a log whose\n"
          "output is the motor angle is differentiated first (central differences, Section 5.2).\n"
-         "Fit % is (5.2) of the output simulated from zero initial state (input held constant\n"
-         "between samples), from the start of the estimation range, and for validation from\n"
-         "the first sample of the log holding the validation range.\n";
+         "Fit % is printed both ways, of the output simulated from zero initial state (input\n"
+         "held constant between samples), from the start of the estimation range, and for\n"
+         "validation from the first sample of the log holding the validation range:\n"
+         "  (5.2)  the seed's 1 - sum e^2 / sum (y - mean y)^2 (JSON: fit_percent,\n"
+         "         fit_percent_validation, and fit_percent in each experiment)\n"
+         "  NRMSE  MATLAB compare's 1 - ||e|| / ||y - mean y|| (JSON: fit_percent_nrmse,\n"
+         "         fit_percent_validation_nrmse); 96.4 % (5.2) is 81.0 % NRMSE.\n"
+         "Notches and peaks (JSON notches_rad_s, peaks_rad_s): the frequencies of the local\n"
+         "minima and maxima of |G(i w)| of the estimate, what a click on the Bode plot reads\n"
+         "(the same rule as `flexarm model`).\n";
 }
 
 int runFitPipeline(ArgParser& args, const std::string& verb, FitResult& result, std::ostream& err,
@@ -525,7 +532,8 @@ int runFit(const std::vector<std::string>& argv, std::ostream& out, std::ostream
       a.push_back({{"log", i < names.size() ? names[i] : std::string()},
                    {"range_s", {d.timeAt(range.begin), d.timeAt(range.end - 1)}},
                    {"samples", range.size()},
-                   {"fit_percent", optJson(list[i].fitPercent)}});
+                   {"fit_percent", optJson(list[i].fitPercent)},
+                   {"fit_percent_nrmse", optJson(list[i].fitPercentNrmse)}});
     }
     return a;
   };
@@ -562,6 +570,8 @@ int runFit(const std::vector<std::string>& argv, std::ostream& out, std::ostream
                         {"effects", effects},
                         {"fit_percent", optJson(fit.fitEstimation)},
                         {"fit_percent_validation", optJson(fit.fitValidation())},
+                        {"fit_percent_nrmse", optJson(fit.fitEstimationNrmse)},
+                        {"fit_percent_validation_nrmse", optJson(fit.fitValidationNrmse())},
                         {"fit_percent_experiments", experiments(fit.estimation, files.estimation, false)},
                         {"fit_percent_validation_experiments", experiments(fit.validation, files.validation, true)},
                         {"warnings", fit.warnings},
@@ -600,9 +610,21 @@ int runFit(const std::vector<std::string>& argv, std::ostream& out, std::ostream
     out << "  " << p.name << " = " << p.value << " +- " << p.std << (p.free ? "" : " (fixed)")
         << (p.effect.empty() ? "" : " " + p.unit + " (" + p.effect + ")") << "\n";
   out << "loss " << s.loss << ", FPE " << s.fpe;
-  if (fit.fitEstimation) out << ", fit " << *fit.fitEstimation << " %";
-  if (auto v = fit.fitValidation()) out << ", validation fit " << *v << " %";
   out << "\n";
+  // Both fit percentages, named (evaluation.h): the seed's (5.2) and MATLAB compare's NRMSE.
+  auto both = [&](const std::optional<double>& seed52, const std::optional<double>& nrmse) {
+    out << *seed52 << " % (5.2), " << nrmse.value_or(NAN) << " % NRMSE";
+  };
+  if (fit.fitEstimation) {
+    out << "fit on the estimation data: ";
+    both(fit.fitEstimation, fit.fitEstimationNrmse);
+    out << "\n";
+  }
+  if (auto v = fit.fitValidation()) {
+    out << "fit on the validation data: ";
+    both(v, fit.fitValidationNrmse());
+    out << "\n";
+  }
   // Each experiment's fit % when there are several of a kind.
   auto listFits = [&](const char* what, const std::vector<FitValidation>& list,
                       const std::vector<std::string>& names, bool validation) {
@@ -612,7 +634,10 @@ int runFit(const std::vector<std::string>& argv, std::ostream& out, std::ostream
       const SampleRange& range = validation ? d.validation : d.estimation;
       out << what << " " << i + 1 << " (" << (i < names.size() ? names[i] : std::string()) << ", "
           << d.timeAt(range.begin) << "-" << d.timeAt(range.end - 1) << " s): fit ";
-      if (list[i].fitPercent) out << *list[i].fitPercent << " %\n";
+      if (list[i].fitPercent) {
+        both(list[i].fitPercent, list[i].fitPercentNrmse);
+        out << "\n";
+      }
       else out << "undefined\n";
     }
   };

@@ -14,11 +14,17 @@ const char* kModelHelp =
     "Usage: flexarm model [--model STRUCTURE] [--param NAME=VALUE ...] [options] [--json]\n\n"
     "Builds a physical model of the seed's chapter 3 and prints its matrices A, B, C, D (seed\n"
     "state coordinates), poles, transmission zeros, the transfer function, and the notch\n"
-    "(antiresonance, lightly damped zero pair) and peak (resonance, lightly damped pole pair)\n"
-    "frequencies in rad/s, as (5.4) defines them: the imaginary part of the root.\n\n";
+    "and peak frequencies in rad/s.\n"
+    "Notches and peaks (JSON notches_rad_s, peaks_rad_s) are the frequencies of the local\n"
+    "minima and maxima of |G(i w)|, at least 1 dB deep: what a click on the Bode plot reads\n"
+    "and what `flexarm fit`, the panels and the reports print for the same model. For a\n"
+    "lightly damped pair they lie near the imaginary part of the zero (notch) or pole (peak),\n"
+    "which (5.4) approximates; those roots are listed apart (JSON lightly_damped_zeros,\n"
+    "lightly_damped_poles, with their damping ratios).\n\n";
 
 const char* kModelHelpTail =
-    "  --damping-limit Z     a pair is a notch/peak when |damping ratio| < Z (default 0.3)\n"
+    "  --damping-limit Z     list a root pair as lightly damped when |damping ratio| < Z\n"
+    "                        (default 0.3)\n"
     "  --discretize zoh|foh  also print the discrete model (needs --sample-time)\n"
     "  --sample-time T       sample time in seconds for --discretize\n"
     "  --bode W0:W1:N        frequency response at N log-spaced frequencies W0..W1 rad/s\n"
@@ -117,8 +123,9 @@ int runModel(const std::vector<std::string>& argv, std::ostream& out, std::ostre
   const auto p = poles(ss);
   const auto z = zeros(ss);
   const auto tf = transferFunction(ss);
-  const auto notches = lightlyDamped(z, limit);
-  const auto peaks = lightlyDamped(p, limit);
+  const auto dampedZeros = lightlyDamped(z, limit);
+  const auto dampedPoles = lightlyDamped(p, limit);
+  const NotchesPeaks np = notchesAndPeaks(ss);
   nlohmann::json j = modelJson(*model);
   j["states"] = model->stateNames();
   j["outputs"] = model->outputNames();
@@ -127,8 +134,10 @@ int runModel(const std::vector<std::string>& argv, std::ostream& out, std::ostre
   j["zeros"] = rootsJson(z);
   j["transfer_function"] = {{"num", tf.num}, {"den", tf.den}, {"output", model->outputNames()[0]},
                             {"input", "u (torque reference)"}};
-  j["notches"] = modesJson(notches);
-  j["peaks"] = modesJson(peaks);
+  j["notches_rad_s"] = np.notches;
+  j["peaks_rad_s"] = np.peaks;
+  j["lightly_damped_zeros"] = modesJson(dampedZeros);
+  j["lightly_damped_poles"] = modesJson(dampedPoles);
   if (method) j["discrete"] = stateSpaceJson(discretize(ss, sampleTime, *method));
   if (nBode > 0) {
     std::vector<double> w;
@@ -159,10 +168,14 @@ int runModel(const std::vector<std::string>& argv, std::ostream& out, std::ostre
   };
   printRoots("Poles", p);
   printRoots("Zeros", z);
-  out << "\nNotches (rad/s):";
-  for (const auto& m : notches) out << " " << m.frequency;
-  out << "\nPeaks (rad/s):";
-  for (const auto& m : peaks) out << " " << m.frequency;
+  out << "\nNotches (rad/s, minima of |G(i w)|):";
+  for (double w : np.notches) out << " " << w;
+  out << "\nPeaks (rad/s, maxima of |G(i w)|):";
+  for (double w : np.peaks) out << " " << w;
+  out << "\nLightly damped zeros (Im rad/s, damping):";
+  for (const auto& m : dampedZeros) out << " " << m.frequency << " (" << m.damping << ")";
+  out << "\nLightly damped poles (Im rad/s, damping):";
+  for (const auto& m : dampedPoles) out << " " << m.frequency << " (" << m.damping << ")";
   out << "\n";
   return kExitOk;
 }

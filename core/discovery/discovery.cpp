@@ -66,18 +66,33 @@ using Clock = std::chrono::steady_clock;
 // rate, what the plant integrates), the means kept (friction and backlash act on the real
 // velocity, the ripple on the real angle). The angle is differentiated here, at the fitting
 // rate, exactly as the predicted angle is.
+//
+// A log whose output is the motor velocity (motor_velocity_rad_s, or an output channel in
+// rad/s, as the physical models give it) is integrated to an angle from zero (trapezoids),
+// and that angle is differentiated like a measured one, so the measured and the predicted
+// velocity pass the same central differences. Only the ripple, which acts on the absolute
+// angle, then sees an angle offset by the unknown start.
+const Channel* velocityChannel(const IdData& data) {
+  if (const Channel* v = data.channel(columns::kMotorVelocity)) return v;
+  const Channel* out = data.output();
+  return out && out->unit == "rad/s" ? out : nullptr;
+}
+
 std::optional<NonlinearSeries> makeSeries(const IdData& data, double maxRateHz, std::string* why) {
   const Channel* in = data.input();
   if (!in) in = data.channel(columns::kTorqueRef);
   const Channel* angle = data.channel(columns::kMotorAngle);
-  if (!in || !angle || in == angle) {
-    *why = "the log needs the torque reference (input) and the motor angle channel " +
-           std::string(columns::kMotorAngle);
+  const Channel* velocity = angle ? nullptr : velocityChannel(data);
+  const Channel* measured = angle ? angle : velocity;
+  if (!in || !measured || in == measured) {
+    *why = "the log needs the torque reference (input) and the motor angle " +
+           std::string(columns::kMotorAngle) + " or the motor velocity " +
+           std::string(columns::kMotorVelocity) + " (or an output in rad/s)";
     return std::nullopt;
   }
   FitDataOptions o;
   o.input = in->name;
-  o.output = angle->name;
+  o.output = measured->name;
   o.reference = "";
   o.decimation = std::max(1, static_cast<int>(std::floor(data.sampleRateHz() / maxRateHz + 0.5)));
   o.decimatedInput = FitDataOptions::DecimatedInput::HeldMean;
@@ -95,6 +110,15 @@ std::optional<NonlinearSeries> makeSeries(const IdData& data, double maxRateHz, 
   s.startTime = p.startTime;
   s.u.assign(p.u.data(), p.u.data() + p.u.size());
   s.phi.assign(p.y.data(), p.y.data() + p.y.size());
+  if (velocity) {  // the angle from the velocity, from zero
+    double phi = 0.0, previous = s.phi.empty() ? 0.0 : s.phi[0];
+    for (auto& x : s.phi) {
+      const double v = x;
+      phi += 0.5 * s.Ts * (previous + v);
+      previous = v;
+      x = phi;
+    }
+  }
   for (std::size_t k = 0; k < s.u.size(); ++k)
     if (!std::isfinite(s.u[k]) || !std::isfinite(s.phi[k])) {
       *why = "the log holds a non-finite value near sample " + std::to_string(k * static_cast<std::size_t>(o.decimation));
@@ -131,10 +155,16 @@ double rms(const std::vector<double>& a, const std::vector<double>& b) {
   return a.empty() ? 0.0 : std::sqrt(s / static_cast<double>(a.size()));
 }
 
-double fitPercentOf(const std::vector<double>& y, const std::vector<double>& yhat) {
+FitPercents fitPercentOf(const std::vector<double>& y, const std::vector<double>& yhat) {
   const Eigen::Map<const Eigen::VectorXd> a(y.data(), static_cast<Eigen::Index>(y.size()));
   const Eigen::Map<const Eigen::VectorXd> b(yhat.data(), static_cast<Eigen::Index>(yhat.size()));
-  return fitPercent(a, b);
+  return fitPercents(a, b);
+}
+
+// Both fit percentages of the estimation (or validation) data into a score.
+void setFit(DiscoveryScore& s, bool validation, const FitPercents& f) {
+  (validation ? s.fitPercentValidation : s.fitPercent) = f.seed52;
+  (validation ? s.fitPercentValidationNrmse : s.fitPercentNrmse) = f.nrmse;
 }
 
 double correlation(const std::vector<double>& a, const std::vector<double>& b) {
@@ -436,13 +466,13 @@ void fitCandidate(EffectKind kind, const PhysicalModel& base, const PhysicalMode
   c.lossEst = f.sol.sumSquares / static_cast<double>(f.sol.eps.size());
   pr.simulate(f.sol.phi, est, w.yhatEst);
   c.score.rmsEstimation = rms(est.y, w.yhatEst);
-  c.score.fitPercent = fitPercentOf(est.y, w.yhatEst);
+  setFit(c.score, false, fitPercentOf(est.y, w.yhatEst));
   if (val && pr.simulate(f.sol.phi, *val, w.yhatVal)) {
     c.score.rmsValidation = rms(val->y, w.yhatVal);
-    c.score.fitPercentValidation = fitPercentOf(val->y, w.yhatVal);
+    setFit(c.score, true, fitPercentOf(val->y, w.yhatVal));
   } else if (val) {
     c.score.rmsValidation = INFINITY;
-    c.score.fitPercentValidation = -INFINITY;
+    setFit(c.score, true, {-INFINITY, -INFINITY});
   }
   std::vector<double> share(w.yhatEst.size());
   for (std::size_t k = 0; k < share.size(); ++k) share[k] = w.yhatEst[k] - (est.y[k] - eBase[k]);
@@ -560,10 +590,10 @@ DiscoveryResult discoverMissingEffect(const PhysicalModel& base, const IdData& e
   const double nEff = static_cast<double>(N) / inflation;
   R.baseAic = nEff * std::log(R.baseLoss) + 2.0 * R.baseParameterCount;
   R.base.rmsEstimation = rms(est->y, yBase);
-  R.base.fitPercent = fitPercentOf(est->y, yBase);
+  setFit(R.base, false, fitPercentOf(est->y, yBase));
   if (valp) {
     R.base.rmsValidation = rms(valp->y, yBaseVal);
-    R.base.fitPercentValidation = fitPercentOf(valp->y, yBaseVal);
+    setFit(R.base, true, fitPercentOf(valp->y, yBaseVal));
   }
 
   // 2. Where the disagreement lives.

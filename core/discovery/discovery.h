@@ -54,9 +54,11 @@ struct EffectParameterEstimate {
   bool estimated = true;  // false: held at a value chosen by a grid (e.g. ripple periods n)
 };
 
-// Fit % (5.2) and residual RMS of one model on the estimation and the validation data.
+// Fit % and residual RMS of one model on the estimation and the validation data: fit % as
+// the seed's (5.2) and as MATLAB compare's NRMSE fit (fitPercents, core/ident/evaluation.h).
 struct DiscoveryScore {
-  double fitPercent = 0.0, fitPercentValidation = 0.0;
+  double fitPercent = 0.0, fitPercentValidation = 0.0;            // (5.2)
+  double fitPercentNrmse = 0.0, fitPercentValidationNrmse = 0.0;  // NRMSE
   double rmsEstimation = 0.0, rmsValidation = 0.0;
 };
 

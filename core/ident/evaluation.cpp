@@ -26,8 +26,14 @@ Eigen::VectorXd predict(const PolynomialModel& m, const Eigen::VectorXd& u,
   return filter(num, m.c, gu) + y - filter(polyMultiply(num, m.a), m.c, y);
 }
 
-double fitPercent(const Eigen::VectorXd& y, const Eigen::VectorXd& yhat, Eigen::Index begin,
-                  Eigen::Index end) {
+FitPercents fitPercentsFromSums(double squaredErrors, double squaredDeviations) {
+  if (!(squaredDeviations > 0.0)) return {-INFINITY, -INFINITY};
+  const double ratio = squaredErrors / squaredDeviations;
+  return {(1.0 - ratio) * 100.0, (1.0 - std::sqrt(ratio)) * 100.0};
+}
+
+FitPercents fitPercents(const Eigen::VectorXd& y, const Eigen::VectorXd& yhat, Eigen::Index begin,
+                        Eigen::Index end) {
   if (y.size() != yhat.size())
     throw std::invalid_argument("fitPercent: signals of different length");
   if (end == 0) end = y.size();
@@ -35,9 +41,12 @@ double fitPercent(const Eigen::VectorXd& y, const Eigen::VectorXd& yhat, Eigen::
     throw std::invalid_argument("fitPercent: range outside the data or shorter than 2 samples");
   const auto ys = y.segment(begin, end - begin);
   const auto es = ys - yhat.segment(begin, end - begin);
-  const double den = (ys.array() - ys.mean()).square().sum();
-  if (!(den > 0.0)) return -INFINITY;
-  return (1.0 - es.squaredNorm() / den) * 100.0;
+  return fitPercentsFromSums(es.squaredNorm(), (ys.array() - ys.mean()).square().sum());
+}
+
+double fitPercent(const Eigen::VectorXd& y, const Eigen::VectorXd& yhat, Eigen::Index begin,
+                  Eigen::Index end) {
+  return fitPercents(y, yhat, begin, end).seed52;
 }
 
 double twoSidedNormalQuantile(double level) {
@@ -142,46 +151,9 @@ std::vector<std::complex<double>> poles(const PolynomialModel& m) {
 
 std::vector<std::complex<double>> zeros(const PolynomialModel& m) { return polyRoots(m.b); }
 
-NotchesPeaks notchesAndPeaks(const FrequencyResponse& r, double minDepthDb) {
-  NotchesPeaks out;
-  const std::size_t n = r.magnitude.size();
-  if (n < 3) return out;
-  std::vector<double> db(n);
-  for (std::size_t i = 0; i < n; ++i) db[i] = 20.0 * std::log10(std::max(r.magnitude[i], 1e-300));
-  // Indices of all strict local extrema, with the ends as anchors.
-  std::vector<std::size_t> ext{0};
-  for (std::size_t i = 1; i + 1 < n; ++i)
-    if ((db[i] < db[i - 1] && db[i] <= db[i + 1]) || (db[i] > db[i - 1] && db[i] >= db[i + 1]))
-      ext.push_back(i);
-  ext.push_back(n - 1);
-  auto refine = [&](std::size_t i) {
-    // Parabola through three points in log-frequency.
-    const double x0 = std::log(r.omega[i - 1]), x1 = std::log(r.omega[i]),
-                 x2 = std::log(r.omega[i + 1]);
-    const double y0 = db[i - 1], y1 = db[i], y2 = db[i + 1];
-    const double den = (x0 - x1) * (x0 - x2) * (x1 - x2);
-    const double a = (x2 * (y1 - y0) + x1 * (y0 - y2) + x0 * (y2 - y1)) / den;
-    const double b = (x2 * x2 * (y0 - y1) + x1 * x1 * (y2 - y0) + x0 * x0 * (y1 - y2)) / den;
-    if (a == 0.0) return r.omega[i];
-    const double xv = std::clamp(-b / (2 * a), std::min(x0, x2), std::max(x0, x2));
-    return std::exp(xv);
-  };
-  for (std::size_t k = 1; k + 1 < ext.size(); ++k) {
-    const std::size_t i = ext[k];
-    double left = db[ext[k - 1]], right = db[ext[k + 1]];
-    // Compare with the highest/lowest value on each side up to the next extremum of the
-    // same kind, so that ripples do not hide a real notch.
-    const bool isMin = db[i] < db[i - 1];
-    for (std::size_t j = ext[k - 1]; j < i; ++j)
-      left = isMin ? std::max(left, db[j]) : std::min(left, db[j]);
-    for (std::size_t j = i + 1; j <= ext[k + 1]; ++j)
-      right = isMin ? std::max(right, db[j]) : std::min(right, db[j]);
-    if (isMin && left - db[i] >= minDepthDb && right - db[i] >= minDepthDb)
-      out.notches.push_back(refine(i));
-    if (!isMin && db[i] - left >= minDepthDb && db[i] - right >= minDepthDb)
-      out.peaks.push_back(refine(i));
-  }
-  return out;
+NotchesPeaks notchesAndPeaks(const FrequencyResponse& r, double minDepthDb,
+                             const std::function<double(double)>& exact) {
+  return magnitudeExtrema(r.omega, r.magnitude, minDepthDb, exact);
 }
 
 NotchesPeaks notchesAndPeaksFromRoots(const std::vector<std::complex<double>>& zerosZ,

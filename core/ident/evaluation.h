@@ -3,11 +3,13 @@
 // response with standard deviations and confidence bands (Gauss approximation), poles, zeros
 // and the notch and peak frequencies of the seed's Tables 5.1, 5.3 and 5.5.
 #include <complex>
+#include <functional>
 #include <vector>
 
 #include <Eigen/Dense>
 
 #include "core/ident/blackbox.h"
+#include "core/models/analysis.h"
 
 namespace flexarm {
 
@@ -18,8 +20,22 @@ Eigen::VectorXd simulate(const PolynomialModel& m, const Eigen::VectorXd& u);
 Eigen::VectorXd predict(const PolynomialModel& m, const Eigen::VectorXd& u,
                         const Eigen::VectorXd& y, int k);
 
-// Fit % (5.2): (1 - sum (y - yhat)^2 / sum (y - mean y)^2) * 100 over samples [begin, end)
-// (end 0 means the whole signal). Negative when the model is worse than the mean.
+// Fit % both ways, from the same sums (S_e = sum (y - yhat)^2, S_y = sum (y - mean y)^2):
+//   seed52: the seed's (5.2), (1 - S_e / S_y) * 100, the share of the output's variance the
+//           model explains (what FlexArm has always called "fit %");
+//   nrmse:  MATLAB's compare / goodnessOfFit NRMSE fit, (1 - sqrt(S_e / S_y)) * 100.
+// They are related by nrmse = 100 (1 - sqrt(1 - seed52 / 100)): 96.4 % (5.2) is 81.0 % NRMSE.
+// Both are negative when the model is worse than the mean, -infinity when S_y is zero.
+struct FitPercents {
+  double seed52 = 0.0;
+  double nrmse = 0.0;
+};
+// The one place both are formed: from the sums S_e and S_y (several experiments pool theirs).
+FitPercents fitPercentsFromSums(double squaredErrors, double squaredDeviations);
+// Over samples [begin, end) (end 0 means the whole signal).
+FitPercents fitPercents(const Eigen::VectorXd& y, const Eigen::VectorXd& yhat, Eigen::Index begin = 0,
+                        Eigen::Index end = 0);
+// Fit % (5.2) alone: fitPercents(...).seed52.
 double fitPercent(const Eigen::VectorXd& y, const Eigen::VectorXd& yhat, Eigen::Index begin = 0,
                   Eigen::Index end = 0);
 
@@ -54,12 +70,10 @@ void finishFrequencyResponse(FrequencyResponse& r, const std::vector<Eigen::Matr
 std::vector<std::complex<double>> poles(const PolynomialModel& m);
 std::vector<std::complex<double>> zeros(const PolynomialModel& m);
 
-// Frequencies (rad/s) of local minima (notches) and maxima (peaks) of the magnitude, each at
-// least `minDepthDb` below/above both neighbouring extrema; refined by parabolic interpolation.
-struct NotchesPeaks {
-  std::vector<double> notches, peaks;
-};
-NotchesPeaks notchesAndPeaks(const FrequencyResponse& r, double minDepthDb = 1.0);
+// Notches and peaks of a sampled response: magnitudeExtrema (core/models/analysis.h, FlexArm's
+// one definition) of r.magnitude over r.omega, refined on `exact` |G| when given.
+NotchesPeaks notchesAndPeaks(const FrequencyResponse& r, double minDepthDb = 1.0,
+                             const std::function<double(double)>& exact = {});
 
 // Notches and peaks from roots: complex zeros (notches) and poles (peaks) with damping ratio
 // below maxDamping, as the frequency |log z| / T of each lightly damped pair.

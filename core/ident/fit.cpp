@@ -172,6 +172,11 @@ std::optional<double> FitResult::fitValidation() const {
   return validation.front().fitPercent;
 }
 
+std::optional<double> FitResult::fitValidationNrmse() const {
+  if (validation.empty()) return std::nullopt;
+  return validation.front().fitPercentNrmse;
+}
+
 std::string FitResult::modelName() const {
   if (physical)
     return model.name() + (K.size() ? std::string(" (innovations form)") : std::string(" (K = 0)"));

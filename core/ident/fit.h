@@ -168,7 +168,8 @@ struct FitParameter {
 // sample, as the estimator saw it.
 struct FitValidation {
   PreparedData data;
-  std::optional<double> fitPercent;
+  std::optional<double> fitPercent;       // the seed's (5.2)
+  std::optional<double> fitPercentNrmse;  // MATLAB compare's NRMSE fit (evaluation.h)
   Eigen::VectorXd simulated;  // the whole log, from its first sample
 };
 
@@ -220,8 +221,12 @@ struct FitResult {
   // experiments, of them all together: 1 - sum of every squared error / sum of every squared
   // deviation from its own experiment's mean (each experiment's own is in `estimation`).
   std::optional<double> fitEstimation;
-  // Of the first validation experiment, when there is one.
+  // The same errors as MATLAB's compare prints them: the NRMSE fit 1 - ||e|| / ||y - mean y||
+  // (fitPercentsFromSums, evaluation.h), set exactly when fitEstimation is.
+  std::optional<double> fitEstimationNrmse;
+  // Of the first validation experiment, when there is one: (5.2) and NRMSE.
   std::optional<double> fitValidation() const;
+  std::optional<double> fitValidationNrmse() const;
   Eigen::VectorXd simulated;  // of the whole estimation log, from its first sample
   // Prediction errors (one-step for black-box models, output errors for physical ones) of
   // the validation range (the estimation range without one), tested for whiteness and
@@ -268,6 +273,13 @@ FrequencyResponse fitResponse(const FitResult& result, const std::vector<double>
 FrequencyResponse estimateResponse(const PhysicalModel* physical, const Eigen::MatrixXd& covariance,
                                    const std::vector<int>& freeIndices, const PolynomialModel* polynomial,
                                    const std::vector<double>& omega, double level);
+
+// Notches and peaks of an estimate on a response of it (FitResult::response, or another grid
+// as `flexarm bode` draws): FlexArm's one definition (magnitudeExtrema, core/models/analysis.h),
+// extrema at least depthDb deep (kNonparametricNotchDepthDb for SPA and ETFE, whose curves
+// ripple), refined on the exact response of a physical or black-box estimate.
+inline constexpr double kNonparametricNotchDepthDb = 3.0;
+NotchesPeaks fitNotchesAndPeaks(const FitResult& result, const FrequencyResponse& response, double depthDb);
 
 // The default frequency grid of a fit: responsePoints from 2 pi / (N T) to pi / T, N the
 // estimation samples.

@@ -3,6 +3,8 @@
 // sentences the user reads beside the numbers.
 #include <cmath>
 #include <cstdio>
+#include <functional>
+#include <memory>
 #include <string>
 
 #include "core/ident/evaluation.h"
@@ -78,6 +80,29 @@ void intervalCaveats(const FitOptions& o, FitResult& r) {
 
 }  // namespace
 
+}  // namespace flexarm::fit_detail
+
+namespace flexarm {
+
+NotchesPeaks fitNotchesAndPeaks(const FitResult& r, const FrequencyResponse& response, double depthDb) {
+  // FlexArm's one definition (core/models/analysis.h): extrema of |G(i w)|, refined on the
+  // estimate's exact response, so a physical estimate gives what `flexarm model` gives.
+  std::function<double(double)> exact;
+  if (r.physical) {
+    const StateSpace sys = r.physical->stateSpace();
+    exact = [sys](double w) { return std::abs(frequencyResponse(sys, std::vector<double>{w}).front()); };
+  } else if (r.polynomial) {
+    const std::shared_ptr<const PolynomialModel> m = r.polynomial;
+    exact = [m](double w) { return frequencyResponse(*m, std::vector<double>{w}).magnitude.front(); };
+  }
+  const bool nonparametric = !r.physical && !r.polynomial;
+  return notchesAndPeaks(response, nonparametric ? kNonparametricNotchDepthDb : depthDb, exact);
+}
+
+}  // namespace flexarm
+
+namespace flexarm::fit_detail {
+
 void evaluate(const FitOptions& o, FitResult& r) {
   const bool parametric = r.physical || r.polynomial;
   const PreparedData& d = r.data;
@@ -89,30 +114,44 @@ void evaluate(const FitOptions& o, FitResult& r) {
     for (auto& e : r.estimation) {
       const Eigen::VectorXd yEst = e.data.estimationOutput();
       const Eigen::VectorXd ySim = simulated(o, r, e.data, e.data.estimation);
-      const double fe = fitPercent(yEst, ySim);
+      const FitPercents fe = fitPercents(yEst, ySim);
       const SampleRange whole{0, static_cast<std::size_t>(e.data.u.size())};
       e.simulated = simulated(o, r, e.data, whole);  // from the log's first sample
-      if (std::isfinite(fe)) e.fitPercent = fe;
-      else finite = false;
+      if (std::isfinite(fe.seed52)) {
+        e.fitPercent = fe.seed52;
+        e.fitPercentNrmse = fe.nrmse;
+      } else {
+        finite = false;
+      }
       errors += (yEst - ySim).squaredNorm();
       deviations += (yEst.array() - yEst.mean()).square().sum();
     }
     r.simulated = r.estimation.front().simulated;
-    const double fe = r.estimation.size() == 1 ? r.estimation.front().fitPercent.value_or(NAN)
-                                               : 100.0 * (1.0 - errors / deviations);
-    finite = finite && std::isfinite(fe);
-    if (finite) r.fitEstimation = fe;
+    const FitPercents fe = fitPercentsFromSums(errors, deviations);
+    finite = finite && std::isfinite(fe.seed52);
+    if (finite) {
+      r.fitEstimation = fe.seed52;
+      r.fitEstimationNrmse = fe.nrmse;
+    }
     for (auto& v : r.validation) {
       v.simulated = simulated(o, r, v.data, SampleRange{0, static_cast<std::size_t>(v.data.u.size())});
-      const double fv = fitPercent(v.data.y, v.simulated, static_cast<Eigen::Index>(v.data.validation.begin),
-                                   static_cast<Eigen::Index>(v.data.validation.end));
-      if (std::isfinite(fv)) v.fitPercent = fv;
-      else finite = false;
+      const FitPercents fv = fitPercents(v.data.y, v.simulated, static_cast<Eigen::Index>(v.data.validation.begin),
+                                         static_cast<Eigen::Index>(v.data.validation.end));
+      if (std::isfinite(fv.seed52)) {
+        v.fitPercent = fv.seed52;
+        v.fitPercentNrmse = fv.nrmse;
+      } else {
+        finite = false;
+      }
     }
     if (!finite) {
       r.fitEstimation.reset();
-      for (auto& v : r.estimation) v.fitPercent.reset();
-      for (auto& v : r.validation) v.fitPercent.reset();
+      r.fitEstimationNrmse.reset();
+      for (auto* list : {&r.estimation, &r.validation})
+        for (auto& v : *list) {
+          v.fitPercent.reset();
+          v.fitPercentNrmse.reset();
+        }
       r.warnings.push_back("the model's G is unstable, so its simulated output diverges and the fit % is "
                            "undefined; it can still predict one step ahead");
     }
@@ -135,7 +174,7 @@ void evaluate(const FitOptions& o, FitResult& r) {
   r.notches.clear();
   r.peaks.clear();
   if (!r.response.omega.empty()) {
-    const auto np = notchesAndPeaks(r.response, nonparametric ? 3.0 : o.notchDepthDb);
+    const auto np = fitNotchesAndPeaks(r, r.response, o.notchDepthDb);
     r.notches = np.notches;
     r.peaks = np.peaks;
   }

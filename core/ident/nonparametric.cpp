@@ -212,6 +212,42 @@ NonparametricEstimate etfe(const Eigen::VectorXd& u, const Eigen::VectorXd& y, d
   return r;
 }
 
+// The time SPA's default lag window spans (spaDefaultWindow).
+constexpr double kSpaWindowSeconds = 1.0;
+// Frequencies where SPA's smoothed input spectrum is below this share of its largest value
+// on the grid are left out of the estimate (counted in omittedFrequencies).
+constexpr double kSpaWeakInput = 1e-2;
+
+SpaWindow spaDefaultWindow(Eigen::Index samples, double sampleTime) {
+  if (samples < 2 || !(sampleTime > 0.0))
+    throw std::invalid_argument("spaDefaultWindow: needs two samples and a positive sample time");
+  const auto tenth = static_cast<int>(std::max<Eigen::Index>(1, samples / 10));
+  const auto second = static_cast<int>(std::min(1e9, std::ceil(kSpaWindowSeconds / sampleTime)));
+  SpaWindow w;
+  char buf[400];
+  if (second <= 30) {
+    w.width = std::min(tenth, 30);
+    std::snprintf(buf, sizeof buf, "the default min(N/10, 30) of N = %lld samples, as SITB's",
+                  static_cast<long long>(samples));
+  } else if (tenth <= second) {
+    w.width = tenth;
+    std::snprintf(buf, sizeof buf,
+                  "chosen from the data: N/10 of N = %lld samples (%.3g s), as long as the record "
+                  "allows for a bounded variance, short of %.3g s at %.4g Hz",
+                  static_cast<long long>(samples), tenth * sampleTime, kSpaWindowSeconds,
+                  1.0 / sampleTime);
+  } else {
+    w.width = second;
+    std::snprintf(buf, sizeof buf,
+                  "chosen from the data: %.3g s at %.4g Hz, a resolution of about %.3g rad/s; "
+                  "30 lags would span %.3g ms and ripple every %.3g rad/s",
+                  kSpaWindowSeconds, 1.0 / sampleTime, 2.0 * M_PI / kSpaWindowSeconds,
+                  30e3 * sampleTime, 2.0 * M_PI / (30.0 * sampleTime));
+  }
+  w.reason = buf;
+  return w;
+}
+
 NonparametricEstimate spa(const Eigen::VectorXd& u, const Eigen::VectorXd& y, double ts,
                           const SpaOptions& options) {
   std::string why;
@@ -220,8 +256,8 @@ NonparametricEstimate spa(const Eigen::VectorXd& u, const Eigen::VectorXd& y, do
   NonparametricEstimate r;
   if (!checkSignals(u, y, ts, r, 8)) return r;
   const Eigen::Index n = u.size();
-  int M = options.windowWidth > 0 ? options.windowWidth
-                                  : static_cast<int>(std::min<Eigen::Index>(n / 10, 30));
+  const SpaWindow chosen = spaDefaultWindow(n, ts);
+  int M = options.windowWidth > 0 ? options.windowWidth : chosen.width;
   M = static_cast<int>(std::max<Eigen::Index>(1, std::min<Eigen::Index>(M, n - 1)));
   r.window = M;
   // Covariances R_yu(tau) = 1/N sum y(t + tau) u(t), tau = -M..M, and R_u, R_y for tau >= 0.
@@ -249,9 +285,17 @@ NonparametricEstimate spa(const Eigen::VectorXd& u, const Eigen::VectorXd& y, do
   std::vector<Eigen::Matrix2d> covs;
   // The lag window's spectral window has negative side lobes, so where the input has no power
   // the smoothed Phi_u can come out zero or negative: G is undefined there and the frequency
-  // is left out of the estimate (counted and named in the message).
-  int undefined = 0;
-  double undefinedLow = INFINITY, undefinedHigh = 0.0;
+  // is left out of the estimate (counted and named in the message). So is a frequency where
+  // Phi_u is below kSpaWeakInput of its largest value on the grid: there the estimate is the
+  // leakage of the window's side lobes and the noise, not G (a PRBS's spectral nulls, the
+  // band above a chirp's last frequency), and it draws notches and peaks that are not there.
+  struct Spectra {
+    double phiU, phiY;
+    std::complex<double> phiYU;
+  };
+  std::vector<Spectra> spectra;
+  spectra.reserve(omega.size());
+  double phiUMax = 0.0;
   for (double w : omega) {
     const double wt = w * ts;
     double phiU = ru[0] * win[0], phiY = ry[0] * win[0];
@@ -263,8 +307,16 @@ NonparametricEstimate spa(const Eigen::VectorXd& u, const Eigen::VectorXd& y, do
       phiYU += win[tau] * (ryu[M + tau] * std::polar(1.0, -wt * tau) +
                            ryu[M - tau] * std::polar(1.0, wt * tau));
     }
-    if (!(phiU > 0.0)) {
-      ++undefined;
+    spectra.push_back({phiU, phiY, phiYU});
+    phiUMax = std::max(phiUMax, phiU);
+  }
+  int undefined = 0, weak = 0;
+  double undefinedLow = INFINITY, undefinedHigh = 0.0;
+  for (std::size_t i = 0; i < omega.size(); ++i) {
+    const double w = omega[i];
+    const auto& [phiU, phiY, phiYU] = spectra[i];
+    if (!(phiU > 0.0) || phiU < kSpaWeakInput * phiUMax) {
+      ++(phiU > 0.0 ? weak : undefined);
       undefinedLow = std::min(undefinedLow, w);
       undefinedHigh = std::max(undefinedHigh, w);
       continue;
@@ -280,15 +332,16 @@ NonparametricEstimate spa(const Eigen::VectorXd& u, const Eigen::VectorXd& y, do
   finishFrequencyResponse(r.response, covs);
   r.termination = Termination::Converged;
   r.message = std::string("SPA with a ") + toString(options.window) + " lag window of width " +
-              std::to_string(M);
-  r.omittedFrequencies = undefined;
-  if (undefined > 0) {
+              std::to_string(M) +
+              (options.windowWidth > 0 ? std::string(" (as asked)") : " (" + chosen.reason + ")");
+  r.omittedFrequencies = undefined + weak;
+  if (undefined + weak > 0) {
     char range[96];
     std::snprintf(range, sizeof range, "%.4g-%.4g rad/s", undefinedLow, undefinedHigh);
-    r.message += "; left out " + std::to_string(undefined) + " of " +
-                 std::to_string(omega.size()) + " frequencies (" + range +
-                 ") where the smoothed input spectrum is not positive: the input has no "
-                 "power there";
+    r.message += "; left out " + std::to_string(undefined + weak) + " of " +
+                 std::to_string(omega.size()) + " frequencies (between " + range +
+                 ") where the smoothed input spectrum is not positive or below 1e-2 of its "
+                 "peak: the input has (almost) no power there";
   }
   if (r.response.omega.empty()) {
     r.termination = Termination::Failed;

@@ -41,8 +41,20 @@ struct EtfeOptions {
   bool isValid(std::string* why) const;
 };
 
+// SPA's default lag window, chosen from the record length N and the sample time T: the
+// window spans 1 s (a resolution of about 2 pi rad/s, fine enough for the
+// resonances of an arm), at most N/10 lags (variance), and SITB's min(N/10, 30) where 1 s is
+// fewer than 30 samples. SITB's 30 lags at 2 kHz span 15 ms: the covariances of an arm's
+// velocity are cut while still large, and the estimate ripples every 2 pi / (30 T) = 419
+// rad/s with notches and peaks that are not there. `reason` says which rule gave the width.
+struct SpaWindow {
+  int width = 0;
+  std::string reason;
+};
+SpaWindow spaDefaultWindow(Eigen::Index samples, double sampleTime);
+
 struct SpaOptions {
-  // Lag-window width M (samples); 0 picks SITB's default min(N/10, 30).
+  // Lag-window width M (samples); 0 picks spaDefaultWindow (its reason is in the message).
   int windowWidth = 0;
   LagWindow window = LagWindow::Hann;
   // Frequencies (rad/s) to report; empty: 128 frequencies linear up to pi/T, as SITB.

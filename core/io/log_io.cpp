@@ -53,7 +53,7 @@ bool LogReadOptions::isValid(std::string* why) const {
     return fail("column numbers go up to 65536");
   if (inputColumn == outputColumn) return fail("input and output must be different columns");
   if (timeColumn < 0) return fail("the time column number must be 1 or more (0 for none)");
-  if (!(sampleTime >= IdData::kMinSampleTime) || !(sampleTime <= 1e6))
+  if (sampleTime != 0.0 && (!(sampleTime >= IdData::kMinSampleTime) || !(sampleTime <= 1e6)))
     return fail("the sample time must lie between 1e-06 s (1 MHz) and 1e+06 s");
   if (!(maxSampleJitter > 0.0)) return fail("the sampling tolerance must be positive");
   return true;

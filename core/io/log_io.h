@@ -30,6 +30,9 @@ struct LogReadResult {
   // Refused for its time stamps (jitter, gaps, duplicates, reversals) alone: read with
   // LogReadOptions::keepIrregularTime, the log opens for an explicit resampling step.
   bool irregularTime = false;
+  // Refused because the file stores no time and no sample time was given (a .mat file
+  // without time_s or a scalar Ts/dt/sample_time): read again with LogReadOptions::sampleTime.
+  bool needsSampleTime = false;
 };
 
 enum class LogFormat { Auto, FlexArmCsv, Table, Mat };
@@ -49,11 +52,16 @@ struct LogReadOptions {
 
   // Headerless tables and .mat files without FlexArm names: which column (1-based) or
   // variable is the input u and the output y, an optional time column, and the sample time
-  // used when there is no time column.
+  // used when there is no time column. sampleTime 0: not given; a table then takes 1 s (and
+  // says so in its "sample_time" metadata), a .mat file without time is refused with a
+  // sentence asking for it (LogReadResult::needsSampleTime).
   int inputColumn = 1;
   int outputColumn = 2;
   int timeColumn = 0;  // 0: none, use sampleTime
-  double sampleTime = 1.0;
+  double sampleTime = 0.0;
+  // Channel names of the input and output; a .mat file's channels keep their variable names
+  // unless these differ from the defaults u and y, and a .mat variable named like outputName
+  // (inputName) is the output (input) when outputVariable (inputVariable) is empty.
   std::string inputName = "u";
   std::string outputName = "y";
   std::string inputVariable;   // .mat: variable holding u (default: torque_ref_nm or u)

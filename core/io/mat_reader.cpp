@@ -262,11 +262,26 @@ LogReadResult readMat(const std::string& path, const LogReadOptions& options) {
   auto has = [&](const std::string& n) {
     return std::find(names.begin(), names.end(), n) != names.end();
   };
+  // A channel name the user chose (not the default u / y) names the variable when no variable
+  // was named, and the channel either way.
+  const LogReadOptions defaults;
+  const bool inputNamed = options.inputName != defaults.inputName && !options.inputName.empty();
+  const bool outputNamed = options.outputName != defaults.outputName && !options.outputName.empty();
   std::string uName = options.inputVariable, yName = options.outputVariable;
+  if (uName.empty() && inputNamed && has(options.inputName)) uName = options.inputName;
+  if (yName.empty() && outputNamed && has(options.outputName)) yName = options.outputName;
   if (uName.empty()) uName = has(columns::kTorqueRef) ? columns::kTorqueRef : "u";
   if (yName.empty()) yName = has(columns::kMotorAngle) ? columns::kMotorAngle : "y";
   if (names.empty())
     return failure(path, 0, 0, {}, "the .mat file holds no variables FlexArm can read");
+  for (const auto* wanted : {&uName, &yName})
+    if (!has(*wanted)) {
+      std::string list;
+      for (const auto& n : names) list += (list.empty() ? "" : ", ") + n;
+      return failure(path, 0, 0, *wanted,
+                     "the variable '" + *wanted + "' is missing; the file holds " + list +
+                         " (name the input and output with --input-var and --output-var)");
+    }
   for (const auto& [name, claimed] : bytesOf)
     if (claimed > static_cast<double>(budget))
       return failure(path, 0, 0, name,
@@ -283,6 +298,27 @@ LogReadResult readMat(const std::string& path, const LogReadOptions& options) {
                        std::to_string(u.size()));
   if (u.size() < 2) return failure(path, 0, 0, uName, "at least two samples are needed");
   data.sampleTime = options.sampleTime;
+  // The sample time: the time variable, else the one given, else a scalar the file stores
+  // under a usual name; never a silent guess.
+  if (!has(columns::kTime) && !(options.sampleTime > 0.0)) {
+    for (const char* n : {"Ts", "ts", "dt", "sample_time", "sample_time_s", "Ts_s"}) {
+      std::vector<double> v;
+      LogReadResult ignore;
+      if (has(n) && readMatVector(vars, path, n, v, ignore, false) && v.size() == 1 &&
+          v[0] >= IdData::kMinSampleTime && v[0] <= 1e6) {
+        data.sampleTime = v[0];
+        data.setMeta("sample_time", std::string("from the variable ") + n);
+        break;
+      }
+    }
+    if (!(data.sampleTime > 0.0)) {
+      LogReadResult r = failure(path, 0, 0, {},
+                                "the file stores no time (no variable time_s, Ts or dt): give the "
+                                "sample time, e.g. --sample-time 0.0005 for 2 kHz");
+      r.needsSampleTime = true;
+      return r;
+    }
+  }
   if (has(columns::kTime)) {
     if (!readMatVector(vars, path, columns::kTime, t, fail, true)) return fail;
     if (t.size() != u.size())
@@ -303,17 +339,18 @@ LogReadResult readMat(const std::string& path, const LogReadOptions& options) {
     Channel c{name, unitFromColumnName(name), role, std::move(v)};
     data.channels.push_back(std::move(c));
   };
-  push(uName, std::move(u), ChannelRole::Input);
-  push(yName, std::move(y), ChannelRole::Output);
+  push(inputNamed ? options.inputName : uName, std::move(u), ChannelRole::Input);
+  push(outputNamed ? options.outputName : yName, std::move(y), ChannelRole::Output);
   for (const auto& n : names) {
     if (n == uName || n == yName || n == columns::kTime) continue;
+    if ((inputNamed && n == options.inputName) || (outputNamed && n == options.outputName)) continue;
     std::vector<double> v;
     LogReadResult ignore;
     if (readMatVector(vars, path, n, v, ignore, false) && v.size() == data.samples())
       push(n, std::move(v), n == columns::kAngleRef ? ChannelRole::Reference : ChannelRole::None);
   }
   if (data.channel(columns::kMotorVelocity) && uName == columns::kTorqueRef &&
-      options.outputVariable.empty())
+      options.outputVariable.empty() && !outputNamed)
     data.setRole(columns::kMotorVelocity, ChannelRole::Output);
   data.setMeta("source", std::filesystem::path(path).filename().string());
   data.setMeta("format", "MATLAB .mat");

@@ -85,7 +85,9 @@ LogReadResult readTableText(std::string_view text, const std::string& path,
   if (rows < 2)
     return failure(path, rows == 0 ? 1 : firstRowLine, 0, {}, "at least two rows of numbers are needed");
   IdData data;
-  data.sampleTime = options.sampleTime;
+  data.sampleTime = options.sampleTime > 0.0 ? options.sampleTime : 1.0;
+  if (options.timeColumn == 0 && !(options.sampleTime > 0.0))
+    data.setMeta("sample_time", "assumed 1 s: the table has no time column and no sample time was given");
   if (options.timeColumn > 0) {
     auto lineOf = [&](std::size_t row) {
       return io::lineOfRow(text, firstRowOffset, firstRowLine, row, "#%");

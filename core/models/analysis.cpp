@@ -168,6 +168,94 @@ std::vector<Mode> peakFrequencies(const StateSpace& sys, double maxDamping) {
   return lightlyDamped(poles(sys), maxDamping);
 }
 
+NotchesPeaks magnitudeExtrema(const std::vector<double>& omega, const std::vector<double>& magnitude,
+                              double minDepthDb, const std::function<double(double)>& exact) {
+  if (omega.size() != magnitude.size())
+    throw std::invalid_argument("magnitudeExtrema: omega and magnitude differ in length");
+  NotchesPeaks out;
+  const std::size_t n = magnitude.size();
+  if (n < 3) return out;
+  auto toDb = [](double m) { return 20.0 * std::log10(std::max(m, 1e-300)); };
+  std::vector<double> db(n);
+  for (std::size_t i = 0; i < n; ++i) db[i] = toDb(magnitude[i]);
+  // Indices of all strict local extrema, with the ends as anchors.
+  std::vector<std::size_t> ext{0};
+  for (std::size_t i = 1; i + 1 < n; ++i)
+    if ((db[i] < db[i - 1] && db[i] <= db[i + 1]) || (db[i] > db[i - 1] && db[i] >= db[i + 1]))
+      ext.push_back(i);
+  ext.push_back(n - 1);
+  auto refine = [&](std::size_t i, bool isMin) {
+    const double x0 = std::log(omega[i - 1]), x1 = std::log(omega[i]), x2 = std::log(omega[i + 1]);
+    if (exact) {
+      // Golden-section search of the extremum of |G| in dB over log-frequency in [x0, x2].
+      const double sign = isMin ? 1.0 : -1.0;
+      auto f = [&](double x) { return sign * toDb(exact(std::exp(x))); };
+      const double g = 0.5 * (std::sqrt(5.0) - 1.0);
+      double a = x0, b = x2, c = b - g * (b - a), d = a + g * (b - a);
+      double fc = f(c), fd = f(d);
+      while (b - a > 1e-10) {
+        if (fc < fd) {
+          b = d; d = c; fd = fc; c = b - g * (b - a); fc = f(c);
+        } else {
+          a = c; c = d; fc = fd; d = a + g * (b - a); fd = f(d);
+        }
+      }
+      return std::exp(0.5 * (a + b));
+    }
+    // Parabola through three points in log-frequency.
+    const double y0 = db[i - 1], y1 = db[i], y2 = db[i + 1];
+    const double den = (x0 - x1) * (x0 - x2) * (x1 - x2);
+    const double a = (x2 * (y1 - y0) + x1 * (y0 - y2) + x0 * (y2 - y1)) / den;
+    const double b = (x2 * x2 * (y0 - y1) + x1 * x1 * (y2 - y0) + x0 * x0 * (y1 - y2)) / den;
+    if (a == 0.0) return omega[i];
+    const double xv = std::clamp(-b / (2 * a), std::min(x0, x2), std::max(x0, x2));
+    return std::exp(xv);
+  };
+  for (std::size_t k = 1; k + 1 < ext.size(); ++k) {
+    const std::size_t i = ext[k];
+    double left = db[ext[k - 1]], right = db[ext[k + 1]];
+    // Compare with the highest/lowest value on each side up to the next extremum of the
+    // same kind, so that ripples do not hide a real notch.
+    const bool isMin = db[i] < db[i - 1];
+    for (std::size_t j = ext[k - 1]; j < i; ++j)
+      left = isMin ? std::max(left, db[j]) : std::min(left, db[j]);
+    for (std::size_t j = i + 1; j <= ext[k + 1]; ++j)
+      right = isMin ? std::max(right, db[j]) : std::min(right, db[j]);
+    if (isMin && left - db[i] >= minDepthDb && right - db[i] >= minDepthDb)
+      out.notches.push_back(refine(i, true));
+    if (!isMin && db[i] - left >= minDepthDb && db[i] - right >= minDepthDb)
+      out.peaks.push_back(refine(i, false));
+  }
+  return out;
+}
+
+NotchesPeaks notchesAndPeaks(const StateSpace& sys, int output, int input, double minDepthDb) {
+  if (sys.isDiscrete()) throw std::invalid_argument("notchesAndPeaks: the model must be continuous");
+  double lo = INFINITY, hi = 0.0;
+  auto span = [&](const std::vector<std::complex<double>>& roots) {
+    for (const auto& r : roots) {
+      const double m = std::abs(r);
+      if (m > 1e-9 && std::isfinite(m)) {
+        lo = std::min(lo, m);
+        hi = std::max(hi, m);
+      }
+    }
+  };
+  span(poles(sys));
+  span(zeros(sys, output, input));
+  if (!(hi > 0.0)) return {};
+  const int points = 4000;
+  std::vector<double> w(points);
+  const double w0 = 0.1 * lo, w1 = 10.0 * hi;
+  for (int i = 0; i < points; ++i) w[i] = w0 * std::pow(w1 / w0, static_cast<double>(i) / (points - 1));
+  const auto g = frequencyResponse(sys, w, output, input);
+  std::vector<double> mag(points);
+  for (int i = 0; i < points; ++i) mag[i] = std::abs(g[i]);
+  return magnitudeExtrema(w, mag, minDepthDb, [&](double x) {
+    return std::abs(frequencyResponse(sys, std::vector<double>{x}, output, input).front());
+  });
+}
+
 const char* toString(Discretization d) {
   return d == Discretization::FirstOrderHold ? "foh" : "zoh";
 }

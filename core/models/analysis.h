@@ -3,6 +3,7 @@
 // zeros, notch and peak frequencies (antiresonances and resonances, as (5.4) and Table 5.5),
 // and conversion to discrete time with zero-order or first-order hold.
 #include <complex>
+#include <functional>
 #include <optional>
 #include <string_view>
 #include <vector>
@@ -52,6 +53,30 @@ std::vector<Mode> lightlyDamped(const std::vector<std::complex<double>>& roots,
 std::vector<Mode> notchFrequencies(const StateSpace& sys, int output = 0, int input = 0,
                                    double maxDamping = 0.3);
 std::vector<Mode> peakFrequencies(const StateSpace& sys, double maxDamping = 0.3);
+
+// Notches and peaks, FlexArm's one definition (used by `flexarm model`, `flexarm fit`, the
+// panels and the reports): the frequencies (rad/s) of the local minima (notches) and maxima
+// (peaks) of the magnitude |G(i w)|, each at least minDepthDb below (above) the highest
+// (lowest) magnitude on both sides up to the neighbouring extremum of the other kind. This is
+// what the seed's Figure 5.3 marks as omega_n and omega_p "in the Bode plot" and what a click
+// on a Bode plot reads; for a lightly damped pair it lies near the imaginary part of the zero
+// (notch) or pole (peak), which (5.4) approximates as sqrt(k / J_a), and it moves away from it
+// as the damping grows (lightlyDamped above lists the roots themselves).
+struct NotchesPeaks {
+  std::vector<double> notches, peaks;
+};
+// The extrema of a magnitude sampled at increasing frequencies omega (> 0). With `exact`
+// (|G| at any frequency) each extremum is refined on it to about 1e-9 relative, so that two
+// grids give the same frequency; without, by a parabola through three points in dB over
+// log-frequency.
+NotchesPeaks magnitudeExtrema(const std::vector<double>& omega, const std::vector<double>& magnitude,
+                              double minDepthDb = 1.0,
+                              const std::function<double(double)>& exact = {});
+// Of a continuous-time model's output-input pair, on 4000 log-spaced frequencies from a tenth
+// of its smallest to ten times its largest non-zero pole or zero magnitude, refined on the
+// exact response.
+NotchesPeaks notchesAndPeaks(const StateSpace& sys, int output = 0, int input = 0,
+                             double minDepthDb = 1.0);
 
 enum class Discretization { ZeroOrderHold, FirstOrderHold };
 const char* toString(Discretization d);  // "zoh", "foh"

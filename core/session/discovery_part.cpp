@@ -58,6 +58,8 @@ bool dataRefFromJson(const json& j, DiscoveryDataRef& d, std::string* why, const
 json scoreToJson(const DiscoveryScore& s) {
   return {{"fit_percent", number(s.fitPercent)},
           {"fit_percent_validation", number(s.fitPercentValidation)},
+          {"fit_percent_nrmse", number(s.fitPercentNrmse)},
+          {"fit_percent_validation_nrmse", number(s.fitPercentValidationNrmse)},
           {"rms_estimation", number(s.rmsEstimation)},
           {"rms_validation", number(s.rmsValidation)}};
 }
@@ -69,6 +71,8 @@ bool scoreFromJson(const json& j, DiscoveryScore& s, std::string* why, const std
   }
   return readNumber(j, "fit_percent", s.fitPercent, true, why, where) &&
          readNumber(j, "fit_percent_validation", s.fitPercentValidation, true, why, where) &&
+         readNumber(j, "fit_percent_nrmse", s.fitPercentNrmse, false, why, where) &&
+         readNumber(j, "fit_percent_validation_nrmse", s.fitPercentValidationNrmse, false, why, where) &&
          readNumber(j, "rms_estimation", s.rmsEstimation, true, why, where) &&
          readNumber(j, "rms_validation", s.rmsValidation, true, why, where);
 }

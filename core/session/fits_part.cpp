@@ -154,7 +154,7 @@ class FitsPart : public SessionPart {
     const int m = e.nonparametric.window;
     s.paragraphs.push_back("Blackman-Tukey spectral analysis (4.28) of the estimation data (" +
                            std::to_string(n) + " samples, " + e.data.note() + "), Hann lag window M = " +
-                           std::to_string(m) + ", 99 % band from (6.62).");
+                           std::to_string(m) + ", 99 % band from (6.62): " + e.nonparametric.message + ".");
     for (const auto& w : e.warnings) s.paragraphs.push_back(w);
     std::size_t undefined = 0;
     for (std::size_t i = 0; i < e.response.omega.size(); ++i)
@@ -164,10 +164,11 @@ class FitsPart : public SessionPart {
                              std::to_string(e.response.omega.size()) +
                              " frequencies; the plots leave gaps there.");
     s.paragraphs.push_back("Notches: " + joinedFrequencies(e.notches) + ". Peaks: " +
-                           joinedFrequencies(e.peaks) + ".");
+                           joinedFrequencies(e.peaks) + " (minima and maxima of the magnitude).");
     s.plots = bodeWithBand(e.response, "SPA", "SPA of the estimation data");
     s.values = {{"samples", n},
                 {"lag_window", m},
+                {"lag_window_note", e.nonparametric.message},
                 {"undefined_frequencies", undefined},
                 {"notches_rad_s", e.notches},
                 {"peaks_rad_s", e.peaks}};
@@ -261,18 +262,21 @@ class FitsPart : public SessionPart {
     s.tables.push_back(
         parameterTable("Estimated parameters (value +- std, 99 % interval)", run.parameters, values, stds));
 
-    ReportTable quality{"Loss and fit % (5.2)", {"Quantity", "Value"}, {}};
+    ReportTable quality{"Loss and fit %: the seed's (5.2) and MATLAB compare's NRMSE", {"Quantity", "Value"}, {}};
     quality.rows.push_back({"loss V_N (4.6)", formatSignificant(run.summary.loss, 6)});
     quality.rows.push_back({"FPE", formatSignificant(run.summary.fpe, 6)});
-    if (run.fitEstimation)
-      quality.rows.push_back({"fit % on the estimation range", formatFixed(*run.fitEstimation, 2)});
-    if (auto v = run.fitValidation())
-      quality.rows.push_back({"fit % on the validation range", formatFixed(*v, 2)});
-    else
+    if (run.fitEstimation) {
+      quality.rows.push_back({"fit % (5.2) on the estimation range", formatFixed(*run.fitEstimation, 2)});
+      quality.rows.push_back({"NRMSE fit % on the estimation range", formatFixed(*run.fitEstimationNrmse, 2)});
+    }
+    if (auto v = run.fitValidation()) {
+      quality.rows.push_back({"fit % (5.2) on the validation range", formatFixed(*v, 2)});
+      quality.rows.push_back({"NRMSE fit % on the validation range", formatFixed(*run.fitValidationNrmse(), 2)});
+    } else
       s.paragraphs.push_back("No validation range: the fit is not validated.");
     s.tables.push_back(quality);
 
-    ReportTable modes{"Notches and peaks of the estimate (5.4)", {"Kind", "Frequency (rad/s)"}, {}};
+    ReportTable modes{"Notches and peaks of the estimate: minima and maxima of |G(i w)|", {"Kind", "Frequency (rad/s)"}, {}};
     for (double w : run.notches) modes.rows.push_back({"notch", formatSignificant(w, 5)});
     for (double w : run.peaks) modes.rows.push_back({"peak", formatSignificant(w, 5)});
     s.tables.push_back(modes);
@@ -280,8 +284,15 @@ class FitsPart : public SessionPart {
     s.values["parameters"] = values;
     s.values["std"] = stds;
     s.values["loss"] = run.summary.loss;
-    if (run.fitEstimation) s.values["fit_estimation_percent"] = *run.fitEstimation;
-    if (auto v = run.fitValidation()) s.values["fit_validation_percent"] = *v;
+    // fit_*_percent: the seed's (5.2); fit_*_percent_nrmse: MATLAB compare's NRMSE fit.
+    if (run.fitEstimation) {
+      s.values["fit_estimation_percent"] = *run.fitEstimation;
+      s.values["fit_estimation_percent_nrmse"] = *run.fitEstimationNrmse;
+    }
+    if (auto v = run.fitValidation()) {
+      s.values["fit_validation_percent"] = *v;
+      s.values["fit_validation_percent_nrmse"] = *run.fitValidationNrmse();
+    }
     s.values["notches_rad_s"] = run.notches;
     s.values["peaks_rad_s"] = run.peaks;
     s.values["iterations"] = run.summary.iterations;

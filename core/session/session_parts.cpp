@@ -109,16 +109,12 @@ class ModelsPart : public SessionPart {
     s.values = {{"name", spec.name}, {"structure", model.structureName()}, {"parameters", paramsJson}};
 
     const StateSpace sys = model.stateSpace();
-    ReportTable modes{"Notches and peaks (5.4)", {"Kind", "Frequency (rad/s)", "Damping"}, {}};
-    json notches = json::array(), peaks = json::array();
-    for (const auto& n : notchFrequencies(sys)) {
-      modes.rows.push_back({"notch", formatSignificant(n.frequency, 5), formatSignificant(n.damping, 3)});
-      notches.push_back(n.frequency);
-    }
-    for (const auto& p : peakFrequencies(sys)) {
-      modes.rows.push_back({"peak", formatSignificant(p.frequency, 5), formatSignificant(p.damping, 3)});
-      peaks.push_back(p.frequency);
-    }
+    // FlexArm's one definition (core/models/analysis.h): extrema of |G(i w)|.
+    ReportTable modes{"Notches and peaks: minima and maxima of |G(i w)|", {"Kind", "Frequency (rad/s)"}, {}};
+    const NotchesPeaks np = notchesAndPeaks(sys);
+    json notches = np.notches, peaks = np.peaks;
+    for (double w : np.notches) modes.rows.push_back({"notch", formatSignificant(w, 5)});
+    for (double w : np.peaks) modes.rows.push_back({"peak", formatSignificant(w, 5)});
     s.tables.push_back(modes);
     s.values["notches_rad_s"] = notches;
     s.values["peaks_rad_s"] = peaks;

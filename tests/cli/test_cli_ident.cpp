@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -66,6 +67,16 @@ TEST(CliIdent, FitBlackBoxOnTheDaisyArmReportsParametersStdAndFit) {
   }
   EXPECT_GT(j["fit_percent"].get<double>(), 90.0);
   EXPECT_GT(j["fit_percent_validation"].get<double>(), 90.0);
+  // Beside the seed's (5.2), MATLAB compare's NRMSE fit of the same errors:
+  // 1 - sqrt(S_e/S_y) = 1 - sqrt(1 - (5.2)), lower than (5.2) for any imperfect fit.
+  for (const char* k : {"", "_validation"}) {
+    const double f52 = j[std::string("fit_percent") + k].get<double>();
+    const double nrmse = j[std::string("fit_percent") + k + "_nrmse"].get<double>();
+    EXPECT_NEAR(nrmse, 100.0 * (1.0 - std::sqrt(1.0 - f52 / 100.0)), 1e-9) << k;
+    EXPECT_LT(nrmse, f52 - 1.0) << k;
+  }
+  EXPECT_NEAR(j["fit_percent_experiments"][0]["fit_percent_nrmse"].get<double>(),
+              j["fit_percent_nrmse"].get<double>(), 1e-12);
   EXPECT_GT(j["loss"].get<double>(), 0.0);
   EXPECT_GE(j["peaks_rad_s"].size(), 1u);  // a flexible arm
   EXPECT_EQ(j["samples_estimation"].get<int>(), 700);
@@ -110,6 +121,24 @@ TEST(CliIdent, FitPhysicalWithFreeAndFixedParametersOnTheSampleLog) {
   EXPECT_TRUE(j["closed_loop"].get<bool>());
   EXPECT_EQ(j["closed_loop_method"], "direct");
   EXPECT_EQ(j["covariance"], "white");
+
+  // One definition of notches and peaks (extrema of |G(i w)|): `flexarm model` of the
+  // estimated parameters gives the fit's numbers, and so does the session report of that
+  // model (tests/core/session/test_session.cpp compares the report path).
+  std::vector<std::string> model = {"model", "--model", "three-mass", "--json"};
+  for (auto it = j["parameters"].begin(); it != j["parameters"].end(); ++it) {
+    char v[64];
+    std::snprintf(v, sizeof v, "%s=%.17g", it.key().c_str(), it.value().get<double>());
+    model.insert(model.end(), {"--param", v});
+  }
+  const auto m = runFlexarm(model);
+  ASSERT_EQ(m.code, 0) << m.err;
+  const json mj = json::parse(m.out);
+  for (const char* k : {"notches_rad_s", "peaks_rad_s"}) {
+    ASSERT_EQ(mj[k].size(), j[k].size()) << k;
+    for (std::size_t i = 0; i < j[k].size(); ++i)
+      EXPECT_NEAR(mj[k][i].get<double>() / j[k][i].get<double>(), 1.0, 1e-6) << k << " " << i;
+  }
 }
 
 // The two-stage fit (output error on the part of the torque the reference explains),

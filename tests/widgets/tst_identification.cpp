@@ -5,6 +5,7 @@
 // panel.
 #include <QApplication>
 #include <QCheckBox>
+#include <cmath>
 #include <QComboBox>
 #include <QDockWidget>
 #include <QLineEdit>
@@ -113,7 +114,9 @@ class IdentificationTest : public QObject {
     }
     QCOMPARE(freeRows, 5);
     const QString s = fit->summaryText();
-    QVERIFY2(s.contains("% on the estimation data") && s.contains("% on the validation data"),
+    // Both fit percentages, named: the seed's (5.2) and MATLAB compare's NRMSE.
+    QVERIFY2(s.contains("% NRMSE on the estimation data") && s.contains("% NRMSE on the validation data") &&
+                 s.contains("% (5.2), "),
              qPrintable(s));
     QVERIFY2(s.contains("Notches: ") && s.contains("rad/s"), qPrintable(s));
     // The log has a reference channel and is decimated, so the indirect fit cannot run at the
@@ -338,6 +341,13 @@ class IdentificationTest : public QObject {
     QVERIFY2(fits.back() > 30.0, qPrintable(cmp->fitText()));
     QVERIFY2(cmp->fitText().contains("(at 200 Hz)"), qPrintable(cmp->fitText()));
     QVERIFY2(cmp->fitText().contains("validation"), qPrintable(cmp->fitText()));
+    // Both fit percentages, named: the seed's (5.2) and MATLAB compare's NRMSE of the same errors.
+    const auto nrmse = cmp->fitsNrmse();
+    QCOMPARE(nrmse.size(), fits.size());
+    for (std::size_t i = 0; i < fits.size(); ++i)
+      QVERIFY2(std::abs(nrmse[i] - 100.0 * (1.0 - std::sqrt(1.0 - fits[i] / 100.0))) < 1e-9,
+               qPrintable(cmp->fitText()));
+    QVERIFY2(cmp->fitText().contains("% (5.2), ") && cmp->fitText().contains("% NRMSE"), qPrintable(cmp->fitText()));
     QCOMPARE(cmp->plot()->graphCount(), static_cast<int>(fits.size()) + 1);
     test::saveShot(cmp->grab().toImage(), "compare_panel");
   }

@@ -17,6 +17,7 @@
 #include "core/discovery/discovery.h"
 #include "core/io/log_io.h"
 #include "core/models/nonlinear_plant.h"
+#include "core/signal/preprocess.h"
 #include "core/sim/closed_loop.h"
 
 namespace flexarm {
@@ -145,6 +146,49 @@ TEST(Discovery, RejectsMisuseAndReportsBadData) {
   const auto r = discoverMissingEffect(*base, empty, nullptr);
   EXPECT_EQ(r.termination, Termination::Failed);
   EXPECT_NE(r.message.find("motor angle"), std::string::npos) << r.message;
+}
+
+// The log as a drive that records the motor velocity instead of the angle (issue 14): the
+// angle channel replaced by its derivative, which becomes the output.
+IdData velocityOnly(IdData d) {
+  const Channel* angle = d.channel(columns::kMotorAngle);
+  if (!angle) throw std::runtime_error("no motor angle to replace");
+  Channel v{columns::kMotorVelocity, "", ChannelRole::Output, differentiate(angle->values, d.sampleTime)};
+  d.channels.erase(std::remove_if(d.channels.begin(), d.channels.end(),
+                                  [](const Channel& c) { return c.name == columns::kMotorAngle; }),
+                   d.channels.end());
+  d.setChannel(v);
+  d.setRole(columns::kMotorVelocity, ChannelRole::Output);
+  return d;
+}
+
+// Discovery accepts a log whose output is the motor velocity and names the hidden effect on
+// it as on the log with the angle.
+TEST(Discovery, AcceptsAVelocityOutput) {
+  const Case c{EffectKind::CoulombFriction, 11 + 7 * 2 + static_cast<int>(EffectKind::CoulombFriction), 3.0};
+  auto truth = truthModel(c.seed);
+  const std::vector<Effect> effects{hiddenEffect(*c.hidden, c.magnitude)};
+  const IdData est = makeLog(*truth, effects, c.seed, false, false);
+  const IdData val = makeLog(*truth, effects, c.seed, true, false);
+  const IdData estV = velocityOnly(est), valV = velocityOnly(val);
+  ASSERT_EQ(estV.channel(columns::kMotorAngle), nullptr);
+  ASSERT_EQ(estV.output()->unit, "rad/s");
+  DiscoveryOptions o;
+  o.threads = 1;
+  auto base = makeModel("two-mass");
+  const DiscoveryResult fromVelocity = discoverMissingEffect(*base, estV, &valV, o);
+  ASSERT_EQ(fromVelocity.termination, Termination::Converged) << fromVelocity.message;
+  ASSERT_TRUE(fromVelocity.effect.has_value()) << fromVelocity.evidence;
+  EXPECT_EQ(*fromVelocity.effect, EffectKind::CoulombFriction) << fromVelocity.evidence;
+  EXPECT_LE(fromVelocity.augmented.rmsValidation, 0.7 * fromVelocity.base.rmsValidation);
+  // Without either channel the sentence names both.
+  IdData none = estV;
+  none.channels.erase(std::remove_if(none.channels.begin(), none.channels.end(),
+                                     [](const Channel& ch) { return ch.name == columns::kMotorVelocity; }),
+                      none.channels.end());
+  const auto r = discoverMissingEffect(*base, none, nullptr, o);
+  EXPECT_EQ(r.termination, Termination::Failed);
+  EXPECT_NE(r.message.find("motor velocity"), std::string::npos) << r.message;
 }
 
 // The headline test: every effect hidden in several logs (three seeds and sizes each, the

@@ -184,5 +184,21 @@ TEST(Evaluation, FitPercentIsSeedDefinition52) {
   EXPECT_NEAR(fitPercent(y, yh, 2, 4), (1.0 - 1.0 / 0.5) * 100.0, 1e-12);  // negative fit
 }
 
+// Both fit percentages from one function: the seed's (5.2) 1 - S_e/S_y and MATLAB compare's
+// NRMSE fit 1 - sqrt(S_e/S_y) (issue 14: 96.4 % (5.2) is about 81 % NRMSE).
+TEST(Evaluation, FitPercentsGiveSeed52AndNrmse) {
+  Eigen::VectorXd y(4), yh(4);
+  y << 1, 2, 3, 4;   // S_y = 5
+  yh << 1, 2, 3, 3;  // S_e = 1
+  const FitPercents f = fitPercents(y, yh);
+  EXPECT_NEAR(f.seed52, 80.0, 1e-12);
+  EXPECT_NEAR(f.nrmse, (1.0 - std::sqrt(0.2)) * 100.0, 1e-12);  // 55.28 %
+  EXPECT_EQ(f.seed52, fitPercent(y, yh));
+  const FitPercents g = fitPercentsFromSums(0.036, 1.0);
+  EXPECT_NEAR(g.seed52, 96.4, 1e-9);
+  EXPECT_NEAR(g.nrmse, 81.03, 0.01);
+  EXPECT_EQ(fitPercentsFromSums(1.0, 0.0).nrmse, -INFINITY);
+}
+
 }  // namespace
 }  // namespace flexarm

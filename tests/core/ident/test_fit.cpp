@@ -217,3 +217,48 @@ TEST(Fit, DataFailuresAreSentencesAndMisuseThrows) {
 
 }  // namespace
 }  // namespace flexarm
+
+namespace flexarm {
+namespace {
+
+// Issue 14: SPA's default lag window is chosen from the data. On a 2 kHz two-mass log (20 s,
+// the chirp of Section 5.1, PRBS) SITB's 30 lags span 15 ms and the estimate ripples every
+// 2 pi / (30 T) = 419 rad/s with peaks far above the resonance; the default (1 s of lags, and
+// frequencies where the input has almost no power left out) draws none above it, finds the
+// notch of the truth, and says which window it used and why.
+TEST(FitPipeline, SpaDefaultWindowDrawsNoSpuriousPeaksAt2kHz) {
+  const NotchesPeaks truth = notchesAndPeaks(makeModel("two-mass")->stateSpace());
+  ASSERT_EQ(truth.peaks.size(), 1u);
+  ASSERT_EQ(truth.notches.size(), 1u);
+  for (ExcitationKind kind : {ExcitationKind::Chirp, ExcitationKind::Prbs}) {
+    SimulationOptions so;
+    so.durationS = 20.0;
+    so.seed = 3;
+    so.excitation.kind = kind;
+    const SimulationResult sim = simulateClosedLoop(*makeModel("two-mass"), {}, so);
+    ASSERT_EQ(sim.termination, Termination::Converged) << sim.message;
+    FitOptions o;
+    o.model.kind = FitModelKind::Spa;
+    o.estimation = {{std::make_shared<IdData>(sim.data), std::nullopt}};
+    const FitResult r = fitModel(o);
+    ASSERT_TRUE(r.ok()) << r.message;
+    EXPECT_EQ(r.nonparametric.window, 2000);  // 1 s at 2 kHz, below N/10 = 4000
+    EXPECT_NE(r.summary.message.find("chosen from the data: 1 s at 2000 Hz"), std::string::npos)
+        << r.summary.message;
+    for (double w : r.peaks)
+      EXPECT_LT(w, 1.3 * truth.peaks[0]) << toString(kind) << ": a peak at " << w << " rad/s";
+    ASSERT_FALSE(r.notches.empty()) << toString(kind);
+    EXPECT_NEAR(r.notches.front() / truth.notches[0], 1.0, 0.05) << toString(kind);
+    if (kind != ExcitationKind::Prbs) continue;
+    // SITB's 30 lags on the PRBS log: a peak far above the resonance (406 rad/s), where the
+    // estimate ripples every 419 rad/s.
+    o.model.windowWidth = 30;
+    const FitResult sitb = fitModel(o);
+    ASSERT_TRUE(sitb.ok()) << sitb.message;
+    EXPECT_TRUE(std::any_of(sitb.peaks.begin(), sitb.peaks.end(),
+                            [&](double w) { return w > 1.3 * truth.peaks[0]; }));
+  }
+}
+
+}  // namespace
+}  // namespace flexarm

@@ -239,3 +239,73 @@ TEST(LogIo, MatFileWithFlexArmNames) {
   EXPECT_EQ(m.error.columnName, "arm_angle");
   EXPECT_NE(m.error.toString().find("'arm_angle' is missing"), std::string::npos);
 }
+
+// Writes double vectors (n x 1) and scalars into a new .mat file.
+static void writeMat(const fs::path& p, const std::vector<std::pair<std::string, std::vector<double>>>& vars) {
+  mat_t* mat = Mat_CreateVer(p.string().c_str(), nullptr, MAT_FT_MAT5);
+  ASSERT_NE(mat, nullptr);
+  for (const auto& [name, values] : vars) {
+    std::vector<double> v = values;
+    size_t dims[2] = {v.size(), 1};
+    matvar_t* var = Mat_VarCreate(name.c_str(), MAT_C_DOUBLE, MAT_T_DOUBLE, 2, dims, v.data(), 0);
+    Mat_VarWrite(mat, var, MAT_COMPRESSION_NONE);
+    Mat_VarFree(var);
+  }
+  Mat_Close(mat);
+}
+
+// Issue 14's .mat papercuts: a file without time asks for the sample time (never 1 Hz
+// silently), a missing variable lists those that exist, and --output-name is honoured.
+TEST(LogIo, MatFileWithoutTimeAsksForTheSampleTimeAndNamesItsVariables) {
+  const fs::path p = tempDir() / "velocity.mat";
+  const std::size_t n = 50;
+  std::vector<double> u(n), v(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    u[i] = std::sin(0.2 * i);
+    v[i] = std::cos(0.3 * i);
+  }
+  const fs::path uy = tempDir() / "uy.mat";
+  writeMat(uy, {{"u", u}, {"y", v}});
+  LogReadResult r = readLog(uy.string());
+  ASSERT_FALSE(r.ok);
+  EXPECT_TRUE(r.needsSampleTime);
+  EXPECT_NE(r.error.problem.find("--sample-time"), std::string::npos) << r.error.problem;
+
+  writeMat(p, {{"tau", u}, {"motor_speed", v}});
+  LogReadOptions o;
+  o.sampleTime = 0.0005;
+  o.inputVariable = "tau";
+  o.outputVariable = "velocity";  // not in the file
+  r = readLog(p.string(), o);
+  ASSERT_FALSE(r.ok);
+  EXPECT_FALSE(r.needsSampleTime);
+  EXPECT_NE(r.error.problem.find("the file holds tau, motor_speed"), std::string::npos) << r.error.problem;
+
+  // --output-name picks the variable of that name and names the channel; --input-name renames.
+  o.outputVariable.clear();
+  o.outputName = "motor_speed";
+  o.inputName = columns::kTorqueRef;
+  r = readLog(p.string(), o);
+  ASSERT_TRUE(r.ok) << r.error.toString();
+  EXPECT_NEAR(r.data.sampleTime, 0.0005, 1e-15);
+  ASSERT_NE(r.data.output(), nullptr);
+  EXPECT_EQ(r.data.output()->name, "motor_speed");
+  EXPECT_EQ(r.data.output()->values, v);
+  EXPECT_EQ(r.data.input()->name, columns::kTorqueRef);
+  EXPECT_EQ(r.data.channels.size(), 2u);
+  // A variable and a channel name of the user's choice.
+  o.outputVariable = "motor_speed";
+  o.outputName = columns::kMotorVelocity;
+  r = readLog(p.string(), o);
+  ASSERT_TRUE(r.ok) << r.error.toString();
+  EXPECT_EQ(r.data.output()->name, columns::kMotorVelocity);
+  EXPECT_EQ(r.data.output()->unit, "rad/s");
+
+  // A scalar Ts in the file is its sample time.
+  const fs::path q = tempDir() / "with_ts.mat";
+  writeMat(q, {{"u", u}, {"y", v}, {"Ts", {0.002}}});
+  r = readLog(q.string());
+  ASSERT_TRUE(r.ok) << r.error.toString();
+  EXPECT_NEAR(r.data.sampleTime, 0.002, 1e-15);
+  EXPECT_EQ(r.data.channels.size(), 2u);  // Ts is no channel
+}

@@ -185,6 +185,10 @@ TEST(FitsPart, SampleSessionIdentifiesTheThreeMassArm) {
   }
   EXPECT_GT((*fit)["fit_estimation_percent"].get<double>(), 75.0);
   EXPECT_GT((*fit)["fit_validation_percent"].get<double>(), 75.0);
+  // The report names both fit percentages: (5.2) and MATLAB compare's NRMSE fit.
+  for (const char* k : {"fit_estimation_percent", "fit_validation_percent"})
+    EXPECT_NEAR((*fit)[std::string(k) + "_nrmse"].get<double>(),
+                100.0 * (1.0 - std::sqrt(1.0 - (*fit)[k].get<double>() / 100.0)), 1e-9) << k;
   EXPECT_GT((*fit)["loss"].get<double>(), 0.0);
   // Three masses: two anti-resonances and two resonances (5.4), each within 10 % of the
   // truth's, which the resonances determine better than single parameters.
@@ -197,16 +201,33 @@ TEST(FitsPart, SampleSessionIdentifiesTheThreeMassArm) {
     EXPECT_NEAR((*fit)["notches_rad_s"][i].get<double>() / truthNotches[i].frequency, 1.0, 0.10) << i;
     EXPECT_NEAR((*fit)["peaks_rad_s"][i].get<double>() / truthPeaks[i].frequency, 1.0, 0.10) << i;
   }
+  // One definition of notches and peaks (core/models/analysis.h): the report's are those of
+  // the estimated model as `flexarm model` and the Model panel compute them.
+  {
+    auto estimate = makeModel("three-mass");
+    for (auto it = (*fit)["parameters"].begin(); it != (*fit)["parameters"].end(); ++it)
+      estimate->setParameter(it.key(), it.value().get<double>());
+    const NotchesPeaks np = notchesAndPeaks(estimate->stateSpace());
+    ASSERT_EQ(np.notches.size(), 2u);
+    ASSERT_EQ(np.peaks.size(), 2u);
+    for (std::size_t i = 0; i < 2; ++i) {
+      EXPECT_NEAR((*fit)["notches_rad_s"][i].get<double>() / np.notches[i], 1.0, 1e-6) << i;
+      EXPECT_NEAR((*fit)["peaks_rad_s"][i].get<double>() / np.peaks[i], 1.0, 1e-6) << i;
+    }
+  }
   // Closed-loop output error leaves coloured residuals: the tests say so.
   EXPECT_FALSE((*fit)["residuals"]["white"].get<bool>());
 
-  // The SPA of the estimation range (0.5-12 s at 200 Hz) with SITB's lag window min(N/10, 30).
+  // The SPA of the estimation range (0.5-12 s at 200 Hz): the lag window chosen from the data
+  // spans 1 s (200 lags, less than N/10 = 230), and the report says why.
   const json* np = section(j, "Non-parametric estimate (SPA)");
   ASSERT_NE(np, nullptr);
   const json* data = section(j, "Data");
   ASSERT_NE(data, nullptr);
   EXPECT_EQ((*np)["samples"], (*data)["ranges"]["estimation"]["samples"]);
-  EXPECT_EQ((*np)["lag_window"].get<int>(), 30);
+  EXPECT_EQ((*np)["lag_window"].get<int>(), 200);
+  EXPECT_NE((*np)["lag_window_note"].get<std::string>().find("chosen from the data: 1 s at 200 Hz"),
+            std::string::npos) << (*np)["lag_window_note"];
 
   // The report's parameter table shows value, std and the 99 % interval (z = 2.576).
   const ReportSection* rs = nullptr;
