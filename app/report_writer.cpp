@@ -86,8 +86,11 @@ QString sectionHtml(const ReportSection& s) {
     // heading, number and name on one line: never squeezed into vertical letters.
     const QString size = t.header.size() > 6 ? "font-size:7.5pt;" : "";
     h += "<p class=\"caption\">" + esc(t.caption) + "</p><table cellspacing=\"0\" cellpadding=\"3\" border=\"1\"><tr>";
+    // A heading breaks only between its words ("Interval / low"), never inside one.
     for (const auto& c : t.header)
-      h += "<th style=\"white-space:nowrap;" + size + "\">" + esc(c) + "</th>";
+      h += QString("<th style=\"%1%2\">")
+               .arg(c.find(' ') == std::string::npos ? "white-space:nowrap;" : "", size) +
+           esc(c) + "</th>";
     h += "</tr>";
     for (const auto& row : t.rows) {
       h += "<tr>";
