@@ -187,7 +187,7 @@ LqgPanel::LqgPanel(Workspace* workspace, QWidget* parent)
   badgeRow->addWidget(pinnedBadge_, 1);
   auto* grid = new QGridLayout;
   plotGrid_ = grid;
-  arrangePlots(2);
+  arrangePlots(1);  // compact until shown: reflow() widens to two columns when there is room
   auto* right = new QWidget(this);
   auto* rightLayout = new QVBoxLayout(right);
   rightLayout->setContentsMargins(0, 0, 0, 0);
