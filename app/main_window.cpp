@@ -23,7 +23,9 @@
 #include <QSettings>
 #include <QSpinBox>
 #include <QUndoStack>
+#include <QScreen>
 #include <QStatusBar>
+#include <QTabBar>
 #include <QToolBar>
 #include <QtConcurrent>
 #include <fstream>
@@ -184,11 +186,16 @@ MainWindow::MainWindow(QWidget* parent)
   transport->addWidget(transportBar_);
   addToolBar(Qt::BottomToolBarArea, transport);
   session_ = new SessionController(this, workspace_);  // File menu: sessions and reports
-  resize(1280, 860);
+  // The first size fits the screen (a 1366x768 laptop too); the docks scroll what is taller.
+  const QRect screenRect = screen() ? screen()->availableGeometry() : QRect(0, 0, 1280, 860);
+  resize(std::min(1280, screenRect.width()), std::min(860, screenRect.height()));
+  showWholeTabTitles();
+  connect(this, &QMainWindow::tabifiedDockWidgetActivated, this, &MainWindow::showWholeTabTitles);
 
   QSettings settings;
   restoreGeometry(settings.value("window/geometry").toByteArray());
   restoreState(settings.value("window/state").toByteArray());
+  showWholeTabTitles();
   rebuildRecentMenu();
   statusBar()->showMessage(tr("Open a robot log with Ctrl+O, or drop it on the window"));
 
@@ -266,6 +273,15 @@ void MainWindow::createMenus() {
                        tr("<b>FlexArm %1</b><p>Identification, diagnosis and control of "
                           "flexible robot arms.</p>").arg(FLEXARM_VERSION));
   });
+}
+
+void MainWindow::showWholeTabTitles() {
+  // Eleven panels share one dock area: their tabs keep whole titles and scroll, rather than
+  // reading "Prepr...", "M...".
+  for (QTabBar* bar : findChildren<QTabBar*>(Qt::FindDirectChildrenOnly)) {
+    bar->setElideMode(Qt::ElideNone);
+    bar->setUsesScrollButtons(true);
+  }
 }
 
 QDockWidget* MainWindow::addPanel(QWidget* panel, const QString& title, const char* objectName,
@@ -476,7 +492,7 @@ void MainWindow::closeEvent(QCloseEvent* e) {
 
 void MainWindow::keyPressEvent(QKeyEvent* e) {
   // Keys reach the window only when no focused widget used them.
-  if (TransportBar::handleKey(playhead_, e)) {
+  if (TransportBar::handleKey(playhead_, e) || logPanel_->handleModeKey(e)) {
     e->accept();
     return;
   }

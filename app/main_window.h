@@ -83,6 +83,8 @@ class MainWindow : public QMainWindow {
   // menu entry with the shortcut.
   QDockWidget* addPanel(QWidget* panel, const QString& title, const char* objectName,
                         const QString& shortcut, QDockWidget* tabWith);
+  // Tabs of tabified docks show whole titles and scroll when there are many.
+  void showWholeTabTitles();
   void openDialog();
   void exportData();
   void addRecent(const QString& path);

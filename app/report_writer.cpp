@@ -10,6 +10,8 @@
 #include <QPdfWriter>
 #include <QSaveFile>
 #include <QTextDocument>
+#include <algorithm>
+#include <cctype>
 #include <memory>
 #include <qcustomplot.h>
 
@@ -17,7 +19,7 @@ namespace flexarm {
 namespace {
 
 constexpr int kPlotWidth = 680;   // logical pixels of a plot (96 dpi)
-constexpr int kPlotHeight = 260;
+constexpr int kPlotHeight = 300;
 
 QString esc(const std::string& s) { return QString::fromStdString(s).toHtmlEscaped(); }
 
@@ -38,14 +40,38 @@ bool looksNumeric(const std::string& s) {
   return true;
 }
 
+// "Log", "Reference log", "Log monitored": the log's name without saying "log" twice.
+QString logLabel(const std::string& name) {
+  QString n = QString::fromStdString(name).trimmed();
+  if (n.isEmpty() || n.compare("log", Qt::CaseInsensitive) == 0) return "Log";
+  if (!n.contains("log", Qt::CaseInsensitive)) return "Log " + n.toHtmlEscaped();
+  n[0] = n[0].toUpper();
+  return n.toHtmlEscaped();
+}
+
+// A long unbroken string (a SHA-256, a path) in groups of 16 characters that the page may
+// wrap between; removing the spaces gives it back.
+QString breakable(const std::string& s) {
+  QString out;
+  const QString q = QString::fromStdString(s);
+  for (int i = 0; i < q.size(); i += 16) out += (i ? " " : "") + q.mid(i, 16).toHtmlEscaped();
+  return out;
+}
+
+// A hexadecimal checksum (SHA-256: 64 digits).
+bool isChecksum(const std::string& s) {
+  return s.size() >= 32 &&
+         std::all_of(s.begin(), s.end(), [](char c) { return std::isxdigit(static_cast<unsigned char>(c)); });
+}
+
 // Title block: version, session, logs with checksums, warnings.
 QString headerHtml(const Report& r) {
   QString h = QString("<h1>%1</h1><p class=\"prov\">FlexArm %2<br>Session: %3<br>")
                   .arg(esc(r.title), esc(r.flexarmVersion), esc(r.session));
   for (const auto& l : r.logs)
-    h += QString("Log %1: %2%3<br>SHA-256 %4<br>")
-             .arg(esc(l.name), esc(l.path), l.note.empty() ? QString() : " (" + esc(l.note) + ")",
-                  esc(l.sha256));
+    h += QString("%1: %2%3<br>SHA-256 %4<br>")
+             .arg(logLabel(l.name), esc(l.path),
+                  l.note.empty() ? QString() : " (" + esc(l.note) + ")", breakable(l.sha256));
   h += "</p>";
   for (const auto& w : r.warnings) h += "<p class=\"warn\">Warning: " + esc(w) + "</p>";
   return h;
@@ -56,18 +82,28 @@ QString sectionHtml(const ReportSection& s) {
   QString h = "<h2>" + esc(s.title) + "</h2>";
   for (const auto& p : s.paragraphs) h += "<p>" + esc(p) + "</p>";
   for (const auto& t : s.tables) {
+    // A wide table (many columns) in a smaller font, so that it fits the page with every
+    // heading, number and name on one line: never squeezed into vertical letters.
+    const QString size = t.header.size() > 6 ? "font-size:7.5pt;" : "";
     h += "<p class=\"caption\">" + esc(t.caption) + "</p><table cellspacing=\"0\" cellpadding=\"3\" border=\"1\"><tr>";
-    for (const auto& c : t.header) h += "<th>" + esc(c) + "</th>";
+    // A heading breaks only between its words ("Interval / low"), never inside one.
+    for (const auto& c : t.header)
+      h += QString("<th style=\"%1%2\">")
+               .arg(c.find(' ') == std::string::npos ? "white-space:nowrap;" : "", size) +
+           esc(c) + "</th>";
     h += "</tr>";
     for (const auto& row : t.rows) {
       h += "<tr>";
       for (const auto& c : row) {
-        // A single word (an effect or parameter name) is never broken across lines.
-        const bool word = c.find(' ') == std::string::npos;
-        h += (looksNumeric(c) ? "<td class=\"num\" align=\"right\">"
-              : word          ? "<td style=\"white-space:nowrap\">"
-                              : "<td>") +
-             esc(c) + "</td>";
+        // A number, a single word (an effect or parameter name) or a short label (a unit,
+        // "kg m^2") is never broken; a sentence wraps at its spaces.
+        // A checksum wraps between its groups of 16 characters.
+        const bool checksum = isChecksum(c);
+        const bool word = !checksum && (c.find(' ') == std::string::npos || c.size() <= 12);
+        const QString style = (word ? "white-space:nowrap;" : "") + size;
+        h += QString(looksNumeric(c) ? "<td class=\"num\" align=\"right\" style=\"%1\">"
+                                     : "<td style=\"%1\">").arg(style) +
+             (checksum ? breakable(c) : esc(c)) + "</td>";
       }
       h += "</tr>";
     }
@@ -87,7 +123,12 @@ std::unique_ptr<QCustomPlot> makePlot(const ReportPlot& p) {
                                    QColor(148, 103, 189)};
   for (std::size_t i = 0; i < p.series.size(); ++i) {
     const auto& s = p.series[i];
-    QPen pen(kColors[(s.color >= 0 ? static_cast<std::size_t>(s.color) : i) % 4], 1.4);
+    // Thousands of points over a page width: thin, slightly transparent lines, so that
+    // overlaid curves (measured and simulated) stay apart instead of merging into a band.
+    const bool dense = s.x.size() > 2 * static_cast<std::size_t>(kPlotWidth);
+    QColor color = kColors[(s.color >= 0 ? static_cast<std::size_t>(s.color) : i) % 4];
+    if (dense && p.series.size() > 1) color.setAlpha(190);
+    QPen pen(color, dense ? 0.7 : 1.4);
     if (s.dashed) pen.setStyle(Qt::DashLine);
     const QVector<double> x(s.x.begin(), s.x.end()), y(s.y.begin(), s.y.end());
     QCPAbstractPlottable* item = nullptr;

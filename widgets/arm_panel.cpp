@@ -38,8 +38,15 @@ constexpr double kTraceSeconds = 1.0;
 // largest deflection at about that one (radians).
 constexpr double kMotionDrawn = 0.6, kDeflectionDrawn = 0.5;
 
-// A deflection in milliradians with four decimals, without the "-0.0000" of a tiny negative.
-QString mrad(double rad) { return QString::number(std::round(1e7 * rad) / 1e4 + 0.0, 'f', 4); }
+// v with a fixed number of decimals, without the "-0.0000" of a tiny negative (5e-22 rad
+// reads 0.0000, not 5.195e-22).
+QString fixed(double v, int decimals) {
+  const double scale = std::pow(10.0, decimals);
+  return QString::number(std::round(v * scale) / scale + 0.0, 'f', decimals);
+}
+
+// A deflection in milliradians with four decimals.
+QString mrad(double rad) { return fixed(1e3 * rad, 4); }
 
 // The largest of 1, 2, 5 times a power of ten that is at most x, clamped to [lo, hi].
 int niceDown(double x, int lo, int hi) {
@@ -100,6 +107,7 @@ ArmPanel::ArmPanel(Workspace* workspace, QWidget* parent)
                              "behind the one before it"));
   ghost_->setObjectName("armGhost");
   ghost_->setChecked(true);
+  ghost_->setToolTip(tr("Draw the rigid arm (no spring deflection) as a ghost to compare"));
   trace_->setObjectName("armTrace");
   trace_->setChecked(true);
   trace_->setToolTip(tr("Where the tool tip was over the last second (time runs downwards), "
@@ -107,6 +115,7 @@ ArmPanel::ArmPanel(Workspace* workspace, QWidget* parent)
   export_->setObjectName("armExport");
   export_->setText(tr("Export"));
   export_->setPopupMode(QToolButton::InstantPopup);
+  export_->setToolTip(tr("Save the view as a still image or export frames of the motion"));
   auto* menu = new QMenu(export_);
   menu->addAction(tr("Save still..."), this, &ArmPanel::saveStill);
   menu->addAction(tr("Export frames (PNG + ffmpeg)..."), this, &ArmPanel::askExportFrames);
@@ -116,6 +125,7 @@ ArmPanel::ArmPanel(Workspace* workspace, QWidget* parent)
   progress_->setMaximumHeight(14);
   progress_->setVisible(false);
   cancel_->setText(tr("Cancel"));
+  cancel_->setToolTip(tr("Stop exporting frames"));
   cancel_->setVisible(false);
   label_->setObjectName("armLabel");
   label_->setWordWrap(true);
@@ -424,8 +434,8 @@ void ArmPanel::showTime(double t) {
   if (d && (angles_ || d->channel(columns::kMotorAngle))) {
     status = tr("t = %1 s   motor %2 rad   arm %3 mrad")
                  .arg(t, 0, 'f', 3)
-                 .arg(pose.motor, 0, 'g', 4)
-                 .arg(1e3 * pose.arm, 0, 'g', 4);
+                 .arg(fixed(pose.motor, 4))
+                 .arg(fixed(1e3 * pose.arm, 3));
     if (angles_ && angles_->springs >= 1)
       status += tr("\nr phi_m - phi_g %1 mrad").arg(mrad(pose.gearDeflection));
     if (angles_ && angles_->springs >= 2)

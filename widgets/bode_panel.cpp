@@ -19,6 +19,13 @@
 namespace flexarm {
 namespace {
 
+// A percentage without trailing zeros: "99 %", "99.5 %".
+class PercentSpinBox : public QDoubleSpinBox {
+ public:
+  using QDoubleSpinBox::QDoubleSpinBox;
+  QString textFromValue(double v) const override { return QString::number(v, 'g', 4); }
+};
+
 const QColor kPalette[] = {QColor(31, 119, 180), QColor(214, 39, 40), QColor(44, 160, 44),
                            QColor(148, 103, 189), QColor(255, 127, 14), QColor(23, 190, 207),
                            QColor(140, 86, 75), QColor(227, 119, 194)};
@@ -46,7 +53,7 @@ BodeCurve toCurve(const QString& name, const QColor& color, const FrequencyRespo
 
 BodePanel::BodePanel(Workspace* workspace, QWidget* parent)
     : QWidget(parent), workspace_(workspace), models_(new QListWidget(this)),
-      level_(new QDoubleSpinBox(this)), spa_(new QCheckBox(tr("SPA"), this)),
+      level_(new PercentSpinBox(this)), spa_(new QCheckBox(tr("SPA"), this)),
       etfe_(new QCheckBox(tr("ETFE"), this)), window_(new QSpinBox(this)),
       export_(new QPushButton(tr("Export..."), this)), plot_(new BodePlot(this)),
       note_(new QLabel(this)) {
@@ -55,10 +62,12 @@ BodePanel::BodePanel(Workspace* workspace, QWidget* parent)
   models_->setMaximumWidth(220);
   models_->setToolTip(tr("Checked models of the shared list are drawn"));
   level_->setObjectName("bodeLevelSpin");
-  level_->setRange(0.5, 0.9999);
-  level_->setDecimals(4);
-  level_->setSingleStep(0.01);
-  level_->setValue(0.99);
+  // Shown in percent ("99 %"); the analysis takes the fraction.
+  level_->setRange(50.0, 99.99);
+  level_->setDecimals(2);
+  level_->setSingleStep(1.0);
+  level_->setSuffix(" %");
+  level_->setValue(99.0);
   level_->setToolTip(tr("Confidence level of the shaded bands"));
   spa_->setObjectName("bodeSpaCheck");
   spa_->setToolTip(tr("Spectral analysis (4.28) of the estimation data"));
@@ -115,7 +124,7 @@ void BodePanel::setModelShown(int index, bool shown) {
   models_->item(index)->setCheckState(shown ? Qt::Checked : Qt::Unchecked);
 }
 
-void BodePanel::setLevel(double level) { level_->setValue(level); }
+void BodePanel::setLevel(double level) { level_->setValue(100.0 * level); }
 
 void BodePanel::setNonparametricShown(bool spa, bool etfe) {
   filling_ = true;
@@ -145,7 +154,7 @@ void BodePanel::refresh() {
     wmax = M_PI / data->sampleTime;
   }
   const auto grid = logGrid(wmin, wmax, 800);
-  const double level = level_->value();
+  const double level = level_->value() / 100.0;
   int colour = 0;
   auto add = [&](const BodeCurve& c) {
     plot_->addCurve(c);

@@ -12,6 +12,7 @@
 
 #include "widgets/ident_data.h"
 #include "widgets/plots/playhead_cursor.h"
+#include "widgets/plots/plot_tools.h"
 
 namespace flexarm {
 namespace {
@@ -38,6 +39,8 @@ ComparePanel::ComparePanel(Workspace* workspace, QWidget* parent)
   plot_->setInteractions(QCP::iRangeDrag | QCP::iRangeZoom);
   plot_->legend->setVisible(true);
   plot_->legend->setFont(QFont(font().family(), 8));
+  placeLegendAbove(plot_);
+  PlotTools::install(plot_)->limitAxisToData(plot_->xAxis);  // no time before the range
   fit_->setObjectName("compareFitLabel");
   fit_->setWordWrap(true);
 
@@ -117,6 +120,7 @@ void ComparePanel::refresh() {
     g->setName(name);
     g->setPen(pen);
   };
+  plot_->yAxis->setLabel(outputAxisLabel(*workspace_, velocity));
   const auto& base = at(1);
   if (!base) {
     fit_->setText(why);

@@ -24,6 +24,7 @@
 #include "core/io/log_io.h"
 #include "widgets/playhead.h"
 #include "widgets/plots/playhead_cursor.h"
+#include "widgets/plots/plot_tools.h"
 
 namespace flexarm {
 
@@ -35,6 +36,7 @@ void setupPlot(QCustomPlot* p, const QString& y) {
   p->legend->setVisible(true);
   p->legend->setFont(QFont(p->font().family(), 7));
   p->setInteractions(QCP::iRangeDrag | QCP::iRangeZoom);
+  PlotTools::install(p);
   p->legend->setBrush(QColor(255, 255, 255, 190));  // the curves stay visible beneath it
   p->setMinimumHeight(90);
 }
@@ -98,8 +100,8 @@ DiagnosisPanel::DiagnosisPanel(Workspace* workspace, QWidget* parent)
   setupPlot(estimates_, "");
   estimates_->legend->setVisible(false);
   estimates_->setMinimumHeight(170);
-  setupPlot(cusum_, tr("g / h"));
-  setupPlot(hypothesis_, tr("T"));
+  setupPlot(cusum_, tr("g / h [-]"));
+  setupPlot(hypothesis_, tr("T [-]"));
   setupPlot(timeline_, "");
   timeline_->legend->setVisible(false);
   timeline_->yAxis->setRange(-0.3, 5.0);

@@ -107,9 +107,9 @@ void DiagnosisPanel::buildPlots() {
     rect->axis(QCPAxis::atLeft)->setLabel(yLabel);
     level(p, rect, line, kAlarm);
   };
-  simple(cusum_, r.trace(DiagnosisTest::Cusum), true, 1.0, 10.0, tr("CUSUM g / h"));
+  simple(cusum_, r.trace(DiagnosisTest::Cusum), true, 1.0, 10.0, tr("CUSUM g / h [-]"));
   simple(hypothesis_, r.trace(DiagnosisTest::Hypothesis), false, r.options.hypothesisThreshold, 3.0,
-         tr("hypothesis T"));
+         tr("hypothesis T [-]"));
 
   // Alarm timeline: a row per test and one for the decision, raised while NF is rejected.
   QCPAxisRect* rect = timeline_->axisRect();

@@ -11,11 +11,13 @@
 #include <QTableWidget>
 #include <QVBoxLayout>
 #include <QtConcurrent>
+#include <algorithm>
 #include <cmath>
 #include <qcustomplot.h>
 
 #include "core/signal/preprocess.h"
 #include "widgets/plots/playhead_cursor.h"
+#include "widgets/plots/plot_tools.h"
 
 namespace flexarm {
 
@@ -36,8 +38,10 @@ void setupPlot(QCustomPlot* p, const QString& x, const QString& y) {
   p->yAxis->setLabel(y);
   p->legend->setVisible(true);
   p->legend->setFont(QFont(p->font().family(), 8));
+  placeLegendAbove(p);  // never over the residuals
   p->setInteractions(QCP::iRangeDrag | QCP::iRangeZoom);
-  p->setMinimumHeight(170);
+  PlotTools::install(p);
+  p->setMinimumHeight(200);  // the legend row above leaves the axis its label's length
 }
 
 QCPGraph* addCurve(QCustomPlot* p, const QString& name, const QColor& c) {
@@ -104,6 +108,10 @@ DiscoveryPanel::DiscoveryPanel(Workspace* workspace, QWidget* parent)
   table_->setHorizontalHeaderLabels({tr("Effect"), tr("Loss est."), tr("RMS val."), tr("ΔAIC"),
                                      tr("F / threshold"), tr("Significant"), tr("Why")});
   table_->horizontalHeader()->setStretchLastSection(true);
+  table_->setWordWrap(true);
+  table_->setToolTip(tr("Each candidate effect fitted on the estimation range: its loss, the RMS "
+                        "error on the validation range, the AIC change against the base model "
+                        "and the F test; hover a cell for its whole text"));
   table_->verticalHeader()->setVisible(false);
   table_->setEditTriggers(QAbstractItemView::NoEditTriggers);
   table_->setSelectionBehavior(QAbstractItemView::SelectRows);
@@ -391,13 +399,14 @@ void DiscoveryPanel::showResult() {
     const QStringList cells = {
         toString(c.kind),
         num(c.lossEst, 4),
-        r.hasValidation ? num(c.score.rmsValidation, 4) : tr("-"),
+        r.hasValidation ? num(c.score.rmsValidation, 4) : tr("no validation range"),
         std::isfinite(c.aic) ? QString::number(c.aic - r.baseAic, 'f', 1) : tr("-"),
         num(c.fStatistic, 3) + " / " + num(c.fThreshold, 3),
         c.significant ? tr("yes") : tr("no"),
         QString::fromStdString(c.reason)};
     for (int col = 0; col < cells.size(); ++col) {
       auto* item = new QTableWidgetItem(cells[col]);
+      item->setToolTip(cells[col]);  // the whole text, also when the column wraps it
       if (static_cast<int>(i) == r.best) {
         QFont f = item->font();
         f.setBold(true);
@@ -407,7 +416,14 @@ void DiscoveryPanel::showResult() {
       table_->setItem(row, col, item);
     }
   }
+  // Every column as wide as its text except "Why", which wraps within what is left, so the
+  // reason reads whole in the row (and in its tooltip).
   table_->resizeColumnsToContents();
+  const int why = table_->columnCount() - 1;
+  int others = 0;
+  for (int col = 0; col < why; ++col) others += table_->columnWidth(col);
+  table_->setColumnWidth(why, std::max(220, table_->viewport()->width() - others));
+  table_->resizeRowsToContents();
 
   // Base residual in time and frequency, the model's resonances marked (a stored summary
   // has no traces).

@@ -45,6 +45,17 @@ void useWorkspaceData(const Workspace& workspace, FitOptions& options) {
   if (auto v = seconds(RangeKind::Validation)) options.validation.push_back({data, v});
 }
 
+QString outputAxisLabel(const Workspace& workspace, bool velocityOutput) {
+  const IdData* d = workspace.current();
+  const Channel* y = d ? d->output() : nullptr;
+  if (!y) return velocityOutput ? QObject::tr("motor velocity [rad/s]") : QObject::tr("output");
+  const QString name = QString::fromStdString(y->name);
+  const QString unit = QString::fromStdString(y->unit);
+  if (velocityOutput)
+    return QObject::tr("d/dt %1 [%2/s]").arg(name, unit.isEmpty() ? QString("1") : unit);
+  return unit.isEmpty() ? name : QString("%1 [%2]").arg(name, unit);
+}
+
 std::optional<PreparedData> workspaceData(const Workspace& workspace, int decimation, bool velocityOutput,
                                           QString* why) {
   const IdData* current = workspace.current();

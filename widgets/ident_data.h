@@ -32,6 +32,10 @@ bool isModelChecked(const QListWidget* list, std::size_t index);
 std::optional<PreparedData> workspaceData(const Workspace& workspace, int decimation, bool velocityOutput,
                                           QString* why);
 
+// The quantity and unit the models' output is drawn in: the output channel's name and unit,
+// or its derivative ("d/dt motor_angle_rad [rad/s]") when the models give the velocity.
+QString outputAxisLabel(const Workspace& workspace, bool velocityOutput);
+
 // The workspace's current data and ranges as the experiments of a fit: the estimation range
 // (the whole log without one) and, when one is set, the validation range of the same log.
 void useWorkspaceData(const Workspace& workspace, FitOptions& options);

@@ -1,8 +1,10 @@
 #include "widgets/log_panel.h"
 
 #include <QHBoxLayout>
+#include <QKeyEvent>
 #include <QHeaderView>
 #include <QLabel>
+#include <QLocale>
 #include <QTableWidget>
 #include <QToolButton>
 #include <QVBoxLayout>
@@ -12,6 +14,7 @@
 
 #include "widgets/playhead.h"
 #include "widgets/plots/playhead_cursor.h"
+#include "widgets/plots/plot_tools.h"
 
 namespace flexarm {
 namespace {
@@ -42,7 +45,6 @@ LogPanel::LogPanel(Workspace* workspace, QWidget* parent)
     auto* b = new QToolButton(this);
     b->setText(text);
     b->setToolTip(tip + " (" + shortcut + ")");
-    b->setShortcut(QKeySequence(shortcut));
     b->setCheckable(true);
     b->setAutoExclusive(true);
     b->setToolButtonStyle(Qt::ToolButtonTextOnly);
@@ -64,6 +66,7 @@ LogPanel::LogPanel(Workspace* workspace, QWidget* parent)
   auto* clear = new QToolButton(this);
   clear->setText(tr("Clear ranges"));
   clear->setObjectName("clearRangesButton");
+  clear->setToolTip(tr("Remove the estimation and validation ranges (undo with Ctrl+Z)"));
   auto* all = new QToolButton(this);
   all->setText(tr("Show all"));
   all->setToolTip(tr("Show the whole log (double click in the plot does the same)"));
@@ -84,8 +87,11 @@ LogPanel::LogPanel(Workspace* workspace, QWidget* parent)
   rangeTable_->setHorizontalHeaderLabels({tr("Range"), tr("From [s]"), tr("To [s]"), tr("Samples")});
   rangeTable_->verticalHeader()->hide();
   rangeTable_->horizontalHeader()->setSectionResizeMode(QHeaderView::Stretch);
-  rangeTable_->setEditTriggers(QAbstractItemView::NoEditTriggers);
-  rangeTable_->setSelectionMode(QAbstractItemView::NoSelection);
+  // From and To can be typed (a double click or F2 on the cell): exact ranges such as 0.5-12 s.
+  rangeTable_->setEditTriggers(QAbstractItemView::DoubleClicked | QAbstractItemView::EditKeyPressed);
+  rangeTable_->setSelectionMode(QAbstractItemView::SingleSelection);
+  rangeTable_->setToolTip(tr("Drag in the plot in range mode (E, V), or double click From or To "
+                             "and type the time in seconds"));
   rangeTable_->setMaximumHeight(rangeTable_->horizontalHeader()->height() +
                                 2 * rangeTable_->verticalHeader()->defaultSectionSize() + 6);
 
@@ -93,6 +99,7 @@ LogPanel::LogPanel(Workspace* workspace, QWidget* parent)
   plot_->setNoAntialiasingOnDrag(true);
   plot_->setInteractions(QCP::iRangeDrag | QCP::iRangeZoom);
   plot_->setMinimumHeight(240);
+  plot_->setFocusPolicy(Qt::StrongFocus);  // a click gives the log view the E/V/Z/L keys
 
   auto* layout = new QVBoxLayout(this);
   layout->setContentsMargins(4, 4, 4, 4);
@@ -110,10 +117,12 @@ LogPanel::LogPanel(Workspace* workspace, QWidget* parent)
     workspace_->clearRange(RangeKind::Validation);
   });
   connect(all, &QToolButton::clicked, this, &LogPanel::showAll);
+  connect(rangeTable_, &QTableWidget::itemChanged, this, &LogPanel::onRangeEdited);
   connect(plot_, &QCustomPlot::mousePress, this, &LogPanel::onMousePress);
   connect(plot_, &QCustomPlot::mouseMove, this, &LogPanel::onMouseMove);
   connect(plot_, &QCustomPlot::mouseRelease, this, &LogPanel::onMouseRelease);
-  connect(plot_, &QCustomPlot::mouseDoubleClick, this, &LogPanel::onMouseDoubleClick);
+  // Double click and the right-click menu reset the zoom to the whole log.
+  PlotTools::install(plot_)->setReset([this] { showAll(); });
   connect(workspace_, &Workspace::currentChanged, this, &LogPanel::rebuild);
   connect(workspace_, &Workspace::rangesChanged, this, &LogPanel::updateRanges);
   playheadCursor_->setFollow(true);
@@ -127,6 +136,24 @@ void LogPanel::setPlayhead(Playhead* playhead) {
   if (playhead_)
     connect(playhead_, &Playhead::selectionChanged, this, &LogPanel::updateLoopSelection);
   updateLoopSelection();
+}
+
+bool LogPanel::handleModeKey(QKeyEvent* e) {
+  if (e->modifiers() & ~(Qt::KeypadModifier | Qt::ShiftModifier)) return false;
+  switch (e->key()) {
+    case Qt::Key_Z: setMode(Mode::Navigate); return true;
+    case Qt::Key_E: setMode(Mode::SelectEstimation); return true;
+    case Qt::Key_V: setMode(Mode::SelectValidation); return true;
+    case Qt::Key_L: setMode(Mode::SelectLoop); return true;
+    default: return false;
+  }
+}
+
+void LogPanel::keyPressEvent(QKeyEvent* e) {
+  if (handleModeKey(e))
+    e->accept();
+  else
+    QWidget::keyPressEvent(e);
 }
 
 void LogPanel::setMode(Mode m) {
@@ -223,6 +250,12 @@ void LogPanel::rebuild() {
     const double pad = std::max(1e-12, 0.05 * (hi - lo));
     y->setRange(lo - pad, hi + pad);
     rects_.push_back(rect);
+    // Panning and zooming stay inside the log: no time before its first sample.
+    PlotTools::of(plot_)->limitAxis(x, [this]() -> std::pair<double, double> {
+      const IdData* d = workspace_->shown();
+      if (!d || d->samples() < 2) return {0.0, 0.0};
+      return {d->startTime, d->timeAt(d->samples() - 1)};
+    });
     connect(x, QOverload<const QCPRange&>::of(&QCPAxis::rangeChanged), this,
             [this, rect, c](const QCPRange&) {
               syncTimeAxes(rect);
@@ -341,17 +374,74 @@ void LogPanel::updateRanges() {
     for (auto* item : *row.rects) placeRect(item, r ? r->start : 0, r ? r->end : 0, r.has_value());
     const SampleRange s = workspace_->samples(row.kind);
     QStringList cells = {row.kind == RangeKind::Estimation ? tr("Estimation") : tr("Validation"),
-                         r ? QString::number(r->start, 'f', 4) : QString("-"),
-                         r ? QString::number(r->end, 'f', 4) : QString("-"),
+                         r ? QString::number(r->start, 'g', 10) : QString("-"),
+                         r ? QString::number(r->end, 'g', 10) : QString("-"),
                          r ? QString::number(s.size()) : tr("drag in the plot")};
+    const QSignalBlocker block(rangeTable_);  // filling is no edit
     for (int c = 0; c < 4; ++c) {
-      auto* item = new QTableWidgetItem(cells[c]);
-      if (c == 0) item->setForeground(row.color.darker(120));
-      rangeTable_->setItem(i, c, item);
+      QTableWidgetItem* item = rangeTable_->item(i, c);
+      if (!item) {  // made once: an edit in progress keeps its item
+        item = new QTableWidgetItem;
+        if (c == 0) item->setForeground(row.color.darker(120));
+        if (c == 1 || c == 2)
+          item->setToolTip(tr("Double click to type the time in seconds"));
+        else
+          item->setFlags(item->flags() & ~Qt::ItemIsEditable);
+        rangeTable_->setItem(i, c, item);
+      }
+      item->setText(cells[c]);
     }
   }
   if (auto* layer = plot_->layer("ranges")) layer->replot();
   plot_->replot(QCustomPlot::rpQueuedReplot);
+}
+
+bool LogPanel::setRangeText(RangeKind kind, const QString& from, const QString& to, QString* why) {
+  const IdData* data = workspace_->current();
+  auto fail = [why](const QString& reason) {
+    if (why) *why = reason;
+    return false;
+  };
+  if (!data || data->samples() < 2) return fail(tr("open a log first"));
+  const double first = data->startTime, last = data->timeAt(data->samples() - 1);
+  auto parse = [](QString text, double fallback, bool* ok) {
+    text = text.trimmed();
+    if (text.endsWith('s')) text.chop(1);
+    text = text.trimmed();
+    if (text.isEmpty() || text == "-") {
+      *ok = true;
+      return fallback;
+    }
+    return QLocale::c().toDouble(text, ok);
+  };
+  bool ok0 = false, ok1 = false;
+  const double t0 = parse(from, first, &ok0), t1 = parse(to, last, &ok1);
+  if (!ok0) return fail(tr("'%1' is not a time in seconds").arg(from));
+  if (!ok1) return fail(tr("'%1' is not a time in seconds").arg(to));
+  if (!(t1 > t0)) return fail(tr("the range must end after it starts (%1 to %2 s)").arg(t0).arg(t1));
+  if (t0 < first - 0.5 * data->sampleTime || t1 > last + 0.5 * data->sampleTime)
+    return fail(tr("%1 to %2 s is outside the log (%3 to %4 s)").arg(t0).arg(t1).arg(first).arg(last));
+  if (data->rangeForTimes(t0, t1).size() < 2) return fail(tr("the range holds fewer than 2 samples"));
+  workspace_->setRange(kind, {std::max(t0, first), std::min(t1, last)});
+  return true;
+}
+
+void LogPanel::onRangeEdited(QTableWidgetItem* item) {
+  if (!item || item->row() < 0 || item->row() > 1 || (item->column() != 1 && item->column() != 2))
+    return;
+  const RangeKind kind = item->row() == 0 ? RangeKind::Estimation : RangeKind::Validation;
+  const auto old = workspace_->range(kind);
+  const QString from = item->column() == 1 ? item->text()
+                       : old             ? QString::number(old->start, 'g', 17)
+                                         : QString();
+  const QString to = item->column() == 2 ? item->text()
+                     : old               ? QString::number(old->end, 'g', 17)
+                                         : QString();
+  QString why;
+  if (!setRangeText(kind, from, to, &why)) {
+    updateRanges();  // back to the range in force
+    readout_->setText(tr("Range not changed: %1").arg(why));
+  }
 }
 
 void LogPanel::updateLoopSelection() {
@@ -417,6 +507,5 @@ void LogPanel::onMouseRelease(QMouseEvent* e) {
   workspace_->setRange(kind, {data->timeAt(s.begin), data->timeAt(s.end - 1)});
 }
 
-void LogPanel::onMouseDoubleClick(QMouseEvent*) { showAll(); }
 
 }  // namespace flexarm

@@ -20,7 +20,9 @@ class QCPItemStraightLine;
 class QCPLayer;
 class QLabel;
 class QTableWidget;
+class QTableWidgetItem;
 class QToolButton;
+class QKeyEvent;
 class QMouseEvent;
 class QWheelEvent;
 
@@ -40,6 +42,10 @@ class LogPanel : public QWidget {
   void setPlayhead(Playhead* playhead);
   PlayheadCursor* playheadCursor() const { return playheadCursor_; }
   void setMode(Mode m);
+  // Z, E, V and L choose the mode. They are keys, not shortcuts: a text field with the focus
+  // takes its letters first, and the panel or the window gets the ones nothing used (with the
+  // Log panel focused, or window-wide through MainWindow::keyPressEvent). True when used.
+  bool handleModeKey(QKeyEvent* e);
   Mode mode() const { return mode_; }
   QCustomPlot* plot() const { return plot_; }
   // Axis rectangle of channel i (top to bottom), for tests and screenshots.
@@ -50,9 +56,16 @@ class LogPanel : public QWidget {
   QString readoutText() const;
   // Shows the whole log.
   void showAll();
+  QTableWidget* rangeTable() const { return rangeTable_; }
+  // Sets a range from typed times in seconds ("0.5", "12 s"; empty means the log's start or
+  // end), exactly as typed when inside the log. False with the reason otherwise.
+  bool setRangeText(RangeKind kind, const QString& from, const QString& to, QString* why = nullptr);
   // Zooms to a short window centred on time t with the cursor line there (e.g. a gap of the
   // Preprocess panel's time-stamp report).
   void showAround(double t);
+
+ protected:
+  void keyPressEvent(QKeyEvent* e) override;
 
  private:
   void rebuild();
@@ -60,8 +73,8 @@ class LogPanel : public QWidget {
   void onMousePress(QMouseEvent* e);
   void onMouseMove(QMouseEvent* e);
   void onMouseRelease(QMouseEvent* e);
-  void onMouseDoubleClick(QMouseEvent* e);
   void syncTimeAxes(QCPAxisRect* source);
+  void onRangeEdited(QTableWidgetItem* item);
   // Gives channel c's graph the points to draw for its visible time range.
   void refreshChannel(std::size_t c);
   double timeAtPixel(double x) const;

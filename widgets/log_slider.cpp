@@ -19,16 +19,21 @@ LogSlider::LogSlider(const QString& name, const QString& label, double lowest, d
   field_->setObjectName(name + "Field");
   const int decades = static_cast<int>(std::lround(highExp_ - lowExp_));
   slider_->setRange(allowZero_ ? 0 : 1, decades * steps_ + 1);
+  // An arrow key or a click on the track moves one position (a factor 10^(1/stepsPerDecade)),
+  // never a whole decade; Page Up/Down do the same, dragging reaches any position.
   slider_->setSingleStep(1);
-  slider_->setPageStep(steps_);
+  slider_->setPageStep(1);
   slider_->setMinimumWidth(60);
   slider_->setToolTip(tr("%1 .. %2, %3 steps per decade%4")
                           .arg(lowest)
                           .arg(highest)
                           .arg(steps_)
                           .arg(allowZero_ ? tr("; far left is 0") : QString()));
-  field_->setMaximumWidth(70);
-  label_->setMinimumWidth(70);
+  // The field holds any value it shows ("0.00025", "1e-08") without cutting it.
+  field_->setMinimumWidth(field_->fontMetrics().horizontalAdvance("0.000025") + 16);
+  field_->setMaximumWidth(field_->minimumWidth() + 10);
+  field_->setToolTip(tr("Type a value; the slider moves to the nearest position"));
+  label_->setMinimumWidth(label_->fontMetrics().horizontalAdvance(label) + 6);
   auto* layout = new QHBoxLayout(this);
   layout->setContentsMargins(0, 0, 0, 0);
   layout->addWidget(label_);
@@ -84,7 +89,7 @@ void LogSlider::onField() {
     return;
   }
   field_->setStyleSheet(QString());
-  field_->setToolTip(QString());
+  field_->setToolTip(tr("Type a value; the slider moves to the nearest position"));
   const double old = value_;
   setValue(v);
   if (value_ != old) emit valueChanged(value_);

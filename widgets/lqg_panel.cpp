@@ -10,6 +10,7 @@
 #include <QLineEdit>
 #include <QPushButton>
 #include <QResizeEvent>
+#include <QScrollBar>
 #include <QScrollArea>
 #include <QSplitter>
 #include <QVBoxLayout>
@@ -21,6 +22,7 @@
 
 #include "core/models/two_mass_lqg_reduction.h"
 #include "widgets/log_slider.h"
+#include "widgets/plots/plot_tools.h"
 #include "widgets/plots/pole_zero_plot.h"
 
 namespace flexarm {
@@ -35,6 +37,8 @@ const QColor kAntiWindup(148, 103, 189);
 // Above this cost (redesign plus drawing) a slider move is computed off the GUI thread and
 // moves made meanwhile are coalesced into one redesign.
 constexpr double kSynchronousBudget = 0.012;  // s
+// Smallest plot of the grid: titles, legends and tick labels stay readable.
+constexpr int kPlotMinimumWidth = 230, kPlotMinimumHeight = 210;
 
 QVector<double> qv(const std::vector<double>& v) { return QVector<double>(v.begin(), v.end()); }
 
@@ -54,15 +58,20 @@ void setCurve(QCPCurve* c, const std::vector<std::complex<double>>& pts, bool mi
   c->setData(t, x, y, true);
 }
 
-// Zoom and drag, a small legend in the given corner, and a title row above the axes.
-void setUpPlot(QCustomPlot* p, const char* name, const QString& title, Qt::Alignment legendAt) {
+// Zoom and drag, a title row above the axes and the legend in its own row below the title,
+// never over the curves; at least as wide as the title.
+void setUpPlot(QCustomPlot* p, const char* name, const QString& title) {
   p->setObjectName(name);
   p->setInteractions(QCP::iRangeDrag | QCP::iRangeZoom);
+  PlotTools::install(p);
   p->legend->setVisible(true);
   p->legend->setFont(QFont(p->font().family(), 8));
-  p->axisRect()->insetLayout()->setInsetAlignment(0, legendAt);
   p->plotLayout()->insertRow(0);
-  p->plotLayout()->addElement(0, 0, new QCPTextElement(p, title));
+  auto* text = new QCPTextElement(p, title, QFont(p->font().family(), 9, QFont::Bold));
+  p->plotLayout()->addElement(0, 0, text);
+  placeLegendAbove(p);
+  p->setMinimumSize(std::max(kPlotMinimumWidth, QFontMetrics(text->font()).horizontalAdvance(title) + 24),
+                    kPlotMinimumHeight);
 }
 
 QPen pen(const QColor& c, double width, bool dashed) {
@@ -102,7 +111,6 @@ LqgPanel::LqgPanel(Workspace* workspace, QWidget* parent)
   auto* scroll = new QScrollArea(this);
   scroll->setWidget(box);
   scroll->setWidgetResizable(true);
-  scroll->setMinimumWidth(190);  // a narrow dock scrolls instead of squeezing the window
 
   badge_->setObjectName("stabilityBadge");
   pinnedBadge_->setObjectName("pinnedBadge");
@@ -114,44 +122,46 @@ LqgPanel::LqgPanel(Workspace* workspace, QWidget* parent)
     f.setBold(true);
     b->setFont(f);
     b->setMargin(4);
-    b->setMinimumWidth(80);  // a narrow dock cuts the sentence instead of widening the window
+    b->setMinimumWidth(80);  // a narrow dock wraps the sentence instead of widening the window
+    b->setWordWrap(true);
   }
   pinnedBadge_->hide();
 
   // Nyquist of F_y G, zoomable, with -1 and the -1/Y_f line.
-  setUpPlot(nyquist_, "nyquistPlot", tr("Nyquist curve of F_y G (Section 8.6)"),
-            Qt::AlignTop | Qt::AlignLeft);
-  nyquist_->xAxis->setLabel(tr("Re F_y G"));
-  nyquist_->yAxis->setLabel(tr("Im F_y G"));
+  setUpPlot(nyquist_, "nyquistPlot", tr("Nyquist of F_y G (8.6)"));
+  nyquist_->xAxis->setLabel(tr("Re F_y G [-]"));
+  nyquist_->yAxis->setLabel(tr("Im F_y G [-]"));
   // |S| and |T| on log axes.
-  setUpPlot(sensitivity_, "sensitivityPlot", tr("|S| (8.36) and |T|"),
-            Qt::AlignBottom | Qt::AlignLeft);
+  setUpPlot(sensitivity_, "sensitivityPlot", tr("|S| (8.36) and |T|"));
   sensitivity_->xAxis->setLabel(tr("frequency [rad/s]"));
-  sensitivity_->yAxis->setLabel(tr("magnitude"));
+  sensitivity_->yAxis->setLabel(tr("magnitude [-]"));
   for (QCPAxis* a : {sensitivity_->xAxis, sensitivity_->yAxis}) {
     a->setScaleType(QCPAxis::stLogarithmic);
     a->setTicker(QSharedPointer<QCPAxisTickerLog>(new QCPAxisTickerLog));
   }
   // Steps: arm angle on top, torque below.
-  setUpPlot(steps_, "stepPlot", tr("Unit steps in w (0 s) and v (1 s), Figure 8.3"),
-            Qt::AlignTop | Qt::AlignRight);
+  setUpPlot(steps_, "stepPlot", tr("Steps in w and v (Fig. 8.3)"));
+  steps_->axisRect(0)->axis(QCPAxis::atBottom)->setLabel(tr("time [s]"));
   auto* torqueRect = new QCPAxisRect(steps_);
-  steps_->plotLayout()->addElement(2, 0, torqueRect);
+  steps_->plotLayout()->addElement(steps_->plotLayout()->rowCount(), 0, torqueRect);
   steps_->axisRect(0)->axis(QCPAxis::atLeft)->setLabel(tr("arm angle [rad]"));
   torqueRect->axis(QCPAxis::atLeft)->setLabel(tr("torque [N m]"));
   torqueRect->axis(QCPAxis::atBottom)->setLabel(tr("time [s]"));
+  steps_->setMinimumHeight(kPlotMinimumHeight + 90);
   auto* group = new QCPMarginGroup(steps_);
   steps_->axisRect(0)->setMarginGroup(QCP::msLeft | QCP::msRight, group);
   torqueRect->setMarginGroup(QCP::msLeft | QCP::msRight, group);
   connect(steps_->axisRect(0)->axis(QCPAxis::atBottom),
           QOverload<const QCPRange&>::of(&QCPAxis::rangeChanged), torqueRect->axis(QCPAxis::atBottom),
           QOverload<const QCPRange&>::of(&QCPAxis::setRange));
+  const QString polesTitle = tr("Regulator and closed-loop poles");
+  auto* polesText = new QCPTextElement(poles_->plot(), polesTitle,
+                                       QFont(font().family(), 9, QFont::Bold));
   poles_->plot()->plotLayout()->insertRow(0);
-  poles_->plot()->plotLayout()->addElement(
-      0, 0, new QCPTextElement(poles_->plot(), tr("Regulator poles (of F_y) and closed loop")));
-  for (QWidget* p : {static_cast<QWidget*>(nyquist_), static_cast<QWidget*>(sensitivity_),
-                     static_cast<QWidget*>(steps_), static_cast<QWidget*>(poles_)})
-    p->setMinimumSize(150, 130);
+  poles_->plot()->plotLayout()->addElement(0, 0, polesText);
+  poles_->setMinimumSize(
+      std::max(kPlotMinimumWidth, QFontMetrics(polesText->font()).horizontalAdvance(polesTitle) + 24),
+      kPlotMinimumHeight);
 
   auto* zoomNear = new QPushButton(tr("Nyquist near -1"), this);
   zoomNear->setObjectName("zoomNearMinusOne");
@@ -159,24 +169,39 @@ LqgPanel::LqgPanel(Workspace* workspace, QWidget* parent)
   zoomWide->setObjectName("zoomWide");
   connect(zoomNear, &QPushButton::clicked, this, &LqgPanel::zoomNearMinusOne);
   connect(zoomWide, &QPushButton::clicked, this, &LqgPanel::showWholeNyquist);
+  controlsButton_ = new QPushButton(tr("Hide controls"), this);
+  controlsButton_->setObjectName("controlsToggle");
+  controlsButton_->setToolTip(tr("Hide or show the design controls to give the plots the room"));
+  connect(controlsButton_, &QPushButton::clicked, this,
+          [this] { setControlsShown(!controlsShown()); });
+  zoomNear->setToolTip(tr("Zoom the Nyquist plot around -1, where stability margins show"));
+  zoomWide->setToolTip(tr("Show the whole Nyquist curve"));
+  // Buttons in one row, the verdicts (whole sentences, wrapped) in the next.
+  auto* buttonRow = new QHBoxLayout;
+  buttonRow->addWidget(controlsButton_);
+  buttonRow->addStretch(1);
+  buttonRow->addWidget(zoomNear);
+  buttonRow->addWidget(zoomWide);
   auto* badgeRow = new QHBoxLayout;
-  badgeRow->addWidget(badge_);
-  badgeRow->addWidget(pinnedBadge_);
-  badgeRow->addStretch(1);
-  badgeRow->addWidget(zoomNear);
-  badgeRow->addWidget(zoomWide);
+  badgeRow->addWidget(badge_, 1);
+  badgeRow->addWidget(pinnedBadge_, 1);
   auto* grid = new QGridLayout;
-  grid->addWidget(nyquist_, 0, 0);
-  grid->addWidget(sensitivity_, 0, 1);
-  grid->addWidget(steps_, 1, 0);
-  grid->addWidget(poles_, 1, 1);
+  plotGrid_ = grid;
+  arrangePlots(1);  // compact until shown: reflow() widens to two columns when there is room
   auto* right = new QWidget(this);
   auto* rightLayout = new QVBoxLayout(right);
   rightLayout->setContentsMargins(0, 0, 0, 0);
+  rightLayout->addLayout(buttonRow);
   rightLayout->addLayout(badgeRow);
   rightLayout->addLayout(grid, 1);
   rightLayout->addWidget(summary_);
   auto* split = new QSplitter(Qt::Horizontal, this);
+  // Nothing of the controls hides behind the scroll bar: the side is as wide as the controls
+  // plus the bar; a short dock scrolls them.
+  scroll->setHorizontalScrollBarPolicy(Qt::ScrollBarAlwaysOff);
+  scroll->setMinimumWidth(box->minimumSizeHint().width() +
+                          scroll->verticalScrollBar()->sizeHint().width() + 2 * scroll->frameWidth());
+  controlsSide_ = scroll;
   split->addWidget(scroll);
   split->addWidget(right);
   split->setStretchFactor(0, 0);
@@ -213,12 +238,75 @@ LqgPanel::LqgPanel(Workspace* workspace, QWidget* parent)
 
 LqgPanel::~LqgPanel() { watcher_.waitForFinished(); }
 
+bool LqgPanel::eventFilter(QObject* watched, QEvent* e) {
+  // In a dock the panel sits in a scroll area: the room it has is the viewport's width.
+  if (watched == parentWidget() && e->type() == QEvent::Resize) reflow();
+  return QWidget::eventFilter(watched, e);
+}
+
+void LqgPanel::showEvent(QShowEvent* e) {
+  QWidget::showEvent(e);
+  if (parentWidget() && !filtering_) {
+    parentWidget()->installEventFilter(this);
+    filtering_ = true;
+  }
+  reflow();
+}
+
+void LqgPanel::reflow() {
+  // Controls beside the plots when both fit side by side, else above them (a narrow dock
+  // scrolls down instead of hiding half the panel to the right).
+  const bool inScroll = parentWidget() && parentWidget()->objectName() == "qt_scrollarea_viewport";
+  const int room = inScroll ? parentWidget()->width() : width();
+  const int plotWidth = std::max(nyquist_->minimumWidth(), poles_->minimumWidth());
+  const Qt::Orientation wanted =
+      !controlsShown() || room >= controlsSide_->minimumWidth() + plotWidth + 24 ? Qt::Horizontal
+                                                                                 : Qt::Vertical;
+  if (split_->orientation() != wanted) {
+    split_->setOrientation(wanted);
+    splitterMoved_ = false;
+  }
+  QResizeEvent again(size(), size());
+  resizeEvent(&again);
+}
+
 void LqgPanel::resizeEvent(QResizeEvent* e) {
   QWidget::resizeEvent(e);
-  if (splitterMoved_) return;
+  if (split_->orientation() == Qt::Vertical) {
+    if (!splitterMoved_ && controlsShown()) {
+      const int total = split_->height();
+      const int top = std::min(controlsSide_->sizeHint().height(), std::max(160, total * 2 / 5));
+      split_->setSizes({top, total - top});
+    }
+    const int twoColumns = 2 * std::max(nyquist_->minimumWidth(), poles_->minimumWidth()) + 12;
+    arrangePlots(split_->width() >= twoColumns ? 2 : 1);
+    return;
+  }
   const int total = split_->width();
-  const int left = std::min(controls_->sizeHint().width() + 20, total * 2 / 5);
-  split_->setSizes({left, total - left});
+  if (!splitterMoved_ && controlsShown()) {
+    const int left = std::max(controlsSide_->minimumWidth(),
+                              std::min(controlsSide_->sizeHint().width() + 20, total * 2 / 5));
+    split_->setSizes({left, total - left});
+  }
+  const int plotsWidth = controlsShown() ? total - split_->sizes().value(0) : total;
+  const int twoColumns = 2 * std::max(nyquist_->minimumWidth(), poles_->minimumWidth()) + 12;
+  arrangePlots(plotsWidth >= twoColumns ? 2 : 1);
+}
+
+void LqgPanel::arrangePlots(int columns) {
+  if (columns == plotColumns_) return;
+  plotColumns_ = columns;
+  QWidget* const plots[] = {nyquist_, sensitivity_, steps_, poles_};
+  for (QWidget* p : plots) plotGrid_->removeWidget(p);
+  for (int i = 0; i < 4; ++i) plotGrid_->addWidget(plots[i], i / columns, i % columns);
+}
+
+bool LqgPanel::controlsShown() const { return controlsSide_ && !controlsSide_->isHidden(); }
+
+void LqgPanel::setControlsShown(bool shown) {
+  controlsSide_->setVisible(shown);
+  controlsButton_->setText(shown ? tr("Hide controls") : tr("Show controls"));
+  reflow();
 }
 
 void LqgPanel::buildControls(QWidget* box) {
@@ -294,7 +382,10 @@ void LqgPanel::buildControls(QWidget* box) {
   auto* options = new QGroupBox(tr("Measurement and saturation"), box);
   auto* optionLayout = new QGridLayout(options);
   acceleration_->setObjectName("accelerationFeedback");
+  acceleration_->setToolTip(tr("Measure the arm acceleration besides the motor angle (8.40); "
+                               "its noise weight is R2 phi_a''"));
   saturation_->setObjectName("saturation");
+  saturation_->setToolTip(tr("Simulate the steps with the torque limited to the value beside"));
   saturationLimit_->setObjectName("saturationLimit");
   saturationLimit_->setToolTip(tr("torque limit in N m; the steps are also simulated saturated, "
                                   "without and with anti-windup (8.31)-(8.32)"));
@@ -313,6 +404,7 @@ void LqgPanel::buildControls(QWidget* box) {
   unpinButton_->setObjectName("unpinButton");
   pinButton_->setToolTip(tr("Keep the current design overlaid in every plot to compare"));
   unpinButton_->setEnabled(false);
+  unpinButton_->setToolTip(tr("Remove the pinned design from the plots"));
   connect(pinButton_, &QPushButton::clicked, this, &LqgPanel::pin);
   connect(unpinButton_, &QPushButton::clicked, this, &LqgPanel::unpin);
   auto* pinRow = new QHBoxLayout;

@@ -22,6 +22,7 @@ class QComboBox;
 class QCPCurve;
 class QCPGraph;
 class QCustomPlot;
+class QGridLayout;
 class QLabel;
 class QLineEdit;
 class QPushButton;
@@ -93,8 +94,17 @@ class LqgPanel : public QWidget {
 
  protected:
   // Keeps the controls at their natural width, but at most 40 % of the panel, until the user
-  // moves the splitter.
+  // moves the splitter; the plots stand in two columns when there is room for both, else in
+  // one.
   void resizeEvent(QResizeEvent* e) override;
+  void showEvent(QShowEvent* e) override;
+  bool eventFilter(QObject* watched, QEvent* e) override;
+
+ public:
+  // Columns of the plot grid now (1 or 2), and whether the controls side is shown.
+  int plotColumns() const { return plotColumns_; }
+  bool controlsShown() const;
+  void setControlsShown(bool shown);
 
  private:
   void buildControls(QWidget* box);
@@ -107,6 +117,9 @@ class LqgPanel : public QWidget {
   void showFailure(const QString& why);
   void redraw();
   void updateMeasurementControls();
+  void arrangePlots(int columns);
+  // Chooses controls beside or above the plots for the room there is, then the columns.
+  void reflow();
 
   Workspace* workspace_;
   QComboBox* source_;
@@ -128,6 +141,11 @@ class LqgPanel : public QWidget {
   PoleZeroPlot* poles_;
   QSplitter* split_ = nullptr;
   QWidget* controls_ = nullptr;
+  QWidget* controlsSide_ = nullptr;  // the scroll area around controls_
+  QPushButton* controlsButton_ = nullptr;
+  QGridLayout* plotGrid_ = nullptr;
+  int plotColumns_ = 0;
+  bool filtering_ = false;
   bool splitterMoved_ = false;
   TwoMassLqgParameters parameters_;
 

@@ -23,6 +23,7 @@
 #include "widgets/ident_data.h"
 #include "widgets/plots/bode_plot.h"
 #include "widgets/plots/playhead_cursor.h"
+#include "widgets/plots/plot_tools.h"
 #include "widgets/plots/pole_zero_plot.h"
 
 namespace flexarm {
@@ -67,13 +68,17 @@ ModelPanel::ModelPanel(Workspace* workspace, QWidget* parent)
   params_->setObjectName("parameterTable");
   params_->setHorizontalHeaderLabels({tr("Parameter"), tr("Value"), tr("Unit"), tr("Free")});
   params_->verticalHeader()->hide();
+  // Columns as wide as their text (a narrow dock scrolls; no value is cut to "0....").
   params_->horizontalHeader()->setSectionResizeMode(QHeaderView::ResizeToContents);
-  params_->horizontalHeader()->setSectionResizeMode(1, QHeaderView::Stretch);
+  params_->horizontalHeader()->setStretchLastSection(true);
+  params_->setTextElideMode(Qt::ElideNone);
   params_->verticalHeader()->setDefaultSectionSize(22);
   effects_->setObjectName("effectTable");
   effects_->setHorizontalHeaderLabels({tr("Effect"), tr("On"), tr("Value 1"), tr("Value 2")});
   effects_->verticalHeader()->hide();
   effects_->horizontalHeader()->setSectionResizeMode(QHeaderView::ResizeToContents);
+  effects_->horizontalHeader()->setStretchLastSection(true);
+  effects_->setTextElideMode(Qt::ElideNone);
   effects_->verticalHeader()->setDefaultSectionSize(22);
   effects_->setRowCount(static_cast<int>(allEffectKinds().size()));
   for (int r = 0; r < effects_->rowCount(); ++r) {
@@ -99,6 +104,7 @@ ModelPanel::ModelPanel(Workspace* workspace, QWidget* parent)
   compare_->yAxis->setLabel(tr("motor velocity [rad/s]"));
   compare_->legend->setVisible(true);
   compare_->setInteractions(QCP::iRangeDrag | QCP::iRangeZoom);
+  PlotTools::install(compare_)->limitAxisToData(compare_->xAxis);
   compare_->axisRect()->setRangeZoom(Qt::Horizontal);
   compare_->axisRect()->setRangeDrag(Qt::Horizontal);
   auto* measured = compare_->addGraph();

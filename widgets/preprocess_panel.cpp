@@ -18,6 +18,7 @@
 #include <cmath>
 #include <qcustomplot.h>
 
+#include "widgets/plots/plot_tools.h"
 #include "widgets/timing_table.h"
 
 namespace flexarm {
@@ -116,8 +117,9 @@ PreprocessPanel::PreprocessPanel(Workspace* workspace, QWidget* parent)
     a->setNumberPrecision(0);
   }
   plot_->xAxis->setLabel(tr("frequency [Hz]"));
-  plot_->yAxis->setLabel(tr("amplitude"));
+  plot_->yAxis->setLabel(tr("amplitude per bin"));
   plot_->setInteractions(QCP::iRangeDrag | QCP::iRangeZoom);
+  PlotTools::install(plot_);
   auto* before = plot_->addGraph();
   before->setName(tr("before"));
   before->setPen(QPen(QColor(150, 150, 150), 1));
@@ -130,6 +132,7 @@ PreprocessPanel::PreprocessPanel(Workspace* workspace, QWidget* parent)
   nyq->setVisible(false);
   plot_->legend->setVisible(true);
   plot_->legend->setFont(QFont(font().family(), 8));
+  placeLegendAbove(plot_);  // never over the passband
 
   summary_->setObjectName("preprocessSummary");
   summary_->setWordWrap(true);
@@ -304,10 +307,25 @@ void PreprocessPanel::preview() {
         // Before: the log as read (irregular stamps: its samples at the nominal interval).
         const bool derive = o.differentiateAngle && input->isUniform();
         const IdData beforeData = derive ? addDerivative(*input) : *input;
-        if (const Channel* c = beforeData.channel(channel))
-          out.before = amplitudeSpectrum(sampled(c->values), beforeData.sampleTime);
-        if (const Channel* c = result->channel(channel))
+        // Both spectra at one frequency resolution: a broadband level per bin grows with the
+        // square root of the bin width, so at different resolutions before and after would
+        // differ by sqrt(decimation) inside the passband with nothing changed there.
+        int afterLength = 0;
+        if (const Channel* c = result->channel(channel)) {
           out.after = amplitudeSpectrum(c->values, result->sampleTime);
+          out.unit = QString::fromStdString(c->unit);
+          if (out.after.frequencyHz.size() > 1)
+            afterLength = 2 * static_cast<int>(out.after.frequencyHz.size() - 1);
+        }
+        if (const Channel* c = beforeData.channel(channel)) {
+          const int beforeLength =
+              afterLength > 0 ? static_cast<int>(std::lround(afterLength * result->sampleTime /
+                                                             beforeData.sampleTime))
+                              : 0;
+          out.before = amplitudeSpectrum(sampled(c->values), beforeData.sampleTime, beforeLength);
+          if (out.unit.isEmpty()) out.unit = QString::fromStdString(c->unit);
+        }
+        if (out.after.frequencyHz.size() > 1) out.binHz = out.after.frequencyHz[1];
         out.data = std::move(result);
       }
     } catch (const std::exception& e) {
@@ -335,6 +353,8 @@ void PreprocessPanel::onFinished() {
   const IdData* raw = workspace_->raw();
   setSpectrum(plot_->graph(0), out.before);
   setSpectrum(plot_->graph(1), out.after);
+  plot_->yAxis->setLabel(out.unit.isEmpty() ? tr("amplitude per bin")
+                                            : tr("amplitude per bin [%1]").arg(out.unit));
   plot_->rescaleAxes();
   auto* nyq = qobject_cast<QCPItemStraightLine*>(plot_->item(0));
   const double nyquist = 0.5 * result_->sampleRateHz();
@@ -351,6 +371,11 @@ void PreprocessPanel::onFinished() {
                      .arg(result_->samples())
                      .arg(nyquist, 0, 'g', 4)
                      .arg(out.seconds * 1000.0, 0, 'f', 0);
+  if (out.binHz > 0)
+    text += tr("\nSpectrum: Welch amplitude, a sinusoid of amplitude a peaks at a; before and "
+               "after at the same %1 Hz bins, so inside the passband they agree and differ only "
+               "where the anti-alias filter cuts.")
+                .arg(out.binHz, 0, 'g', 3);
   if (!out.resampling.isEmpty()) text += tr("\nResampled: %1").arg(out.resampling);
   summary_->setText(text);
   apply_->setEnabled(true);

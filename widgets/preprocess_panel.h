@@ -56,8 +56,9 @@ class PreprocessPanel : public QWidget {
     std::shared_ptr<IdData> data;
     AmplitudeSpectrum before, after;
     std::vector<TimingReport> timing;
-    QString error, resampling;
+    QString error, resampling, unit;
     double seconds = 0.0;
+    double binHz = 0.0;  // frequency resolution of both spectra
   };
   void schedulePreview();
   void onFinished();

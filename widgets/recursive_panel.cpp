@@ -19,6 +19,7 @@
 
 #include "widgets/playhead.h"
 #include "widgets/plots/playhead_cursor.h"
+#include "widgets/plots/plot_tools.h"
 
 namespace flexarm {
 
@@ -569,7 +570,7 @@ void RecursivePanel::buildPlot() {
   epsilonRect_ = addRect(row++, tr("pred. error\n[rad/s]"));
   epsilon_ = plot_->addGraph(epsilonRect_->axis(QCPAxis::atBottom), epsilonRect_->axis(QCPAxis::atLeft));
   epsilon_->setPen(QPen(QColor(60, 60, 60), 1.0));
-  pRect_ = addRect(row++, tr("diag P"));
+  pRect_ = addRect(row++, tr("diag P\n[units²]"));
   QCPAxis* py = pRect_->axis(QCPAxis::atLeft);
   py->setScaleType(QCPAxis::stLogarithmic);
   auto logTicker = QSharedPointer<QCPAxisTickerLog>(new QCPAxisTickerLog);
@@ -602,6 +603,7 @@ void RecursivePanel::buildPlot() {
   py->setRange(1e-8, 1.0);
   epsilonRect_->axis(QCPAxis::atLeft)->setRange(-1.0, 1.0);
   plot_->setInteractions(QCP::iRangeDrag | QCP::iRangeZoom);
+  PlotTools::install(plot_);
   drawOverlay();
   buildLegend();
   cursor_->attach();

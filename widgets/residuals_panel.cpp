@@ -8,15 +8,18 @@
 #include <qcustomplot.h>
 
 #include "widgets/ident_data.h"
+#include "widgets/plots/plot_tools.h"
 
 namespace flexarm {
 namespace {
 
 void setupPlot(QCustomPlot* p, const QString& title, const QString& xLabel) {
   p->setMinimumSize(300, 160);
+  PlotTools::install(p);
   p->plotLayout()->insertRow(0);
   p->plotLayout()->addElement(0, 0, new QCPTextElement(p, title, QFont("sans", 9, QFont::Bold)));
   p->xAxis->setLabel(xLabel);
+  p->yAxis->setLabel(QObject::tr("correlation [-]"));
 }
 
 // Correlations as bars with the +-bound band drawn as dashed lines.
@@ -66,8 +69,10 @@ ResidualsPanel::ResidualsPanel(Workspace* workspace, QWidget* parent)
   lags_->setToolTip(tr("Largest lag M of the correlations"));
   auto_->setObjectName("autocorrelationPlot");
   cross_->setObjectName("crossCorrelationPlot");
-  setupPlot(auto_, tr("Autocorrelation of residuals (99 % bounds)"), tr("lag"));
-  setupPlot(cross_, tr("Cross-correlation of input and residuals (99 % bounds)"), tr("lag"));
+  setupPlot(auto_, tr("Autocorrelation of residuals (99 % bounds)"),
+             tr("lag [samples]"));
+  setupPlot(cross_, tr("Cross-correlation of input and residuals (99 % bounds)"),
+             tr("lag [samples]"));
   verdict_->setObjectName("residualsVerdict");
   verdict_->setWordWrap(true);
 
@@ -162,6 +167,9 @@ void ResidualsPanel::refresh() {
     return;
   }
   analysis_ = residualAnalysis(eps->segment(b, n), data->u.segment(b, n), o);
+  // Lags count samples of the data the model works at; the label gives their length.
+  const QString lagLabel = tr("lag [samples of %1 ms]").arg(data->sampleTime * 1000.0, 0, 'g', 4);
+  for (QCustomPlot* p : {auto_, cross_}) p->xAxis->setLabel(lagLabel);
   showCorrelation(auto_, analysis_.lags, analysis_.autocorrelation, analysis_.autocorrelationBound, 1);
   showCorrelation(cross_, analysis_.crossLags, analysis_.crossCorrelation, analysis_.crossCorrelationBound,
        -o.maxLag);

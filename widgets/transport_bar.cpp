@@ -92,6 +92,11 @@ TransportBar::TransportBar(Playhead* playhead, QWidget* parent)
   layout->addWidget(slider_, 1);
   layout->addWidget(time_);
   layout->addWidget(total_);
+  auto* speedLabel = new QLabel(tr("Speed"), this);
+  speedLabel->setObjectName("speedLabel");
+  speedLabel->setToolTip(speed_->toolTip());
+  speedLabel->setBuddy(speed_);
+  layout->addWidget(speedLabel);
   layout->addWidget(speed_);
   layout->addWidget(loop_);
   layout->addWidget(selection_);

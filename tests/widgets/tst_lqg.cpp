@@ -8,6 +8,7 @@
 #include <QMouseEvent>
 #include <QPushButton>
 #include <QSignalSpy>
+#include <QScrollArea>
 #include <QSlider>
 #include <QStyle>
 #include <QStyleOptionSlider>
@@ -287,7 +288,10 @@ class LqgPanelTest : public QObject {
     const QSize model = w.findChild<QWidget*>("modelPanel")->minimumSizeHint();
     qInfo("minimum sizes: LQG %dx%d, Model %dx%d", lqg.width(), lqg.height(), model.width(),
           model.height());
-    QVERIFY(lqg.width() <= 700 && lqg.height() <= 600);
+    QVERIFY(lqg.width() <= 700);
+    // Its plots keep readable sizes; the dock scrolls them, so they never make the window
+    // taller (tst_layout checks the window fits 1366x768).
+    QVERIFY(qobject_cast<QScrollArea*>(w.findChild<QDockWidget*>("lqgDock")->widget()) != nullptr);
     // Docked and raised (a tab next to Preprocess and Model), showing the seed's case (i).
     w.resize(1400, 900);
     w.show();

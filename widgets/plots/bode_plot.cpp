@@ -1,12 +1,11 @@
 #include "widgets/plots/bode_plot.h"
 
-#include <QFileInfo>
 #include <QLabel>
-#include <QPainter>
-#include <QSvgGenerator>
 #include <QVBoxLayout>
 #include <cmath>
 #include <qcustomplot.h>
+
+#include "widgets/plots/plot_tools.h"
 
 namespace flexarm {
 namespace {
@@ -63,11 +62,12 @@ BodePlot::BodePlot(QWidget* parent)
           phaseRect_->axis(QCPAxis::atBottom), QOverload<const QCPRange&>::of(&QCPAxis::setRange));
   connect(phaseRect_->axis(QCPAxis::atBottom), QOverload<const QCPRange&>::of(&QCPAxis::rangeChanged),
           magRect_->axis(QCPAxis::atBottom), QOverload<const QCPRange&>::of(&QCPAxis::setRange));
-  auto* legendRect = magRect_;
+  // The legend sits in its own row above the magnitude, never over a peak or notch.
   plot_->legend = new QCPLegend;
-  legendRect->insetLayout()->addElement(plot_->legend, Qt::AlignRight | Qt::AlignTop);
+  magRect_->insetLayout()->addElement(plot_->legend, Qt::AlignRight | Qt::AlignTop);
   plot_->legend->setLayer("legend");
   plot_->legend->setVisible(true);
+  placeLegendAbove(plot_, magRect_);
   plot_->legend->setSelectableParts(QCPLegend::spItems);
   plot_->setInteractions(QCP::iRangeDrag | QCP::iRangeZoom | QCP::iSelectLegend);
   connect(plot_, &QCustomPlot::legendClick, this,
@@ -78,13 +78,17 @@ BodePlot::BodePlot(QWidget* parent)
               if (curves_[i].mag == pli->plottable()) setCurveVisible(static_cast<int>(i), !isCurveVisible(static_cast<int>(i)));
           });
   connect(plot_, &QCustomPlot::mousePress, this, &BodePlot::onClick);
+  // Double click and the right-click menu reset the zoom to the visible curves.
+  PlotTools::install(plot_)->setReset([this] { rescale(); });
   readout_->setObjectName("bodeReadout");
-  readout_->setText(tr("Click near a peak or notch to read it; click a legend entry to hide it"));
+  readout_->setText(tr("Click near a peak or notch to read it; click a legend entry to hide it; "
+                       "double click resets the zoom"));
+  readout_->setWordWrap(true);
   auto* layout = new QVBoxLayout(this);
   layout->setContentsMargins(0, 0, 0, 0);
   layout->addWidget(plot_, 1);
   layout->addWidget(readout_);
-  setMinimumSize(320, 260);
+  setMinimumSize(320, 340);  // magnitude and phase each tall enough for their labels
 }
 
 void BodePlot::clear() {
@@ -213,7 +217,8 @@ std::optional<std::pair<double, double>> BodePlot::extremumNear(int index, doubl
 QString BodePlot::readoutText() const { return readout_->text(); }
 
 void BodePlot::onClick(QMouseEvent* e) {
-  if (!magRect_->rect().contains(e->pos()) || curves_.empty()) return;
+  if (e->button() != Qt::LeftButton || !magRect_->rect().contains(e->pos()) || curves_.empty())
+    return;
   const double w = magRect_->axis(QCPAxis::atBottom)->pixelToCoord(e->position().x());
   const double level = magRect_->axis(QCPAxis::atLeft)->pixelToCoord(e->position().y());
   // The visible curve whose magnitude at w is closest to the click, then its extremum.
@@ -248,31 +253,7 @@ void BodePlot::onClick(QMouseEvent* e) {
 }
 
 bool BodePlot::exportTo(const QString& path, QString* why) const {
-  const QString ext = QFileInfo(path).suffix().toLower();
-  const int w = std::max(plot_->width(), 800), h = std::max(plot_->height(), 600);
-  bool ok = false;
-  if (ext == "png") {
-    ok = plot_->savePng(path, w, h);
-  } else if (ext == "pdf") {
-    ok = plot_->savePdf(path, w, h);
-  } else if (ext == "svg") {
-    QSvgGenerator svg;
-    svg.setFileName(path);
-    svg.setSize(QSize(w, h));
-    svg.setViewBox(QRect(0, 0, w, h));
-    svg.setTitle("FlexArm Bode plot");
-    QCPPainter painter;
-    ok = painter.begin(&svg);
-    if (ok) {
-      plot_->toPainter(&painter, w, h);
-      painter.end();
-    }
-  } else {
-    if (why) *why = tr("unknown format '%1': use .png, .pdf or .svg").arg(ext);
-    return false;
-  }
-  if (!ok && why) *why = tr("could not write %1").arg(path);
-  return ok;
+  return PlotTools::of(plot_)->exportTo(path, why);
 }
 
 }  // namespace flexarm

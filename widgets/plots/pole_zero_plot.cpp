@@ -5,6 +5,8 @@
 #include <cmath>
 #include <qcustomplot.h>
 
+#include "widgets/plots/plot_tools.h"
+
 namespace flexarm {
 
 PoleZeroPlot::PoleZeroPlot(QWidget* parent) : QWidget(parent), plot_(new QCustomPlot(this)) {
@@ -12,8 +14,13 @@ PoleZeroPlot::PoleZeroPlot(QWidget* parent) : QWidget(parent), plot_(new QCustom
   plot_->xAxis->setLabel(tr("real [1/s]"));
   plot_->yAxis->setLabel(tr("imaginary [rad/s]"));
   plot_->setInteractions(QCP::iRangeDrag | QCP::iRangeZoom);
+  PlotTools::install(plot_)->setReset([this] { rescale(); });
   plot_->legend->setVisible(true);
   plot_->legend->setFont(QFont(font().family(), 8));
+  placeLegendAbove(plot_);  // never over a pole
+  // Few ticks, so that "-2000 -1500 ..." never run into each other in a small plot.
+  plot_->xAxis->ticker()->setTickCount(4);
+  plot_->yAxis->ticker()->setTickCount(4);
   auto* axis = new QCPItemStraightLine(plot_);
   axis->point1->setCoords(0, 0);
   axis->point2->setCoords(0, 1);

@@ -1,0 +1,210 @@
+#include "widgets/plots/plot_tools.h"
+
+#include <QAction>
+#include <QApplication>
+#include <QClipboard>
+#include <QFile>
+#include <QFileDialog>
+#include <QFileInfo>
+#include <QMenu>
+#include <QMessageBox>
+#include <QSvgGenerator>
+#include <QTextStream>
+#include <cmath>
+#include <qcustomplot.h>
+
+namespace flexarm {
+namespace {
+
+constexpr const char* kProperty = "flexarmPlotTools";
+
+QString csvField(QString s) {
+  s.replace('\n', ' ');
+  if (s.contains(',') || s.contains('"')) s = '"' + s.replace('"', "\"\"") + '"';
+  return s;
+}
+
+QString axisName(const QCPAxis* a) { return a ? QString(a->label()).replace('\n', ' ') : QString(); }
+
+}  // namespace
+
+PlotTools::PlotTools(QCustomPlot* plot) : QObject(plot), plot_(plot) {
+  plot->setProperty(kProperty, QVariant::fromValue<QObject*>(this));
+  connect(plot, &QCustomPlot::mouseDoubleClick, this, [this](QMouseEvent* e) {
+    if (e->button() == Qt::LeftButton) resetZoom();
+  });
+  plot->setContextMenuPolicy(Qt::CustomContextMenu);
+  connect(plot, &QWidget::customContextMenuRequested, this, [this](const QPoint& at) {
+    QMenu* menu = createMenu(plot_);
+    menu->setAttribute(Qt::WA_DeleteOnClose);
+    menu->popup(plot_->mapToGlobal(at));
+  });
+  if (plot->toolTip().isEmpty())
+    plot->setToolTip(tr("Wheel zooms, drag pans, double click resets the zoom; right click "
+                        "to export or copy the data"));
+}
+
+PlotTools* PlotTools::install(QCustomPlot* plot) {
+  if (PlotTools* t = of(plot)) return t;
+  return new PlotTools(plot);
+}
+
+PlotTools* PlotTools::of(const QCustomPlot* plot) {
+  return plot ? qobject_cast<PlotTools*>(plot->property(kProperty).value<QObject*>()) : nullptr;
+}
+
+void PlotTools::resetZoom() {
+  if (reset_) {
+    reset_();
+  } else {
+    for (QCPAxisRect* rect : plot_->axisRects())
+      for (QCPAxis* axis : rect->axes())
+        if (!axis->plottables().isEmpty()) axis->rescale(true);
+  }
+  plot_->replot();
+}
+
+void PlotTools::limitAxis(QCPAxis* axis, std::function<std::pair<double, double>()> limits) {
+  if (!axis || !limits) return;
+  connect(axis, QOverload<const QCPRange&>::of(&QCPAxis::rangeChanged), this,
+          [axis, limits](const QCPRange& r) {
+            const auto [lowest, highest] = limits();
+            if (!(highest > lowest)) return;
+            QCPRange fixed = r;
+            if (r.size() >= highest - lowest) {
+              fixed = QCPRange(lowest, highest);
+            } else if (r.lower < lowest) {
+              fixed = QCPRange(lowest, lowest + r.size());
+            } else if (r.upper > highest) {
+              fixed = QCPRange(highest - r.size(), highest);
+            }
+            if (fixed.lower != r.lower || fixed.upper != r.upper) axis->setRange(fixed);
+          });
+}
+
+void PlotTools::limitAxisToData(QCPAxis* axis) {
+  limitAxis(axis, [axis]() -> std::pair<double, double> {
+    bool any = false;
+    QCPRange span;
+    for (QCPAbstractPlottable* p : axis->plottables()) {
+      bool found = false;
+      const QCPRange r = p->keyAxis() == axis ? p->getKeyRange(found) : p->getValueRange(found);
+      if (!found) continue;
+      span = any ? QCPRange(std::min(span.lower, r.lower), std::max(span.upper, r.upper)) : r;
+      any = true;
+    }
+    return any ? std::pair{span.lower, span.upper} : std::pair{0.0, 0.0};
+  });
+}
+
+QMenu* PlotTools::createMenu(QWidget* parent) {
+  auto* menu = new QMenu(parent);
+  menu->setObjectName("plotContextMenu");
+  menu->addAction(tr("Reset zoom"), this, &PlotTools::resetZoom)->setObjectName("resetZoom");
+  menu->addSeparator();
+  menu->addAction(tr("Export image or data (PNG, SVG, PDF, CSV)..."), this, &PlotTools::exportDialog)
+      ->setObjectName("exportPlot");
+  menu->addAction(tr("Copy data"), this, &PlotTools::copyData)->setObjectName("copyData");
+  return menu;
+}
+
+QString PlotTools::dataAsCsv() const {
+  QString out;
+  QTextStream s(&out);
+  s << "series,x,y,x axis,y axis\n";
+  s.setRealNumberPrecision(10);
+  for (int i = 0; i < plot_->plottableCount(); ++i) {
+    QCPAbstractPlottable* p = plot_->plottable(i);
+    const QString name = csvField(p->name().isEmpty() ? tr("series %1").arg(i + 1) : p->name());
+    const QString axes = csvField(axisName(p->keyAxis())) + ',' + csvField(axisName(p->valueAxis()));
+    auto row = [&](double x, double y) {
+      if (std::isfinite(x) && std::isfinite(y)) s << name << ',' << x << ',' << y << ',' << axes << '\n';
+    };
+    if (auto* g = qobject_cast<QCPGraph*>(p)) {
+      for (const auto& d : *g->data()) row(d.key, d.value);
+    } else if (auto* c = qobject_cast<QCPCurve*>(p)) {
+      for (const auto& d : *c->data()) row(d.key, d.value);
+    } else if (auto* b = qobject_cast<QCPBars*>(p)) {
+      for (const auto& d : *b->data()) row(d.key, d.value);
+    }
+  }
+  return out;
+}
+
+bool PlotTools::exportTo(const QString& path, QString* why) const {
+  const QString ext = QFileInfo(path).suffix().toLower();
+  const int w = std::max(plot_->width(), 800), h = std::max(plot_->height(), 600);
+  bool ok = false;
+  if (ext == "png") {
+    ok = plot_->savePng(path, w, h);
+  } else if (ext == "pdf") {
+    ok = plot_->savePdf(path, w, h);
+  } else if (ext == "svg") {
+    QSvgGenerator svg;
+    svg.setFileName(path);
+    svg.setSize(QSize(w, h));
+    svg.setViewBox(QRect(0, 0, w, h));
+    svg.setTitle("FlexArm plot");
+    QCPPainter painter;
+    ok = painter.begin(&svg);
+    if (ok) {
+      plot_->toPainter(&painter, w, h);
+      painter.end();
+    }
+  } else if (ext == "csv") {
+    QFile f(path);
+    ok = f.open(QIODevice::WriteOnly | QIODevice::Truncate | QIODevice::Text);
+    if (ok) ok = f.write(dataAsCsv().toUtf8()) >= 0;
+  } else {
+    if (why) *why = tr("unknown format '%1': use .png, .svg, .pdf or .csv").arg(ext);
+    return false;
+  }
+  if (!ok && why) *why = tr("could not write %1").arg(path);
+  return ok;
+}
+
+void PlotTools::exportDialog() {
+  QString selected;
+  const QString path = QFileDialog::getSaveFileName(
+      plot_, tr("Export plot"), plot_->objectName() + ".png",
+      tr("PNG image (*.png);;SVG drawing (*.svg);;PDF (*.pdf);;CSV data (*.csv)"), &selected);
+  if (path.isEmpty()) return;
+  QString why;
+  if (!exportTo(path, &why))
+    QMessageBox::warning(plot_, tr("Export failed"), why);
+}
+
+void PlotTools::copyData() const { QApplication::clipboard()->setText(dataAsCsv()); }
+
+void placeLegendAbove(QCustomPlot* plot, QCPAxisRect* rect) {
+  QCPLegend* legend = plot->legend;
+  if (!rect) rect = plot->axisRect();
+  if (!legend || !rect) return;
+  if (auto* inset = qobject_cast<QCPLayoutInset*>(legend->layout())) inset->take(legend);
+  if (auto* grid = qobject_cast<QCPLayoutGrid*>(legend->layout())) {
+    grid->take(legend);
+    grid->simplify();
+  }
+  QCPLayoutGrid* layout = plot->plotLayout();
+  int row = -1, column = 0;
+  for (int r = 0; r < layout->rowCount() && row < 0; ++r)
+    for (int c = 0; c < layout->columnCount(); ++c)
+      if (layout->element(r, c) == rect) {
+        row = r;
+        column = c;
+        break;
+      }
+  if (row < 0) return;
+  layout->insertRow(row);
+  layout->addElement(row, column, legend);
+  layout->setRowStretchFactor(row, 0.001);
+  legend->setFillOrder(QCPLayoutGrid::foColumnsFirst);
+  legend->setWrap(4);
+  legend->setMargins(QMargins(4, 2, 4, 2));
+  legend->setMinimumMargins(QMargins(0, 0, 0, 0));
+  legend->setBorderPen(Qt::NoPen);
+  legend->setBrush(Qt::NoBrush);
+  legend->setMaximumSize(QWIDGETSIZE_MAX, QWIDGETSIZE_MAX);
+}
+
+}  // namespace flexarm
