@@ -44,6 +44,8 @@ class MainWindow : public QMainWindow {
   void openFile(const QString& path);
   void openFile(const QString& path, const LogReadOptions& options);
   bool isOpening() const { return reader_.isRunning(); }
+  // Reading a log, a session or a report, or a panel still computing in the background.
+  bool isBusy() const;
 
   Workspace* workspace() const { return workspace_; }
   LogPanel* logPanel() const { return logPanel_; }
@@ -118,7 +120,12 @@ class MainWindow : public QMainWindow {
   QDockWidget* recursiveDock_ = nullptr;
   QMenu* recentMenu_ = nullptr;
   QMenu* viewMenu_ = nullptr;
-  QFutureWatcher<LogReadResult> reader_;
+  // A log read in the background with its file's SHA-256 (empty when it could not be formed).
+  struct ReadLog {
+    LogReadResult result;
+    std::string sha256;
+  };
+  QFutureWatcher<ReadLog> reader_;
   QProgressDialog* progress_ = nullptr;
   QString readingPath_;
   LogReadOptions readingOptions_;
