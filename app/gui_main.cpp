@@ -5,6 +5,7 @@
 #include <iostream>
 
 #include "app/main_window.h"
+#include "app/session_controller.h"
 #include "widgets/arm/vtk_view.h"
 
 namespace flexarm {
@@ -17,6 +18,8 @@ int runGui(int argc, char** argv, const std::string& log, const std::string& scr
   QApplication::setApplicationName("FlexArm");
   QApplication::setApplicationVersion(FLEXARM_VERSION);
   MainWindow window;
+  // A screenshot run asks nothing at start (the recovery question is queued, not yet shown).
+  if (!screenshot.empty()) window.sessionController()->setOfferRecovery(false);
   window.show();
   int code = 0;
   if (!screenshot.empty()) {

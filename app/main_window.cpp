@@ -35,6 +35,7 @@
 #include "app/recent_files.h"
 #include "app/session_controller.h"
 #include "core/io/ranges.h"
+#include "core/session/sha256.h"
 #include "core/models/physical_models.h"
 #include "widgets/arm_panel.h"
 #include "widgets/bode_panel.h"
@@ -199,7 +200,7 @@ MainWindow::MainWindow(QWidget* parent)
   rebuildRecentMenu();
   statusBar()->showMessage(tr("Open a robot log with Ctrl+O, or drop it on the window"));
 
-  connect(&reader_, &QFutureWatcher<LogReadResult>::finished, this, &MainWindow::onReadFinished);
+  connect(&reader_, &QFutureWatcher<ReadLog>::finished, this, &MainWindow::onReadFinished);
   connect(workspace_, &Workspace::rangesChanged, this, [this] {
     QStringList parts;
     for (RangeKind k : {RangeKind::Estimation, RangeKind::Validation})
@@ -221,6 +222,11 @@ MainWindow::MainWindow(QWidget* parent)
 }
 
 MainWindow::~MainWindow() { reader_.waitForFinished(); }
+
+bool MainWindow::isBusy() const {
+  return reader_.isRunning() || session_->isBusy() || comparePanel_->isBusy() ||
+         residualsPanel_->isBusy() || bodePanel_->isBusy() || preprocessPanel_->isBusy();
+}
 
 void MainWindow::createMenus() {
   QMenu* file = menuBar()->addMenu(tr("&File"));
@@ -351,7 +357,12 @@ void MainWindow::openFile(const QString& path, const LogReadOptions& options) {
   progress_->reset();
   progress_->setRange(0, 0);
   const std::string p = path.toStdString();
-  reader_.setFuture(QtConcurrent::run([p, options] { return readLog(p, options); }));
+  reader_.setFuture(QtConcurrent::run([p, options] {
+    ReadLog r{readLog(p, options), {}};
+    // The checksum a session records, formed here rather than on the GUI thread.
+    if (r.result.ok) r.sha256 = sha256OfFile(p, nullptr).value_or("");
+    return r;
+  }));
 }
 
 void MainWindow::onReadFinished() {
@@ -360,7 +371,8 @@ void MainWindow::onReadFinished() {
     statusBar()->showMessage(tr("Opening %1 cancelled").arg(readingPath_), 5000);
     return;
   }
-  LogReadResult r = reader_.result();
+  ReadLog read = reader_.result();
+  LogReadResult& r = read.result;
   if (!r.ok && r.irregularTime && !readingOptions_.keepIrregularTime) {
     offerResampling(QString::fromStdString(r.error.toString()));
     return;
@@ -389,10 +401,13 @@ void MainWindow::onReadFinished() {
     emit openFailed(msg);
     return;
   }
-  const double seconds = (QDateTime::currentMSecsSinceEpoch() - readStartMs_) / 1000.0;
   const std::size_t samples = r.data.samples(), channels = r.data.channels.size();
   const double rate = r.data.sampleRateHz();
+  session_->setLogChecksum(read.sha256);
   workspace_->setLog(std::move(r.data), readingPath_, readingOptions_);
+  // The time from the request to the log shown in the Log panel (reading, checking and
+  // drawing); the panels that simulate models on it go on in the background.
+  const double seconds = (QDateTime::currentMSecsSinceEpoch() - readStartMs_) / 1000.0;
   addRecent(readingPath_);
   QSettings().setValue("lastDir", QFileInfo(readingPath_).absolutePath());
   setWindowTitle(QString("FlexArm - %1[*]").arg(QFileInfo(readingPath_).fileName()));

@@ -47,6 +47,8 @@ class MainWindow : public QMainWindow {
   // Opens a log as File -> Open, a recent file or a drop does: with unsaved changes it first
   // asks Save / Discard / Cancel (SessionController::confirmReplace); Cancel keeps everything.
   void requestOpenFile(const QString& path);
+  // Reading a log, a session or a report, or a panel still computing in the background.
+  bool isBusy() const;
 
   Workspace* workspace() const { return workspace_; }
   LogPanel* logPanel() const { return logPanel_; }
@@ -123,7 +125,12 @@ class MainWindow : public QMainWindow {
   QDockWidget* recursiveDock_ = nullptr;
   QMenu* recentMenu_ = nullptr;
   QMenu* viewMenu_ = nullptr;
-  QFutureWatcher<LogReadResult> reader_;
+  // A log read in the background with its file's SHA-256 (empty when it could not be formed).
+  struct ReadLog {
+    LogReadResult result;
+    std::string sha256;
+  };
+  QFutureWatcher<ReadLog> reader_;
   QProgressDialog* progress_ = nullptr;
   QString readingPath_;
   LogReadOptions readingOptions_;

@@ -49,7 +49,10 @@ SessionController::SessionController(MainWindow* window, Workspace* workspace)
   connect(workspace_, &Workspace::logChanged, this, [this] {
     if (restoring_) return;
     std::string why;
-    logSha256_ = sha256OfFile(workspace_->logPath().toStdString(), &why).value_or("");
+    logSha256_ = !pendingSha256_.empty()
+                     ? pendingSha256_
+                     : sha256OfFile(workspace_->logPath().toStdString(), &why).value_or("");
+    pendingSha256_.clear();
     workspace_->setLogSha256(logSha256_);
     loaded_ = Session{};  // a log opened by hand starts a new session
     path_.clear();
@@ -79,7 +82,9 @@ SessionController::SessionController(MainWindow* window, Workspace* workspace)
   connect(autosaveTimer_, &QTimer::timeout, this, &SessionController::autosave);
   autosaveTimer_->start();
   // A window closed normally leaves no autosave behind; one found on start means a crash.
-  connect(qApp, &QCoreApplication::aboutToQuit, this, [this] { QFile::remove(autosavePath()); });
+  connect(qApp, &QCoreApplication::aboutToQuit, this, [this] {
+    if (offerRecovery_) QFile::remove(autosavePath());
+  });
   QTimer::singleShot(0, this, &SessionController::offerRecovery);
 }
 
@@ -87,7 +92,7 @@ SessionController::~SessionController() {
   opener_.waitForFinished();
   replayer_.waitForFinished();
   writer_.waitForFinished();
-  QFile::remove(autosavePath());  // a normal end; only a crash leaves the autosave behind
+  if (offerRecovery_) QFile::remove(autosavePath());  // a normal end; only a crash leaves it
 }
 
 void SessionController::addMenuActions() {
@@ -334,11 +339,51 @@ void SessionController::exportReport(const QString& path) {
   const Session s = capture(path_);
   const std::string sp = path_.toStdString();
   window_->statusBar()->showMessage(tr("Computing the report..."));
-  replayer_.setFuture(QtConcurrent::run([s, sp] { return replaySession(s, sp); }));
+  reportPermille_ = std::make_shared<std::atomic<int>>(0);
+  reportAbort_ = std::make_shared<std::atomic<bool>>(false);
+  if (!reportProgress_) {
+    reportProgress_ = new QProgressDialog(window_);
+    reportProgress_->setObjectName("reportProgress");
+    reportProgress_->setWindowTitle(tr("Export report"));
+    reportProgress_->setRange(0, 1000);
+    reportProgress_->setMinimumDuration(300);
+    reportProgress_->setAutoClose(false);
+    reportProgress_->setAutoReset(false);
+    connect(reportProgress_, &QProgressDialog::canceled, this, &SessionController::cancelReport);
+    reportPoll_ = new QTimer(this);
+    reportPoll_->setInterval(100);
+    connect(reportPoll_, &QTimer::timeout, this, [this] {
+      if (reportPermille_) reportProgress_->setValue(reportPermille_->load());
+    });
+  }
+  reportProgress_->reset();
+  reportProgress_->setLabelText(tr("Computing the report %1").arg(QFileInfo(path).fileName()));
+  reportProgress_->setValue(0);
+  reportPoll_->start();
+  ReplayOptions options;
+  options.progress = [permille = reportPermille_, abort = reportAbort_](double f, const std::string&) {
+    permille->store(static_cast<int>(1000.0 * std::clamp(f, 0.0, 1.0)));
+    return abort->load() ? ProgressAction::Abort : ProgressAction::Continue;
+  };
+  replayer_.setFuture(QtConcurrent::run([s, sp, options] { return replaySession(s, sp, options); }));
+}
+
+void SessionController::cancelReport() {
+  if (!reportAbort_ || !replayer_.isRunning()) return;
+  reportAbort_->store(true);
+  window_->statusBar()->showMessage(tr("Cancelling the report..."));
 }
 
 void SessionController::onReplayed() {
   ReplayResult r = replayer_.result();
+  reportPoll_->stop();
+  reportProgress_->hide();
+  if (r.termination == Termination::Cancelled || (reportAbort_ && reportAbort_->load())) {
+    // Cancelled, even when the replay ended before it saw the request: nothing is written.
+    window_->statusBar()->showMessage(tr("Report export cancelled: %1 not written").arg(reportPath_), 8000);
+    emit reportCancelled(reportPath_);
+    return;
+  }
   QString why;
   if (r.termination == Termination::Converged) {
     if (path_.isEmpty()) r.report.session = "unsaved session";
@@ -373,7 +418,7 @@ QString SessionController::autosavePath() const {
 }
 
 bool SessionController::autosave() {
-  if (!isDirty() || !workspace_->hasLog() || restoring_) return false;
+  if (!offerRecovery_ || !isDirty() || !workspace_->hasLog() || restoring_) return false;
   std::string why;
   return saveSession(capture(autosavePath()), autosavePath().toStdString(), &why);
 }
@@ -382,7 +427,7 @@ void SessionController::setAutosaveInterval(int ms) { autosaveTimer_->setInterva
 
 void SessionController::offerRecovery() {
   const QString path = autosavePath();
-  if (!QFile::exists(path)) return;
+  if (!offerRecovery_ || !QFile::exists(path)) return;
   auto* box = new QMessageBox(QMessageBox::Question, tr("Recover unsaved work?"),
                               tr("FlexArm did not close normally last time. Open the session "
                                  "saved automatically at %1?")

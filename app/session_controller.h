@@ -8,7 +8,9 @@
 #include <QObject>
 #include <QString>
 #include <QStringList>
+#include <atomic>
 #include <functional>
+#include <memory>
 
 #include "core/session/replay.h"
 #include "core/session/session.h"
@@ -40,9 +42,11 @@ class SessionController : public QObject {
   // openFailed (then the window is unchanged).
   void open(const QString& path);
   bool isBusy() const { return opener_.isRunning() || replayer_.isRunning() || writer_.isRunning(); }
-  // Replays the current state in the background and writes the report (.pdf or .html);
-  // emits reportExported or reportFailed.
+  // Replays the current state in the background, with progress and Cancel, and writes the
+  // report (.pdf or .html); emits reportExported, reportFailed or reportCancelled.
   void exportReport(const QString& path);
+  // Stops the report being computed: nothing is written (what Cancel in its progress does).
+  void cancelReport();
 
   QString sessionPath() const { return path_; }
   // The file of the session's log `name` (paths resolved against the session); empty when the
@@ -74,6 +78,14 @@ class SessionController : public QObject {
   // Writes the autosave file now when there is unsaved work; true when written.
   bool autosave();
   void setAutosaveInterval(int ms);
+  // Whether a start that finds an autosave asks to recover it, and the window autosaves
+  // (default). A window started to take a screenshot, or by a script, asks nothing and
+  // leaves the autosave alone: it may be another running instance's, and a question would
+  // hold the run up.
+  void setOfferRecovery(bool offer) { offerRecovery_ = offer; }
+  // The SHA-256 of the log about to be opened, formed where it was read (off the GUI thread);
+  // without it the checksum is formed when the log changes.
+  void setLogChecksum(const std::string& sha256) { pendingSha256_ = sha256; }
 
  signals:
   void sessionOpened(const QString& path);
@@ -81,6 +93,7 @@ class SessionController : public QObject {
   void sessionSaved(const QString& path);
   void reportExported(const QString& path);
   void reportFailed(const QString& message);
+  void reportCancelled(const QString& path);
   // After a start that found an autosave: the recovery question is showing.
   void recoveryOffered(const QString& autosavePath);
   // After a log was opened with estimates of other data in the list: the offer is showing.
@@ -115,9 +128,11 @@ class SessionController : public QObject {
   bool recovering_ = false;
   bool restoring_ = false;
   bool dirty_ = false;        // changes outside the undo stack (a panel's new result)
+  bool offerRecovery_ = true;
   std::function<ReplaceDecision(const QString&)> decide_;
   QList<QString> recomputeQueue_;  // names of estimates still to recompute
   std::string logSha256_;    // of the log when it was opened
+  std::string pendingSha256_;  // of the log being opened, from its reader
   Session loaded_;           // the last opened session (its extra logs and parts are kept)
   Session opened_;           // the session being restored (its parts read its logs)
   QMenu* recentMenu_ = nullptr;
@@ -127,6 +142,11 @@ class SessionController : public QObject {
   QFutureWatcher<Opened> opener_;
   QFutureWatcher<ReplayResult> replayer_;
   QFutureWatcher<QString> writer_;  // HTML encoding and writing
+  // The report's replay: its progress (per mille, from the worker) and its cancel flag.
+  std::shared_ptr<std::atomic<int>> reportPermille_;
+  std::shared_ptr<std::atomic<bool>> reportAbort_;
+  QProgressDialog* reportProgress_ = nullptr;
+  QTimer* reportPoll_ = nullptr;
 };
 
 }  // namespace flexarm

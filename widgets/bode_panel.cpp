@@ -13,6 +13,7 @@
 #include <cmath>
 
 #include "core/ident/nonparametric.h"
+#include "widgets/background_refresh.h"
 #include "widgets/ident_data.h"
 #include "widgets/plots/bode_plot.h"
 
@@ -56,7 +57,7 @@ BodePanel::BodePanel(Workspace* workspace, QWidget* parent)
       level_(new PercentSpinBox(this)), spa_(new QCheckBox(tr("SPA"), this)),
       etfe_(new QCheckBox(tr("ETFE"), this)), window_(new QSpinBox(this)),
       export_(new QPushButton(tr("Export..."), this)), plot_(new BodePlot(this)),
-      note_(new QLabel(this)) {
+      note_(new QLabel(this)), worker_(new BackgroundRefresh(this)) {
   setObjectName("bodePanel");
   models_->setObjectName("bodeModelList");
   models_->setMaximumWidth(220);
@@ -140,79 +141,110 @@ bool BodePanel::curveHasBand(int curve) const {
 
 QString BodePanel::noteText() const { return note_->text(); }
 
-void BodePanel::refresh() {
-  if (filling_) return;
-  plot_->clear();
-  names_.clear();
-  bands_.clear();
-  QStringList notes;
+bool BodePanel::isBusy() const { return worker_->isBusy(); }
+
+namespace {
+
+struct BodeChoices {
+  std::vector<bool> checked;
+  double level = 0.99;
+  int window = 100;
+  bool spa = false, etfe = false;
+};
+
+// The curves of the checked models and the nonparametric estimates with the notes to show:
+// the work that grows with the log (SPA and ETFE on the estimation data).
+void bodeCurves(const WorkspaceSnapshot& snapshot, const std::vector<ModelEntry>& list,
+                const BodeChoices& c, std::vector<BodeCurve>& curves, QStringList& notes) {
   QString why;
-  const auto data = workspaceData(*workspace_, 1, true, &why);
+  const bool nonparametric = c.spa || c.etfe;
+  const auto data = workspaceData(snapshot, 1, true, &why);
   double wmin = 1.0, wmax = 2000.0;
   if (data) {
     wmin = std::max(2.0 * M_PI / (static_cast<double>(data->estimation.size()) * data->sampleTime), 0.5);
     wmax = M_PI / data->sampleTime;
   }
   const auto grid = logGrid(wmin, wmax, 800);
-  const double level = level_->value() / 100.0;
   int colour = 0;
-  auto add = [&](const BodeCurve& c) {
-    plot_->addCurve(c);
-    names_ << c.name;
-    bands_.push_back(!c.magnitudeLow.empty());
-  };
-  const auto& list = workspace_->models();
   for (std::size_t i = 0; i < list.size(); ++i) {
     const QColor color = kPalette[colour++ % 8];
-    if (!isModelChecked(models_, i)) continue;
+    if (!c.checked[i]) continue;
     try {
-      const FrequencyResponse fr = responseOf(list[i], grid, level);
-      if (!fr.omega.empty()) add(toCurve(list[i].name, color, fr));
+      const FrequencyResponse fr = responseOf(list[i], grid, c.level);
+      if (!fr.omega.empty()) curves.push_back(toCurve(list[i].name, color, fr));
     } catch (const std::exception& e) {
-      notes << tr("%1: %2").arg(list[i].name, QString::fromStdString(e.what()));
+      notes << QObject::tr("%1: %2").arg(list[i].name, QString::fromStdString(e.what()));
     }
   }
-  if ((spa_->isChecked() || etfe_->isChecked()) && !data) notes << why;
-  if (data && (spa_->isChecked() || etfe_->isChecked())) {
+  if (nonparametric && !data) notes << why;
+  if (data && nonparametric) {
     const auto b = static_cast<Eigen::Index>(data->estimation.begin);
     const auto n = static_cast<Eigen::Index>(data->estimation.size());
     const Eigen::VectorXd u = data->u.segment(b, n), y = data->y.segment(b, n);
     const auto pointsGrid = logGrid(wmin, wmax, 250);
     auto addPoints = [&](const QString& name, const QColor& color, const NonparametricEstimate& e) {
       if (e.termination != Termination::Converged) {
-        notes << tr("%1: %2").arg(name, QString::fromStdString(e.message));
+        notes << QObject::tr("%1: %2").arg(name, QString::fromStdString(e.message));
         return;
       }
-      if (e.omittedFrequencies > 0) notes << tr("%1: %2").arg(name, QString::fromStdString(e.message));
-      BodeCurve c = toCurve(name, color, e.response);
-      c.points = true;
-      c.magnitudeLow.clear();  // points only: the SPA region is drawn for models
-      c.magnitudeHigh.clear();
-      c.phaseLowDeg.clear();
-      c.phaseHighDeg.clear();
-      add(c);
+      if (e.omittedFrequencies > 0) notes << QObject::tr("%1: %2").arg(name, QString::fromStdString(e.message));
+      BodeCurve curve = toCurve(name, color, e.response);
+      curve.points = true;
+      curve.magnitudeLow.clear();  // points only: the SPA region is drawn for models
+      curve.magnitudeHigh.clear();
+      curve.phaseLowDeg.clear();
+      curve.phaseHighDeg.clear();
+      curves.push_back(std::move(curve));
     };
-    if (spa_->isChecked()) {
+    if (c.spa) {
       SpaOptions so;
-      so.windowWidth = window_->value();
+      so.windowWidth = c.window;
       so.omega = pointsGrid;
-      so.level = level;
-      addPoints(tr("SPA (M = %1)").arg(window_->value()), QColor(90, 90, 90), spa(u, y, data->sampleTime, so));
+      so.level = c.level;
+      addPoints(QObject::tr("SPA (M = %1)").arg(c.window), QColor(90, 90, 90), spa(u, y, data->sampleTime, so));
     }
-    if (etfe_->isChecked()) {
+    if (c.etfe) {
       EtfeOptions eo;
-      eo.smoothingWidth = std::max(1, window_->value() / 50);
+      eo.smoothingWidth = std::max(1, c.window / 50);
       eo.omega = pointsGrid;
-      addPoints(tr("ETFE"), QColor(180, 140, 20), etfe(u, y, data->sampleTime, eo));
+      addPoints(QObject::tr("ETFE"), QColor(180, 140, 20), etfe(u, y, data->sampleTime, eo));
     }
     if (data->closedLoop) notes << QString::fromUtf8(kClosedLoopBiasWarning);
   }
-  if (names_.isEmpty())
-    notes.prepend(tr("No curve: add a model (Model or Fit panel) or tick SPA/ETFE with a log open."));
+  if (curves.empty())
+    notes.prepend(QObject::tr("No curve: add a model (Model or Fit panel) or tick SPA/ETFE with a log open."));
   else
-    notes.prepend(tr("Bands: %1 % confidence (Gauss approximation).").arg(100.0 * level, 0, 'g', 4));
-  note_->setText(notes.join("\n"));
-  plot_->rescale();
+    notes.prepend(QObject::tr("Bands: %1 % confidence (Gauss approximation).").arg(100.0 * c.level, 0, 'g', 4));
+}
+
+}  // namespace
+
+void BodePanel::refresh() {
+  if (filling_) return;
+  BodeChoices c;
+  for (std::size_t i = 0; i < workspace_->models().size(); ++i) c.checked.push_back(isModelChecked(models_, i));
+  c.level = level_->value() / 100.0;  // the spin box shows percent
+  c.window = window_->value();
+  c.spa = spa_->isChecked();
+  c.etfe = etfe_->isChecked();
+  worker_->run([this, snapshot = snapshotOf(*workspace_), list = workspace_->models(),
+                c](const std::atomic<bool>&) -> BackgroundRefresh::Apply {
+    auto curves = std::make_shared<std::vector<BodeCurve>>();
+    auto notes = std::make_shared<QStringList>();
+    bodeCurves(snapshot, list, c, *curves, *notes);
+    return [this, curves, notes] {
+      plot_->clear();
+      names_.clear();
+      bands_.clear();
+      for (const BodeCurve& curve : *curves) {
+        plot_->addCurve(curve);
+        names_ << curve.name;
+        bands_.push_back(!curve.magnitudeLow.empty());
+      }
+      note_->setText(notes->join("\n"));
+      plot_->rescale();
+    };
+  });
 }
 
 bool BodePanel::exportTo(const QString& path, QString* why) const { return plot_->exportTo(path, why); }

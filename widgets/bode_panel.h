@@ -18,6 +18,8 @@ class QSpinBox;
 
 namespace flexarm {
 
+class BackgroundRefresh;
+
 class BodePlot;
 
 class BodePanel : public QWidget {
@@ -34,6 +36,8 @@ class BodePanel : public QWidget {
   QStringList curveNames() const { return names_; }
   bool curveHasBand(int curve) const;
   QString noteText() const;
+  // Computing in the background: the curves and notes still show the previous state.
+  bool isBusy() const;
   bool exportTo(const QString& path, QString* why = nullptr) const;
 
  public slots:
@@ -55,6 +59,7 @@ class BodePanel : public QWidget {
   QStringList names_;
   std::vector<bool> bands_;
   bool filling_ = false;
+  BackgroundRefresh* worker_;
 };
 
 }  // namespace flexarm

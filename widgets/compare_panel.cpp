@@ -6,11 +6,14 @@
 #include <QListWidget>
 #include <QSplitter>
 #include <QVBoxLayout>
+#include <algorithm>
 #include <cmath>
 #include <map>
 #include <qcustomplot.h>
 
+#include "widgets/background_refresh.h"
 #include "widgets/ident_data.h"
+#include "widgets/plots/envelope_graph.h"
 #include "widgets/plots/playhead_cursor.h"
 #include "widgets/plots/plot_tools.h"
 
@@ -18,14 +21,12 @@ namespace flexarm {
 namespace {
 const QColor kColors[] = {QColor(31, 119, 180), QColor(214, 39, 40), QColor(44, 160, 44),
                           QColor(148, 103, 189), QColor(255, 127, 14), QColor(23, 190, 207)};
-// At most this many points per curve are drawn (every k-th sample).
-constexpr std::size_t kMaxPoints = 6000;
 }  // namespace
 
 ComparePanel::ComparePanel(Workspace* workspace, QWidget* parent)
     : QWidget(parent), workspace_(workspace), models_(new QListWidget(this)),
       range_(new QComboBox(this)), plot_(new QCustomPlot(this)), fit_(new QLabel(this)),
-      cursor_(new PlayheadCursor(plot_, this)) {
+      cursor_(new PlayheadCursor(plot_, this)), worker_(new BackgroundRefresh(this)) {
   setObjectName("comparePanel");
   models_->setObjectName("compareModelList");
   models_->setMaximumWidth(220);
@@ -83,92 +84,166 @@ void ComparePanel::setRangeKind(RangeKind kind) {
 
 QString ComparePanel::fitText() const { return fit_->text(); }
 
-void ComparePanel::refresh() {
-  plot_->clearGraphs();
-  fits_.clear();
-  fitsNrmse_.clear();
-  const auto& list = workspace_->models();
+bool ComparePanel::isBusy() const { return worker_->isBusy(); }
+
+namespace {
+
+// One curve of the plot, computed in the background: its envelope over the range shown.
+struct Curve {
+  QString name;
+  QPen pen;
+  std::shared_ptr<const EnvelopePyramid> envelope;
+  double startTime = 0.0, sampleTime = 1.0;
+  double lo = 0.0, hi = 0.0;
+};
+
+}  // namespace
+
+struct CompareOutcome {
+  std::vector<double> fits, fitsNrmse;
+  bool velocity = false;  // the curves are the motor velocity
+  std::vector<Curve> curves;
+  QString text;
+};
+
+namespace {
+
+
+
+// Simulates every checked model on the snapshot's data and forms the fit (5.2) of each on
+// the range of `kind`: the whole of the work that grows with the log.
+CompareOutcome compareModels(const WorkspaceSnapshot& snapshot, const std::vector<ModelEntry>& list,
+                      const std::vector<bool>& checked, RangeKind kind,
+                      const std::atomic<bool>& stop) {
+  CompareOutcome out;
   // Models give the motor velocity (the fit pipeline's black-box estimates too, Section 5.2),
   // unless a physical model's output is the motor angle.
   bool velocity = false;
   for (std::size_t i = 0; i < list.size(); ++i)
-    if (isModelChecked(models_, i)) velocity = velocity || wantsVelocity(list[i]);
+    if (checked[i]) velocity = velocity || wantsVelocity(list[i]);
   // The data at each rate a model needs (black-box models at the rate they were estimated at).
   std::map<int, std::optional<PreparedData>> rates;
   QString why;
   auto at = [&](int factor) -> const std::optional<PreparedData>& {
     auto it = rates.find(factor);
-    if (it == rates.end()) it = rates.emplace(factor, workspaceData(*workspace_, factor, velocity, &why)).first;
+    if (it == rates.end()) it = rates.emplace(factor, workspaceData(snapshot, factor, velocity, &why)).first;
     return it->second;
   };
-  const auto kind = static_cast<RangeKind>(range_->currentData().toInt());
   auto rangeOf = [kind](const PreparedData& d) {
     const SampleRange r = kind == RangeKind::Validation ? d.validation : d.estimation;
     return r.empty() ? d.estimation : r;
   };
-  auto addGraph = [&](const PreparedData& d, const Eigen::VectorXd& v, const QString& name,
+  auto addCurve = [&](const PreparedData& d, const Eigen::VectorXd& v, const QString& name,
                       const QPen& pen) {
     const SampleRange r = rangeOf(d);
-    const std::size_t step = std::max<std::size_t>(1, r.size() / kMaxPoints);
-    QVector<double> t, y;
-    for (std::size_t i = r.begin; i < r.end; i += step) {
-      t.push_back(d.startTime + static_cast<double>(i) * d.sampleTime);
-      y.push_back(v[static_cast<Eigen::Index>(i)]);
+    std::vector<double> values(v.data() + r.begin, v.data() + r.end);
+    Curve c;
+    c.name = name;
+    c.pen = pen;
+    c.startTime = d.timeAt(r.begin);
+    c.sampleTime = d.sampleTime;
+    if (!values.empty()) {
+      const auto [lo, hi] = std::minmax_element(values.begin(), values.end());
+      c.lo = *lo;
+      c.hi = *hi;
     }
-    auto* g = plot_->addGraph();
-    g->setData(t, y, true);
-    g->setName(name);
-    g->setPen(pen);
+    c.envelope = std::make_shared<const EnvelopePyramid>(values);
+    out.curves.push_back(std::move(c));
   };
-  plot_->yAxis->setLabel(outputAxisLabel(*workspace_, velocity));
+  out.velocity = velocity;
   const auto& base = at(1);
   if (!base) {
-    fit_->setText(why);
-    plot_->replot();
-    return;
+    out.text = why;
+    return out;
   }
   const bool noValidation = kind == RangeKind::Validation && base->validation.empty();
   QStringList lines;
   int colour = 0;
-  for (std::size_t i = 0; i < list.size(); ++i) {
+  for (std::size_t i = 0; i < list.size() && !stop.load(); ++i) {
     const QColor color = kColors[colour++ % 6];
-    if (!isModelChecked(models_, i)) continue;
+    if (!checked[i]) continue;
     QString reason;
     std::optional<Eigen::VectorXd> sim;
     const int factor = decimationFor(list[i], base->sampleTime);
     const auto& data = factor > 0 ? at(factor) : base;
     try {
       if (factor == 0)
-        reason = tr("its sample time is no multiple of the data's");
+        reason = QObject::tr("its sample time is no multiple of the data's");
       else if (data)
         sim = simulateEntry(list[i], data->u, data->sampleTime, &reason);
     } catch (const std::exception& e) {
       reason = QString::fromStdString(e.what());
     }
     if (!sim || !sim->allFinite()) {
-      fits_.push_back(std::nan(""));
-      fitsNrmse_.push_back(std::nan(""));
-      lines << tr("%1: not simulated (%2)").arg(list[i].name, reason.isEmpty() ? tr("unstable") : reason);
+      out.fits.push_back(std::nan(""));
+      out.fitsNrmse.push_back(std::nan(""));
+      lines << QObject::tr("%1: not simulated (%2)")
+                   .arg(list[i].name, reason.isEmpty() ? QObject::tr("unstable") : reason);
       continue;
     }
     const SampleRange r = rangeOf(*data);
     const FitPercents fit = fitPercents(data->y, *sim, static_cast<Eigen::Index>(r.begin),
                                         static_cast<Eigen::Index>(r.end));
-    fits_.push_back(fit.seed52);
-    fitsNrmse_.push_back(fit.nrmse);
-    addGraph(*data, *sim, tr("%1: %2 % (5.2)").arg(list[i].name).arg(fit.seed52, 0, 'f', 1), QPen(color, 1.2));
-    lines << tr("%1: fit %2 % (5.2), %3 % NRMSE%4").arg(list[i].name).arg(fit.seed52, 0, 'f', 1)
+    out.fits.push_back(fit.seed52);
+    out.fitsNrmse.push_back(fit.nrmse);
+    addCurve(*data, *sim, QObject::tr("%1: %2 % (5.2)").arg(list[i].name).arg(fit.seed52, 0, 'f', 1),
+             QPen(color, 1.2));
+    lines << QObject::tr("%1: fit %2 % (5.2), %3 % NRMSE%4").arg(list[i].name).arg(fit.seed52, 0, 'f', 1)
                  .arg(fit.nrmse, 0, 'f', 1)
-                 .arg(factor > 1 ? tr(" (at %1 Hz)").arg(1.0 / data->sampleTime, 0, 'g', 4) : QString());
+                 .arg(factor > 1 ? QObject::tr(" (at %1 Hz)").arg(1.0 / data->sampleTime, 0, 'g', 4) : QString());
   }
-  addGraph(*base, base->y, tr("measured"), QPen(QColor(20, 20, 20), 1.0));  // on top
-  lines.prepend(tr("Fit of the simulated output on the %1 data (%2), as the seed's (5.2) "
-                    "1 - sum e^2/sum (y - mean y)^2 and as MATLAB compare's NRMSE 1 - |e|/|y - mean y|:")
-                    .arg(noValidation ? tr("estimation (no validation range set)")
-                                      : kind == RangeKind::Validation ? tr("validation") : tr("estimation"),
+  addCurve(*base, base->y, QObject::tr("measured"), QPen(QColor(20, 20, 20), 1.0));  // on top
+  lines.prepend(QObject::tr("Fit of the simulated output on the %1 data (%2), as the seed's (5.2) "
+                            "1 - sum e^2/sum (y - mean y)^2 and as MATLAB compare's NRMSE 1 - |e|/|y - mean y|:")
+                    .arg(noValidation ? QObject::tr("estimation (no validation range set)")
+                                      : kind == RangeKind::Validation ? QObject::tr("validation")
+                                                                      : QObject::tr("estimation"),
                          QString::fromStdString(base->note())));
-  fit_->setText(lines.join("\n"));
-  plot_->rescaleAxes();
+  out.text = lines.join("\n");
+  return out;
+}
+
+}  // namespace
+
+void ComparePanel::refresh() {
+  std::vector<bool> checked;
+  for (std::size_t i = 0; i < workspace_->models().size(); ++i) checked.push_back(isModelChecked(models_, i));
+  const auto kind = static_cast<RangeKind>(range_->currentData().toInt());
+  fit_->setText(tr("Simulating..."));
+  worker_->run([this, snapshot = snapshotOf(*workspace_), list = workspace_->models(), checked,
+                kind](const std::atomic<bool>& stop) -> BackgroundRefresh::Apply {
+    auto out = std::make_shared<CompareOutcome>(compareModels(snapshot, list, checked, kind, stop));
+    return [this, out] { showOutcome(*out); };
+  });
+}
+
+void ComparePanel::showOutcome(const CompareOutcome& out) {
+  plot_->clearGraphs();
+  fits_ = out.fits;
+  fitsNrmse_ = out.fitsNrmse;
+  plot_->yAxis->setLabel(outputAxisLabel(*workspace_, out.velocity));
+  fit_->setText(out.text);
+  double t0 = HUGE_VAL, t1 = -HUGE_VAL, lo = HUGE_VAL, hi = -HUGE_VAL;
+  for (const Curve& c : out.curves) {
+    auto* g = plot_->addGraph();
+    g->setName(c.name);
+    g->setPen(c.pen);
+    if (c.envelope->size() == 0) continue;
+    t0 = std::min(t0, c.startTime);
+    t1 = std::max(t1, c.startTime + static_cast<double>(c.envelope->size() - 1) * c.sampleTime);
+    lo = std::min(lo, c.lo);
+    hi = std::max(hi, c.hi);
+  }
+  if (t1 > t0) plot_->xAxis->setRange(t0, t1);
+  if (hi >= lo) {
+    const double pad = std::max(1e-12, 0.05 * (hi - lo));
+    plot_->yAxis->setRange(lo - pad, hi + pad);
+  }
+  // After the range is set, so each curve takes only the points of its visible range.
+  for (std::size_t i = 0; i < out.curves.size(); ++i) {
+    const Curve& c = out.curves[i];
+    new EnvelopeGraph(plot_->graph(static_cast<int>(i)), c.envelope, c.startTime, c.sampleTime);
+  }
   plot_->replot();
 }
 

@@ -2,7 +2,8 @@
 // Compare panel: the measured output against the output simulated by several models of the
 // shared list on the validation range (or the estimation range), each with its fit % (5.2),
 // as the seed's Figure 5.11. Simulation starts at the log's first sample, so no start-up
-// transient enters the fit.
+// transient enters the fit. Simulating runs off the GUI thread; the curves are drawn through
+// their min/max envelope for the visible time range.
 #include <QWidget>
 #include <vector>
 
@@ -16,6 +17,8 @@ class QListWidget;
 namespace flexarm {
 
 class Playhead;
+class BackgroundRefresh;
+struct CompareOutcome;  // what simulating the models gave (compare_panel.cpp)
 class PlayheadCursor;
 
 class ComparePanel : public QWidget {
@@ -34,12 +37,15 @@ class ComparePanel : public QWidget {
   // Shows the window's playhead in the plot; a click there moves it.
   void setPlayhead(Playhead* playhead);
   PlayheadCursor* playheadCursor() const { return cursor_; }
+  // Simulating in the background: fits() and the plot still show the previous state.
+  bool isBusy() const;
 
  public slots:
   void refresh();
 
  private:
   void refillList();
+  void showOutcome(const CompareOutcome& out);
 
   Workspace* workspace_;
   QListWidget* models_;
@@ -48,6 +54,7 @@ class ComparePanel : public QWidget {
   QLabel* fit_;
   PlayheadCursor* cursor_;
   std::vector<double> fits_, fitsNrmse_;
+  BackgroundRefresh* worker_;
 };
 
 }  // namespace flexarm

@@ -34,8 +34,8 @@ bool isModelChecked(const QListWidget* list, std::size_t index) {
 void useWorkspaceData(const Workspace& workspace, FitOptions& options) {
   options.estimation.clear();
   options.validation.clear();
-  if (!workspace.current()) return;
-  auto data = std::make_shared<const IdData>(*workspace.current());
+  auto data = workspace.currentShared();  // shared, not copied on the GUI thread
+  if (!data) return;
   auto seconds = [&workspace](RangeKind kind) -> std::optional<SecondsRange> {
     const auto r = workspace.range(kind);
     if (!r) return std::nullopt;
@@ -56,9 +56,19 @@ QString outputAxisLabel(const Workspace& workspace, bool velocityOutput) {
   return unit.isEmpty() ? name : QString("%1 [%2]").arg(name, unit);
 }
 
+WorkspaceSnapshot snapshotOf(const Workspace& workspace) {
+  return {workspace.currentShared(), workspace.range(RangeKind::Estimation),
+          workspace.range(RangeKind::Validation)};
+}
+
 std::optional<PreparedData> workspaceData(const Workspace& workspace, int decimation, bool velocityOutput,
                                           QString* why) {
-  const IdData* current = workspace.current();
+  return workspaceData(snapshotOf(workspace), decimation, velocityOutput, why);
+}
+
+std::optional<PreparedData> workspaceData(const WorkspaceSnapshot& snapshot, int decimation,
+                                          bool velocityOutput, QString* why) {
+  const IdData* current = snapshot.data.get();
   if (!current || !current->input() || !current->output()) {
     if (why) *why = QObject::tr("Open a log with an input and an output channel first.");
     return std::nullopt;
@@ -66,8 +76,8 @@ std::optional<PreparedData> workspaceData(const Workspace& workspace, int decima
   FitDataOptions o;
   o.decimation = decimation;
   o.velocityOutput = velocityOutput;
-  if (const auto r = workspace.range(RangeKind::Estimation)) o.estimation = SecondsRange{r->start, r->end};
-  if (const auto r = workspace.range(RangeKind::Validation)) o.validation = SecondsRange{r->start, r->end};
+  if (const auto& r = snapshot.estimation) o.estimation = SecondsRange{r->start, r->end};
+  if (const auto& r = snapshot.validation) o.validation = SecondsRange{r->start, r->end};
   std::string reason;
   if (!o.isValid(&reason)) {
     if (why) *why = QString::fromStdString(reason);

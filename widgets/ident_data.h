@@ -24,6 +24,14 @@ std::shared_ptr<PhysicalModel> clonePhysical(const ParametricModel& model);
 void fillModelChecklist(QListWidget* list, const std::vector<ModelEntry>& models);
 bool isModelChecked(const QListWidget* list, std::size_t index);
 
+// What the identification panels read from the workspace, taken on the GUI thread so that
+// work in the background sees it unchanged: the current data (shared) and the ranges.
+struct WorkspaceSnapshot {
+  std::shared_ptr<const IdData> data;
+  std::optional<TimeRange> estimation, validation;
+};
+WorkspaceSnapshot snapshotOf(const Workspace& workspace);
+
 // The workspace's current data prepared as the fit pipeline prepares them (prepareFitData,
 // core/ident/fit_data.h): the workspace's estimation and validation ranges, decimation behind
 // the anti-alias FIR when decimation > 1, the motor velocity from the motor angle when
@@ -31,6 +39,9 @@ bool isModelChecked(const QListWidget* list, std::size_t index);
 // 5.2). nullopt with a sentence in why when there are no usable data.
 std::optional<PreparedData> workspaceData(const Workspace& workspace, int decimation, bool velocityOutput,
                                           QString* why);
+// The same from a snapshot, on any thread.
+std::optional<PreparedData> workspaceData(const WorkspaceSnapshot& snapshot, int decimation,
+                                          bool velocityOutput, QString* why);
 
 // The quantity and unit the models' output is drawn in: the output channel's name and unit,
 // or its derivative ("d/dt motor_angle_rad [rad/s]") when the models give the velocity.

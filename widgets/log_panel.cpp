@@ -13,6 +13,7 @@
 #include <qcustomplot.h>
 
 #include "widgets/playhead.h"
+#include "widgets/plots/envelope_graph.h"
 #include "widgets/plots/playhead_cursor.h"
 #include "widgets/plots/plot_tools.h"
 
@@ -346,8 +347,8 @@ void LogPanel::refreshChannel(std::size_t c) {
   const std::size_t first = data->indexNear(r.lower) > 1 ? data->indexNear(r.lower) - 2 : 0;
   const std::size_t last = std::min(n, data->indexNear(r.upper) + 3);
   static thread_local std::vector<double> position, value;
-  envelopes_[c]->visiblePoints(first, last, static_cast<std::size_t>(2 * std::max(rects_[c]->width(), 800)),
-                               position, value);
+  envelopes_[c]->visiblePoints(first, last, envelopePointBudget(rects_[c]->width()), position, value);
+  setDenseDrawing(plot_->graph(static_cast<int>(c)), position.size() >= static_cast<std::size_t>(rects_[c]->width()));
   QVector<QCPGraphData> points(static_cast<int>(position.size()));
   for (std::size_t i = 0; i < position.size(); ++i)  // positions are sample indices
     points[static_cast<int>(i)] = QCPGraphData(data->timeAt(static_cast<std::size_t>(position[i])), value[i]);

@@ -11,6 +11,7 @@
 #include <QTableWidget>
 #include <QVBoxLayout>
 #include <QtConcurrent>
+#include <algorithm>
 #include <cctype>
 #include <cmath>
 #include <qcustomplot.h>
@@ -22,6 +23,7 @@
 #include "core/sim/log_simulation.h"
 #include "widgets/ident_data.h"
 #include "widgets/plots/bode_plot.h"
+#include "widgets/plots/envelope_graph.h"
 #include "widgets/plots/playhead_cursor.h"
 #include "widgets/plots/plot_tools.h"
 #include "widgets/plots/pole_zero_plot.h"
@@ -371,7 +373,7 @@ void ModelPanel::simulateAgainstLog() {
   if (current_ < 0 || !data || isSimulating()) return;
   if (!workspace_->models()[static_cast<std::size_t>(current_)].model) return;
   const ModelEntry entry = workspace_->models()[static_cast<std::size_t>(current_)];
-  auto log = std::make_shared<const IdData>(*data);
+  auto log = workspace_->currentShared();  // shared, not copied on the GUI thread
   simulate_->setEnabled(false);
   fit_->setText(tr("Simulating..."));
   simulation_.setFuture(QtConcurrent::run([entry, log]() {
@@ -384,9 +386,16 @@ void ModelPanel::simulateAgainstLog() {
         out.error = QString::fromStdString(text);
         return out;
       }
-      out.simulated = std::move(r.simulated);
-      out.measured = std::move(r.measured);
-      out.time = std::move(r.time);
+      out.startTime = r.time.empty() ? log->startTime : r.time.front();
+      out.sampleTime = log->sampleTime;
+      if (!r.measured.empty()) {
+        const auto [lo, hi] = std::minmax_element(r.measured.begin(), r.measured.end());
+        const auto [slo, shi] = std::minmax_element(r.simulated.begin(), r.simulated.end());
+        out.lo = std::min(*lo, *slo);
+        out.hi = std::max(*hi, *shi);
+      }
+      out.measured = std::make_shared<const EnvelopePyramid>(r.measured);
+      out.simulated = std::make_shared<const EnvelopePyramid>(r.simulated);
       out.fit = r.fitPercent;
     } catch (const std::exception& e) {
       out.error = QObject::tr("Simulation failed: %1").arg(QString::fromStdString(e.what()));
@@ -402,10 +411,17 @@ void ModelPanel::onSimulated() {
     fit_->setText(out.error);
     return;
   }
-  auto qv = [](const std::vector<double>& v) { return QVector<double>(v.begin(), v.end()); };
-  compare_->graph(0)->setData(qv(out.time), qv(out.measured), true);
-  compare_->graph(1)->setData(qv(out.time), qv(out.simulated), true);
-  compare_->rescaleAxes();
+  const std::size_t n = out.measured->size();
+  if (n > 1) compare_->xAxis->setRange(out.startTime, out.startTime + static_cast<double>(n - 1) * out.sampleTime);
+  const double pad = std::max(1e-12, 0.05 * (out.hi - out.lo));
+  compare_->yAxis->setRange(out.lo - pad, out.hi + pad);
+  // Each graph is fed from its envelope for the visible time range (the previous feed goes).
+  int g = 0;
+  for (const auto& envelope : {out.measured, out.simulated}) {
+    QCPGraph* graph = compare_->graph(g++);
+    qDeleteAll(graph->findChildren<EnvelopeGraph*>(Qt::FindDirectChildrenOnly));
+    new EnvelopeGraph(graph, envelope, out.startTime, out.sampleTime);
+  }
   compare_->replot();
   lastFit_ = out.fit;
   fit_->setText(tr("Fit %1 % (5.2), simulated from the log's torque reference")

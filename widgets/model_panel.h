@@ -8,6 +8,7 @@
 #include <QWidget>
 #include <vector>
 
+#include "core/signal/envelope.h"
 #include "widgets/workspace.h"
 
 class QComboBox;
@@ -49,7 +50,10 @@ class ModelPanel : public QWidget {
 
  private:
   struct SimOutcome {
-    std::vector<double> time, measured, simulated;
+    // The measured and simulated output as min/max envelopes (drawn for the visible range).
+    std::shared_ptr<const EnvelopePyramid> measured, simulated;
+    double startTime = 0.0, sampleTime = 1.0;
+    double lo = 0.0, hi = 0.0;  // of both curves
     double fit = 0.0;
     QString error;
   };

@@ -7,6 +7,7 @@
 #include <QVBoxLayout>
 #include <qcustomplot.h>
 
+#include "widgets/background_refresh.h"
 #include "widgets/ident_data.h"
 #include "widgets/plots/plot_tools.h"
 
@@ -57,7 +58,8 @@ void showCorrelation(QCustomPlot* p, const std::vector<int>& lags, const std::ve
 ResidualsPanel::ResidualsPanel(Workspace* workspace, QWidget* parent)
     : QWidget(parent), workspace_(workspace), model_(new QComboBox(this)),
       range_(new QComboBox(this)), lags_(new QSpinBox(this)), auto_(new QCustomPlot(this)),
-      cross_(new QCustomPlot(this)), verdict_(new QLabel(this)) {
+      cross_(new QCustomPlot(this)), verdict_(new QLabel(this)),
+      worker_(new BackgroundRefresh(this)) {
   setObjectName("residualsPanel");
   model_->setObjectName("residualsModelCombo");
   range_->setObjectName("residualsRangeCombo");
@@ -117,36 +119,28 @@ void ResidualsPanel::setRangeKind(RangeKind kind) {
 void ResidualsPanel::setMaxLag(int lags) { lags_->setValue(lags); }
 QString ResidualsPanel::verdictText() const { return verdict_->text(); }
 
-void ResidualsPanel::refresh() {
-  if (filling_) return;
-  analysis_ = ResidualAnalysis{};
-  for (QCustomPlot* p : {auto_, cross_}) {
-    p->clearPlottables();
-    p->clearItems();
-    p->replot();
-  }
-  const int index = model_->currentIndex();
-  const auto& list = workspace_->models();
-  if (index < 0 || index >= static_cast<int>(list.size())) {
-    verdict_->setText(tr("No model in the list yet."));
-    return;
-  }
-  const ModelEntry& entry = list[static_cast<std::size_t>(index)];
+bool ResidualsPanel::isBusy() const { return worker_->isBusy(); }
+
+namespace {
+
+// The correlation tests of one model on the snapshot's data: all the work that grows with
+// the log. Sets analysis (empty lags when there is none) and the sentence to show.
+void analyse(const WorkspaceSnapshot& snapshot, const ModelEntry& entry, RangeKind kind, int maxLag,
+             ResidualAnalysis& analysis, QString& text, double& sampleTime) {
   QString why;
-  const int factor = workspace_->current() ? decimationFor(entry, workspace_->current()->sampleTime) : 1;
+  const int factor = snapshot.data ? decimationFor(entry, snapshot.data->sampleTime) : 1;
   if (factor == 0) {
-    verdict_->setText(tr("%1: its sample time is no multiple of the data's.").arg(entry.name));
+    text = QObject::tr("%1: its sample time is no multiple of the data's.").arg(entry.name);
     return;
   }
-  const auto data = workspaceData(*workspace_, factor, wantsVelocity(entry), &why);
+  const auto data = workspaceData(snapshot, factor, wantsVelocity(entry), &why);
   if (!data) {
-    verdict_->setText(why);
+    text = why;
     return;
   }
-  const auto kind = static_cast<RangeKind>(range_->currentData().toInt());
   const SampleRange r = kind == RangeKind::Validation ? data->validation : data->estimation;
   if (r.empty()) {
-    verdict_->setText(tr("No validation range set: select one in the Log panel (V)."));
+    text = QObject::tr("No validation range set: select one in the Log panel (V).");
     return;
   }
   std::optional<Eigen::VectorXd> eps;
@@ -158,33 +152,73 @@ void ResidualsPanel::refresh() {
   const auto b = static_cast<Eigen::Index>(r.begin);
   const auto n = static_cast<Eigen::Index>(r.size());
   ResidualOptions o;
-  o.maxLag = lags_->value();
+  o.maxLag = maxLag;
   if (!eps || !eps->allFinite() || n < 2 * o.maxLag + 10) {
-    verdict_->setText(eps && eps->allFinite()
-                          ? tr("The range holds %1 samples; %2 lags need at least %3.")
-                                .arg(n).arg(o.maxLag).arg(2 * o.maxLag + 10)
-                          : tr("%1: no residuals (%2).").arg(entry.name, why.isEmpty() ? tr("unstable") : why));
+    text = eps && eps->allFinite()
+               ? QObject::tr("The range holds %1 samples; %2 lags need at least %3.")
+                     .arg(n).arg(o.maxLag).arg(2 * o.maxLag + 10)
+               : QObject::tr("%1: no residuals (%2).")
+                     .arg(entry.name, why.isEmpty() ? QObject::tr("unstable") : why);
     return;
   }
-  analysis_ = residualAnalysis(eps->segment(b, n), data->u.segment(b, n), o);
-  // Lags count samples of the data the model works at; the label gives their length.
-  const QString lagLabel = tr("lag [samples of %1 ms]").arg(data->sampleTime * 1000.0, 0, 'g', 4);
-  for (QCustomPlot* p : {auto_, cross_}) p->xAxis->setLabel(lagLabel);
-  showCorrelation(auto_, analysis_.lags, analysis_.autocorrelation, analysis_.autocorrelationBound, 1);
-  showCorrelation(cross_, analysis_.crossLags, analysis_.crossCorrelation, analysis_.crossCorrelationBound,
-       -o.maxLag);
-  verdict_->setText(
-      tr("%1 on the %2 data, %3 samples. Whiteness: %4 (statistic %5, 99 % threshold %6). "
-         "Independence from the input: %7 (statistic %8, threshold %9).\n%10")
-          .arg(entry.name, kind == RangeKind::Validation ? tr("validation") : tr("estimation"))
-          .arg(n)
-          .arg(analysis_.white ? tr("passed") : tr("failed"))
-          .arg(analysis_.whitenessStatistic, 0, 'g', 4)
-          .arg(analysis_.whitenessThreshold, 0, 'g', 4)
-          .arg(analysis_.independent ? tr("passed") : tr("failed"))
-          .arg(analysis_.independenceStatistic, 0, 'g', 4)
-          .arg(analysis_.independenceThreshold, 0, 'g', 4)
-          .arg(QString::fromStdString(analysis_.verdict)));
+  analysis = residualAnalysis(eps->segment(b, n), data->u.segment(b, n), o);
+  sampleTime = data->sampleTime;
+  text = QObject::tr("%1 on the %2 data, %3 samples. Whiteness: %4 (statistic %5, 99 % threshold %6). "
+                     "Independence from the input: %7 (statistic %8, threshold %9).\n%10")
+             .arg(entry.name, kind == RangeKind::Validation ? QObject::tr("validation")
+                                                            : QObject::tr("estimation"))
+             .arg(n)
+             .arg(analysis.white ? QObject::tr("passed") : QObject::tr("failed"))
+             .arg(analysis.whitenessStatistic, 0, 'g', 4)
+             .arg(analysis.whitenessThreshold, 0, 'g', 4)
+             .arg(analysis.independent ? QObject::tr("passed") : QObject::tr("failed"))
+             .arg(analysis.independenceStatistic, 0, 'g', 4)
+             .arg(analysis.independenceThreshold, 0, 'g', 4)
+             .arg(QString::fromStdString(analysis.verdict));
+}
+
+}  // namespace
+
+void ResidualsPanel::refresh() {
+  if (filling_) return;
+  const int index = model_->currentIndex();
+  const auto& list = workspace_->models();
+  if (index < 0 || index >= static_cast<int>(list.size())) {
+    worker_->cancel();
+    analysis_ = ResidualAnalysis{};
+    for (QCustomPlot* p : {auto_, cross_}) {
+      p->clearPlottables();
+      p->clearItems();
+      p->replot();
+    }
+    verdict_->setText(tr("No model in the list yet."));
+    return;
+  }
+  verdict_->setText(tr("Computing the residuals..."));
+  const auto kind = static_cast<RangeKind>(range_->currentData().toInt());
+  worker_->run([this, snapshot = snapshotOf(*workspace_), entry = list[static_cast<std::size_t>(index)],
+                kind, maxLag = lags_->value()](const std::atomic<bool>&) -> BackgroundRefresh::Apply {
+    auto analysis = std::make_shared<ResidualAnalysis>();
+    auto text = std::make_shared<QString>();
+    auto sampleTime = std::make_shared<double>(0.0);
+    analyse(snapshot, entry, kind, maxLag, *analysis, *text, *sampleTime);
+    return [this, analysis, text, sampleTime, maxLag] {
+      analysis_ = *analysis;
+      for (QCustomPlot* p : {auto_, cross_}) {
+        p->clearPlottables();
+        p->clearItems();
+        p->replot();
+      }
+      verdict_->setText(*text);
+      if (analysis_.lags.empty()) return;
+      // Lags count samples of the data the model works at; the label gives their length.
+      const QString lagLabel = tr("lag [samples of %1 ms]").arg(*sampleTime * 1000.0, 0, 'g', 4);
+      for (QCustomPlot* p : {auto_, cross_}) p->xAxis->setLabel(lagLabel);
+      showCorrelation(auto_, analysis_.lags, analysis_.autocorrelation, analysis_.autocorrelationBound, 1);
+      showCorrelation(cross_, analysis_.crossLags, analysis_.crossCorrelation,
+                      analysis_.crossCorrelationBound, -maxLag);
+    };
+  });
 }
 
 }  // namespace flexarm

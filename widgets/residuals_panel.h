@@ -2,7 +2,8 @@
 // Residuals panel: the correlation tests of a model from the shared list on the estimation
 // or validation data, as SITB's resid: autocorrelation of the residuals and their
 // cross-correlation with the input for lags up to M, each with its 99 % bounds, and the
-// verdicts of the whiteness and independence tests.
+// verdicts of the whiteness and independence tests. The residuals are computed off the GUI
+// thread.
 #include <QWidget>
 
 #include "core/ident/residuals.h"
@@ -14,6 +15,8 @@ class QLabel;
 class QSpinBox;
 
 namespace flexarm {
+
+class BackgroundRefresh;
 
 class ResidualsPanel : public QWidget {
   Q_OBJECT
@@ -28,6 +31,8 @@ class ResidualsPanel : public QWidget {
   QString verdictText() const;
   QCustomPlot* autoPlot() const { return auto_; }
   QCustomPlot* crossPlot() const { return cross_; }
+  // Computing in the background: analysis() and the plots still show the previous state.
+  bool isBusy() const;
 
  public slots:
   void refresh();
@@ -44,6 +49,7 @@ class ResidualsPanel : public QWidget {
   QLabel* verdict_;
   ResidualAnalysis analysis_;
   bool filling_ = false;
+  BackgroundRefresh* worker_;
 };
 
 }  // namespace flexarm

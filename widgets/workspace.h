@@ -69,6 +69,13 @@ class Workspace : public QObject {
   const IdData* current() const {
     return processed_ ? processed_.get() : raw_ && raw_->isUniform() ? raw_.get() : nullptr;
   }
+  // current() shared: the workspace never changes its data in place, so work off the GUI
+  // thread may go on reading them after the workspace moved on to other data.
+  std::shared_ptr<const IdData> currentShared() const {
+    if (processed_) return processed_;
+    if (raw_ && raw_->isUniform()) return raw_;
+    return nullptr;
+  }
   // What the Log panel draws: current(), or the raw log when it waits for resampling.
   const IdData* shown() const { return processed_ ? processed_.get() : raw_.get(); }
   // The raw log has irregular time stamps and no resampling has been applied yet.

@@ -54,6 +54,9 @@ class IdentificationTest : public QObject {
  private:
   MainWindow* window_ = nullptr;
 
+  // The Bode, Compare and Residuals panels compute in the background: waits for them.
+  void settle() { QTRY_VERIFY_WITH_TIMEOUT(!window_->isBusy(), 60000); }
+
   void showDock(const char* name) {
     auto* dock = window_->findChild<QDockWidget*>(name);
     QVERIFY(dock);
@@ -282,6 +285,7 @@ class IdentificationTest : public QObject {
     BodePanel* bode = window_->bodePanel();
     showDock("bodeDock");
     bode->setNonparametricShown(true, false);
+    settle();
     const QStringList names = bode->curveNames();
     const int n = static_cast<int>(window_->workspace()->models().size());
     QCOMPARE(names.size(), n + 1);  // every model and SPA
@@ -300,6 +304,7 @@ class IdentificationTest : public QObject {
     // Only the physical estimate: a lower level gives a narrower band.
     for (int i = 0; i < n; ++i) bode->setModelShown(i, i == physical);
     bode->setNonparametricShown(false, false);
+    settle();
     QCOMPARE(bode->curveNames().size(), 1);
     test::saveShot(bode->grab().toImage(), "bode_panel_three_mass_99");
     auto bandArea = [bode] {
@@ -315,10 +320,12 @@ class IdentificationTest : public QObject {
     };
     const double area99 = bandArea();
     bode->setLevel(0.5);
+    settle();
     const double area50 = bandArea();
     QVERIFY2(area99 > 0.0 && area50 < 0.5 * area99,
              qPrintable(QString("band area %1 at 99 %, %2 at 50 %").arg(area99).arg(area50)));
     bode->setLevel(0.99);
+    settle();
     QTemporaryDir dir;
     for (const char* ext : {"png", "pdf", "svg"}) {
       const QString path = dir.filePath(QString("bode.%1").arg(ext));
@@ -333,6 +340,7 @@ class IdentificationTest : public QObject {
     ComparePanel* cmp = window_->comparePanel();
     showDock("compareDock");
     cmp->setRangeKind(RangeKind::Validation);
+    settle();
     const auto fits = cmp->fits();
     QCOMPARE(static_cast<int>(fits.size()), static_cast<int>(window_->workspace()->models().size()));
     // The physical estimate simulates the validation part of the sweep well.
@@ -358,6 +366,7 @@ class IdentificationTest : public QObject {
     res->setRangeKind(RangeKind::Validation);
     res->setMaxLag(30);
     res->selectModel(static_cast<int>(window_->workspace()->models().size()) - 1);
+    settle();
     const ResidualAnalysis& a = res->analysis();
     QCOMPARE(static_cast<int>(a.lags.size()), 31);
     QCOMPARE(static_cast<int>(a.crossLags.size()), 61);

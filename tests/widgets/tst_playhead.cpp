@@ -155,6 +155,7 @@ class PlayheadTest : public QObject {
     e.name = "three-mass";
     e.model = std::shared_ptr<const PhysicalModel>(makeModel("three-mass"));
     window_->workspace()->addModel(e);
+    QTRY_VERIFY_WITH_TIMEOUT(!window_->isBusy(), 60000);  // Compare simulates in the background
   }
 
   void oneTimeMovesEveryPanel() {
