@@ -6,6 +6,7 @@
 #include "app/cli/cli.h"
 #include "app/cli/log_args.h"
 #include "core/discovery/discovery.h"
+#include "core/session/report.h"
 
 namespace flexarm::cli {
 namespace {
@@ -154,6 +155,14 @@ int runDiscover(const std::vector<std::string>& argv, std::ostream& out, std::os
     if (r.effect) {  // the augmented model as `flexarm fit` refines it
       out << "Refine: flexarm fit " << args.positional()[0] << " --model " << *modelName;
       for (const auto& e : r.augmentedEffects) out << " --effect " << toString(e);
+      // The refitted base as start values, so the fit starts where discovery ended.
+      if (r.augmentedModel)
+        for (const auto& p : r.augmentedModel->parameters()) {
+          if (!p.free) continue;
+          out << " --start " << p.name << "=" << formatSignificant(p.value, 8);
+          // A damping the base fit took below zero needs its default bound opened.
+          if (p.value < 0.0 && p.name.rfind("d_", 0) == 0) out << " --bound " << p.name << "=-inf:inf";
+        }
       out << "\n";
     }
     out << "Seconds: " << r.seconds << "\n";

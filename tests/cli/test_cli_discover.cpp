@@ -5,6 +5,7 @@
 #include <cmath>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <vector>
 
 #include "cli_test_support.h"
 
@@ -64,4 +65,39 @@ TEST(CliDiscover, UsageAndBadInputExitCodes) {
   EXPECT_EQ(r.code, 3);
   EXPECT_NE(r.err.find("non_numeric.csv:"), std::string::npos) << r.err;
   EXPECT_TRUE(r.out.empty()) << r.out;
+}
+
+// The "Refine:" line discovery prints is a command `flexarm fit` runs as given: the augmented
+// model (its effect and the refitted base as start values), fitted by the nonlinear grey-box
+// pipeline, which finds the ripple amplitude again within three standard deviations.
+TEST(CliDiscover, TheRefineLineIsAFitThatRuns) {
+  const auto d = runFlexarm({"discover", kRipple, "--model", "three-mass", "--effects",
+                             "coulomb_friction,torque_ripple"});
+  ASSERT_EQ(d.code, 0) << d.err;
+  const auto at = d.out.find("Refine: flexarm fit ");
+  ASSERT_NE(at, std::string::npos) << d.out;
+  const std::string line = d.out.substr(at + 20, d.out.find('\n', at) - at - 20);
+  std::vector<std::string> args{"fit"};
+  for (std::size_t b = 0, e = 0; b < line.size(); b = e + 1) {
+    e = line.find(' ', b);
+    if (e == std::string::npos) e = line.size();
+    if (e > b) args.push_back(line.substr(b, e - b));
+  }
+  EXPECT_NE(line.find("--start "), std::string::npos) << line;
+  args.push_back("--json");
+  const auto f = runFlexarm(args);
+  ASSERT_EQ(f.code, 0) << line << "\n" << f.err;
+  const json j = json::parse(f.out);
+  const auto truth = json::parse(
+      readAll(std::string(FLEXARM_SAMPLE_DIR) + "/effect_torque_ripple.truth.json"));
+  const double A = truth["effects"][0]["parameters"]["A"]["value"].get<double>();
+  bool found = false;
+  for (const auto& e : j["effects"]) {
+    if (e["name"] != "torque_ripple") continue;
+    if (!e["parameters"].contains("A")) continue;
+    found = true;
+    const auto& p = e["parameters"]["A"];
+    EXPECT_LE(std::abs(p["value"].get<double>() - A), 3.0 * p["std"].get<double>()) << p;
+  }
+  EXPECT_TRUE(found) << f.out;
 }
