@@ -259,21 +259,18 @@ void ModelPanel::refreshModel() {
 
   // Linear analysis of the model with the velocity output (structural effects applied).
   try {
-    ModelOptions velocity;
-    std::shared_ptr<PhysicalModel> linear = clonePhysical(m);
-    linear->setOptions(velocity);
-    StateSpace sys = linear->stateSpace();
-    for (const auto& e : entry.effects)
-      if (e.kind == EffectKind::ExtraMass) sys = NonlinearPlant(*linear, {e}).model().stateSpace();
+    const StateSpace sys = *analysedStateSpace(entry);
     const auto w = logGrid(1.0, 2000.0, 600);
     BodeCurve curve;
     curve.name = entry.name;
     curve.color = QColor(31, 119, 180);
     curve.frequency = w;
     curve.response = frequencyResponse(sys, w);
+    const NotchesPeaks np = notchesAndPeaks(sys);
+    curve.extrema = curveExtrema(np, [&](double x) { return std::abs(frequencyResponse(sys, {x}).front()); });
+    curve.extremaKnown = true;
     bode_->addCurve(curve);
     poleZero_->addSet(entry.name, QColor(31, 119, 180), poles(sys), zeros(sys));
-    const NotchesPeaks np = notchesAndPeaks(sys);
     frequencies_->setText(tr("Notches %1 rad/s; peaks %2 rad/s")
                               .arg(frequenciesText(np.notches))
                               .arg(frequenciesText(np.peaks)));
