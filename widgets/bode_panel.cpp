@@ -82,6 +82,7 @@ BodePanel::BodePanel(Workspace* workspace, QWidget* parent)
                          "N/10, SITB's min(N/10, 30) for slow data; the result says which); ETFE uses "
                          "M/50 bins of smoothing"));
   export_->setObjectName("bodeExportButton");
+  export_->setToolTip(tr("Save the Bode plot as PNG, PDF or SVG"));
   note_->setObjectName("bodeNote");
   note_->setWordWrap(true);
   note_->setMinimumHeight(4 * note_->fontMetrics().lineSpacing());
