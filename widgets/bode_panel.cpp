@@ -13,6 +13,7 @@
 #include <cmath>
 
 #include "core/ident/nonparametric.h"
+#include "core/models/analysis.h"
 #include "widgets/background_refresh.h"
 #include "widgets/ident_data.h"
 #include "widgets/plots/bode_plot.h"
@@ -81,6 +82,7 @@ BodePanel::BodePanel(Workspace* workspace, QWidget* parent)
                          "N/10, SITB's min(N/10, 30) for slow data; the result says which); ETFE uses "
                          "M/50 bins of smoothing"));
   export_->setObjectName("bodeExportButton");
+  export_->setToolTip(tr("Save the Bode plot as PNG, PDF or SVG"));
   note_->setObjectName("bodeNote");
   note_->setWordWrap(true);
   note_->setMinimumHeight(4 * note_->fontMetrics().lineSpacing());
@@ -171,7 +173,24 @@ void bodeCurves(const WorkspaceSnapshot& snapshot, const std::vector<ModelEntry>
     if (!c.checked[i]) continue;
     try {
       const FrequencyResponse fr = responseOf(list[i], grid, c.level);
-      if (!fr.omega.empty()) curves.push_back(toCurve(list[i].name, color, fr));
+      if (fr.omega.empty()) continue;
+      BodeCurve curve = toCurve(list[i].name, color, fr);
+      // A click reads the model's own notches and peaks, the numbers the Model panel prints
+      // (notchesAndPeaks on the exact response), not the nearest grid point.
+      auto magnitudeAt = [&](double w) {
+        const FrequencyResponse at = responseOf(list[i], {w}, c.level);
+        return at.value.empty() ? 0.0 : std::abs(at.value.front());
+      };
+      if (const auto sys = analysedStateSpace(list[i])) {
+        curve.extrema = curveExtrema(notchesAndPeaks(*sys), magnitudeAt);
+        curve.extremaKnown = true;
+      } else if (fr.omega.size() >= 3) {  // black box: its own response, refined exactly
+        std::vector<double> magnitude;
+        for (const auto& h : fr.value) magnitude.push_back(std::abs(h));
+        curve.extrema = curveExtrema(magnitudeExtrema(fr.omega, magnitude, 1.0, magnitudeAt), magnitudeAt);
+        curve.extremaKnown = true;
+      }
+      curves.push_back(std::move(curve));
     } catch (const std::exception& e) {
       notes << QObject::tr("%1: %2").arg(list[i].name, QString::fromStdString(e.what()));
     }

@@ -31,6 +31,7 @@ ComparePanel::ComparePanel(Workspace* workspace, QWidget* parent)
   models_->setObjectName("compareModelList");
   models_->setMaximumWidth(220);
   range_->setObjectName("compareRangeCombo");
+  range_->setToolTip(tr("Range the models are simulated on and the fit (5.2) computed over"));
   range_->addItem(tr("Validation range"), static_cast<int>(RangeKind::Validation));
   range_->addItem(tr("Estimation range"), static_cast<int>(RangeKind::Estimation));
   plot_->setObjectName("comparePlot");

@@ -70,12 +70,25 @@ DiagnosisPanel::DiagnosisPanel(Workspace* workspace, QWidget* parent)
   calibrate_->setToolTip(tr("Choose the thresholds by Monte-Carlo runs of the arm under this log's "
                             "conditions for 1 false alarm per hour (takes a minute)"));
   const char* names[] = {"classical", "robust", "CUSUM", "hypothesis"};
+  const char* tips[] = {
+      QT_TR_NOOP("Classical approach (Section 7.4.1): a fault when an estimate leaves theta_0 by "
+                 "more than a fixed threshold"),
+      QT_TR_NOOP("Adaptive threshold 3 sigma_i(t) from the estimate's variance (Section 7.4.1)"),
+      QT_TR_NOOP("CUSUM test (7.1) with drift nu = 3 sigma_i(t) and alarm level h"),
+      QT_TR_NOOP("Hypothesis tests and decision structure (Section 7.4.2): which fault explains "
+                 "the estimates, the table below")};
   for (int i = 0; i < 4; ++i) {
     tests_[i] = new QCheckBox(tr(names[i]), this);
     tests_[i]->setChecked(true);
+    tests_[i]->setToolTip(tr(tips[i]));
   }
   window_->addItem(tr("sliding 5 s"), 5.0);
   window_->addItem(tr("cumulative (seed)"), 0.0);
+  window_->setToolTip(tr("Data the estimates of the tests rest on: a sliding 5 s window, or all "
+                         "data since the start as the seed does (Section 7.5)"));
+  reference_->setToolTip(tr("Where the fault-free parameters theta_0 come from: the model, or a "
+                            "fit on a fault-free log"));
+  cancel_->setToolTip(tr("Stop the diagnosis; nothing is decided on a part of the log"));
   progress_->setRange(0, 1000);
   progress_->setVisible(false);
   cancel_->setVisible(false);

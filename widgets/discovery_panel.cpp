@@ -89,6 +89,8 @@ DiscoveryPanel::DiscoveryPanel(Workspace* workspace, QWidget* parent)
       overlayCursor_(new PlayheadCursor(overlay_, this)) {
   find_->setObjectName("findMissingEffect");
   add_->setObjectName("addToModel");
+  base_->setToolTip(tr("The model to extend: the effect missing from it is looked for"));
+  cancel_->setToolTip(tr("Stop the search; no effect is named from a part of it"));
   find_->setToolTip(tr("Fit the base model, map where it disagrees with the log, fit each "
                        "candidate effect and name the one that is significant"));
   add_->setToolTip(tr("Add the base model with the found effect to the model list (undoable)"));

@@ -64,6 +64,9 @@ FitPanel::FitPanel(Workspace* workspace, QWidget* parent)
       abort_(std::make_shared<std::atomic<bool>>(false)) {
   setObjectName("fitPanel");
   model_->setObjectName("fitModelCombo");
+  model_->setToolTip(tr("What to fit: a black box (4.8: ARX, ARMAX, OE, Box-Jenkins), a physical "
+                        "model of the shared list from its values, or a structure (5.1, 5.3) from "
+                        "its nominal values"));
   const char* orderNames[] = {"na", "nb", "nc", "nd", "nf", "nk"};
   QSpinBox* orders[] = {na_, nb_, nc_, nd_, nf_, nk_};
   const int defaults[] = {2, 4, 2, 2, 4, 1};
@@ -116,6 +119,9 @@ FitPanel::FitPanel(Workspace* workspace, QWidget* parent)
   noise_->setObjectName("noiseModelCombo");
   noise_->addItem(tr("Output error (K = 0)"), "output-error");
   noise_->addItem(tr("Innovations form (K estimated)"), "innovations");
+  noise_->setToolTip(tr("Output error: the model's simulation against the log (K = 0); "
+                        "innovations form: a Kalman gain K is estimated too and the one-step "
+                        "prediction error (4.5) is minimised (4.6)"));
   closedLoop_->setObjectName("closedLoopCombo");
   closedLoop_->addItem(tr("Auto: indirect when the controller is known or identified"), "auto");
   closedLoop_->addItem(tr("Two-stage: fit to the input part the reference explains"), "two-stage");
@@ -136,6 +142,7 @@ FitPanel::FitPanel(Workspace* workspace, QWidget* parent)
                          "notches and peaks match the SPA estimate"));
   iterations_->setRange(1, 1000);
   iterations_->setValue(100);
+  iterations_->setToolTip(tr("Most Gauss-Newton iterations of the prediction-error criterion (4.6)"));
 
   auto* form = new QFormLayout;
   form->addRow(tr("Model"), model_);
@@ -152,6 +159,9 @@ FitPanel::FitPanel(Workspace* workspace, QWidget* parent)
 
   estimate_->setObjectName("estimateButton");
   cancel_->setObjectName("fitCancelButton");
+  estimate_->setToolTip(tr("Fit the model to the estimation range by prediction error (4.6), with "
+                           "99 % intervals of the free parameters"));
+  cancel_->setToolTip(tr("Stop the fit; the model list stays as it was"));
   cancel_->setEnabled(false);
   progress_->setObjectName("fitProgress");
   progress_->setRange(0, 1000);
@@ -179,6 +189,8 @@ FitPanel::FitPanel(Workspace* workspace, QWidget* parent)
   studyRuns_->setRange(1, 100000);
   studyRuns_->setValue(1000);
   studyRuns_->setObjectName("studyRunsSpin");
+  studyRuns_->setToolTip(tr("Number of Monte-Carlo fits from random starts inside the domain of "
+                            "attraction (Section 5.3.3)"));
   study_button_->setObjectName("studyButton");
   study_button_->setEnabled(false);
   study_button_->setToolTip(tr("Domain of attraction of every free parameter by interval "

@@ -5,6 +5,7 @@
 
 #include "core/ident/nonparametric.h"
 #include "core/ident/pem.h"
+#include "core/models/nonlinear_plant.h"
 
 namespace flexarm {
 
@@ -132,6 +133,16 @@ FrequencyResponse responseOf(const ModelEntry& entry, const std::vector<double>&
                              double level) {
   return estimateResponse(entry.model.get(), entry.covariance, entry.covarianceIndices, entry.polynomial.get(),
                           omega, level);
+}
+
+std::optional<StateSpace> analysedStateSpace(const ModelEntry& entry) {
+  if (!entry.model) return std::nullopt;
+  std::shared_ptr<PhysicalModel> linear = clonePhysical(*entry.model);
+  linear->setOptions(ModelOptions{});  // motor velocity, the seed's (5.3) output
+  StateSpace sys = linear->stateSpace();
+  for (const auto& e : entry.effects)
+    if (e.kind == EffectKind::ExtraMass) sys = NonlinearPlant(*linear, {e}).model().stateSpace();
+  return sys;
 }
 
 }  // namespace flexarm

@@ -77,4 +77,9 @@ std::optional<Eigen::VectorXd> residualsOf(const ModelEntry& entry, const Eigen:
 FrequencyResponse responseOf(const ModelEntry& entry, const std::vector<double>& omega,
                              double level);
 
+// The linear model a physical entry's analysis looks at: motor velocity output with its
+// structural effects (an extra mass) applied. nullopt for a black-box entry. The Model panel
+// prints its notchesAndPeaks and the Bode panel's click reads the same values.
+std::optional<StateSpace> analysedStateSpace(const ModelEntry& entry);
+
 }  // namespace flexarm

@@ -57,10 +57,14 @@ ModelPanel::ModelPanel(Workspace* workspace, QWidget* parent)
   setObjectName("modelPanel");
   list_->setObjectName("modelList");
   structure_->setObjectName("structureCombo");
+  list_->setToolTip(tr("The model of the shared list shown and edited here"));
+  structure_->setToolTip(tr("Structure of a new model: rigid, two-mass (5.3) or three-mass (5.1), "
+                            "with the seed's Table 5.2 values"));
   for (const auto& s : modelStructureNames()) structure_->addItem(QString::fromStdString(s));
   structure_->setCurrentText("three-mass");
   auto* add = new QPushButton(tr("New model"), this);
   add->setObjectName("newModelButton");
+  add->setToolTip(tr("Add a model of the chosen structure to the shared list (undoable)"));
   auto* top = new QHBoxLayout;
   top->addWidget(new QLabel(tr("Model"), this));
   top->addWidget(list_, 1);
@@ -100,6 +104,8 @@ ModelPanel::ModelPanel(Workspace* workspace, QWidget* parent)
   frequencies_->setToolTip(tr(kNotchPeakDefinition));
   fit_->setObjectName("fitLabel");
   simulate_->setObjectName("simulateButton");
+  simulate_->setToolTip(tr("Simulate the model (ZOH, 5.3) on the open log's input and compare "
+                           "with its measured motor velocity (fit 5.2)"));
   compare_->setObjectName("comparePlot");
   compare_->setMinimumHeight(160);
   compare_->xAxis->setLabel(tr("time [s]"));
@@ -259,21 +265,18 @@ void ModelPanel::refreshModel() {
 
   // Linear analysis of the model with the velocity output (structural effects applied).
   try {
-    ModelOptions velocity;
-    std::shared_ptr<PhysicalModel> linear = clonePhysical(m);
-    linear->setOptions(velocity);
-    StateSpace sys = linear->stateSpace();
-    for (const auto& e : entry.effects)
-      if (e.kind == EffectKind::ExtraMass) sys = NonlinearPlant(*linear, {e}).model().stateSpace();
+    const StateSpace sys = *analysedStateSpace(entry);
     const auto w = logGrid(1.0, 2000.0, 600);
     BodeCurve curve;
     curve.name = entry.name;
     curve.color = QColor(31, 119, 180);
     curve.frequency = w;
     curve.response = frequencyResponse(sys, w);
+    const NotchesPeaks np = notchesAndPeaks(sys);
+    curve.extrema = curveExtrema(np, [&](double x) { return std::abs(frequencyResponse(sys, {x}).front()); });
+    curve.extremaKnown = true;
     bode_->addCurve(curve);
     poleZero_->addSet(entry.name, QColor(31, 119, 180), poles(sys), zeros(sys));
-    const NotchesPeaks np = notchesAndPeaks(sys);
     frequencies_->setText(tr("Notches %1 rad/s; peaks %2 rad/s")
                               .arg(frequenciesText(np.notches))
                               .arg(frequenciesText(np.peaks)));

@@ -64,6 +64,7 @@ PreprocessPanel::PreprocessPanel(Workspace* workspace, QWidget* parent)
                            "Nyquist frequency); required for a log whose time stamps jitter, skip, "
                            "repeat or run backwards"));
   rate_->setObjectName("resampleRateSpin");
+  rate_->setToolTip(tr("Sample rate after resampling [Hz]"));
   rate_->setRange(0.001, 1e6);
   rate_->setDecimals(3);
   rate_->setSuffix(" Hz");
@@ -86,6 +87,8 @@ PreprocessPanel::PreprocessPanel(Workspace* workspace, QWidget* parent)
   timing_->setMaximumHeight(150);
   differentiate_->setText(tr("Motor velocity from the angle (d/dt, becomes the output)"));
   differentiate_->setObjectName("differentiateCheck");
+  differentiate_->setToolTip(tr("The output becomes d/dt of the motor angle [rad/s], the motor "
+                                "velocity the models (5.3) predict"));
   factor_->setRange(1, 1000);
   factor_->setValue(10);
   factor_->setObjectName("factorSpin");
@@ -94,12 +97,17 @@ PreprocessPanel::PreprocessPanel(Workspace* workspace, QWidget* parent)
   filter_->addItem(tr("FIR, linear phase, >= 80 dB above new Nyquist"), "fir");
   filter_->addItem(tr("Chebyshev I order 8, zero phase (as MATLAB decimate)"), "chebyshev");
   filter_->addItem(tr("None (aliasing)"), "none");
+  filter_->setToolTip(tr("Low-pass filter before decimating, so that nothing above the new "
+                         "Nyquist frequency folds into the band (Section 5.1)"));
   detrend_->setObjectName("detrendCombo");
   detrend_->addItem(tr("Keep"), "none");
   detrend_->addItem(tr("Remove means"), "mean");
   detrend_->addItem(tr("Remove linear trends"), "linear");
   detrend_->setCurrentIndex(1);
+  detrend_->setToolTip(tr("Remove the means or linear trends of input and output: the models "
+                          "(4.1) describe deviations"));
   channel_->setObjectName("spectrumChannelCombo");
+  channel_->setToolTip(tr("Channel whose amplitude spectrum is drawn before and after"));
 
   auto* form = new QFormLayout;
   form->addRow(differentiate_);
@@ -141,6 +149,9 @@ PreprocessPanel::PreprocessPanel(Workspace* workspace, QWidget* parent)
   cancel_->setVisible(false);
   apply_->setObjectName("applyButton");
   reset_->setObjectName("resetButton");
+  apply_->setToolTip(tr("Apply the preprocessing to the log (undoable); fits use the result"));
+  reset_->setToolTip(tr("Back to the log as read"));
+  cancel_->setToolTip(tr("Stop the preprocessing; the log stays as it was"));
   apply_->setEnabled(false);
   auto* buttons = new QHBoxLayout;
   buttons->addWidget(busy_, 1);

@@ -100,6 +100,17 @@ RecursivePanel::RecursivePanel(Workspace* workspace, QWidget* parent)
   algorithm_->addItem(tr("Kalman gain (6.2)"), "kalman");
   gradient_->addItem(tr("sensitivity (6.27)"), "sensitivity");
   gradient_->addItem(tr("differences (6.33)"), "difference");
+  model_->setToolTip(tr("Model of the shared list the estimator starts from and predicts with"));
+  algorithm_->setToolTip(tr("Time update of P: forgetting factor lambda (6.6) or a random walk "
+                            "of the parameters with covariance R1 (6.7)"));
+  gradient_->setToolTip(tr("How the gradient psi of the prediction is computed: sensitivity "
+                           "equations (6.27) or finite differences (6.33)"));
+  lambda_->setToolTip(tr("Forgetting factor lambda of (6.6), 0.5 .. 1; memory about 1/(1 - lambda) "
+                         "samples"));
+  r2_->setToolTip(tr("Measurement noise variance R2 of the Kalman-gain algorithm"));
+  mu_->setToolTip(tr("Regularisation mu of (6.8) and (6.9); 0 switches it off, as the seed's "
+                     "experiments do"));
+  decimation_->setToolTip(tr("Use every N-th sample; the special value decimates to 200 Hz"));
   r1_->setPlaceholderText(tr("(6.54): 5e-8, 5e-7, 5e-6"));
   r1_->setToolTip(tr("diag R1, one value per tracked parameter; empty: the seed's (6.54)"));
   decimation_->setRange(0, 1000);
@@ -160,6 +171,7 @@ RecursivePanel::RecursivePanel(Workspace* workspace, QWidget* parent)
   inverse_->setText(tr("J_a^-1 (seed)"));
   inverse_->setToolTip(tr("theta holds the inverse of J_a, as the seed does; results use J_a"));
   overlay_->setText(tr("Overlay previous"));
+  overlay_->setToolTip(tr("Draw the previous run's estimates beside this one to compare"));
 
   plot_->setMinimumHeight(340);
   plot_->setNoAntialiasingOnDrag(true);

@@ -63,6 +63,10 @@ ResidualsPanel::ResidualsPanel(Workspace* workspace, QWidget* parent)
   setObjectName("residualsPanel");
   model_->setObjectName("residualsModelCombo");
   range_->setObjectName("residualsRangeCombo");
+  model_->setToolTip(tr("Model whose residuals are tested: prediction errors (4.5) of a black box, "
+                        "output errors of a physical model"));
+  range_->setToolTip(tr("Range the residuals are computed on (the validation range tests the model "
+                        "on data it was not fitted to)"));
   range_->addItem(tr("Estimation range"), static_cast<int>(RangeKind::Estimation));
   range_->addItem(tr("Validation range"), static_cast<int>(RangeKind::Validation));
   lags_->setObjectName("residualsLagSpin");

@@ -2,6 +2,7 @@
 // and can be undone, effects switched on, and a simulation against a sample log whose truth
 // is the panel's default three-mass model.
 #include <QApplication>
+#include <QDockWidget>
 #include <cmath>
 #include <QLabel>
 #include <QRegularExpression>
@@ -17,6 +18,7 @@
 #include "core/models/physical_models.h"
 #include "widget_test_support.h"
 #include "widgets/arm/vtk_view.h"
+#include "widgets/bode_panel.h"
 #include "widgets/model_panel.h"
 #include "widgets/plots/bode_plot.h"
 #include "widgets/plots/pole_zero_plot.h"
@@ -30,6 +32,15 @@ namespace {
 double firstNotch(const QString& text) {
   const QRegularExpressionMatch m = QRegularExpression("Notches ([0-9.]+)").match(text);
   return m.hasMatch() ? m.captured(1).toDouble() : -1.0;
+}
+
+// The frequencies after `word` ("Notches 111.8, 300.2 rad/s" or "peaks ...").
+QList<double> listed(const QString& text, const QString& word) {
+  const auto m = QRegularExpression(word + " ([0-9., ]+) rad/s").match(text);
+  QList<double> out;
+  if (m.hasMatch())
+    for (const QString& part : m.captured(1).split(',', Qt::SkipEmptyParts)) out << part.trimmed().toDouble();
+  return out;
 }
 
 int rowOf(QTableWidget* t, const QString& name) {
@@ -163,6 +174,41 @@ class ModelPanelTest : public QObject {
     QVERIFY(done.wait(30000));
     const double wrongFit = done.takeFirst().at(0).toDouble();
     QVERIFY2(wrongFit < trueFit - 5.0, qPrintable(QString("%1 vs %2").arg(wrongFit).arg(trueFit)));
+  }
+
+  // Issue 20, problem 6: the Model panel's notches and peaks and the Bode panel's click readout
+  // give the same numbers for the same model (both notchesAndPeaks on the exact response),
+  // wherever near the extremum the user clicks.
+  void bodeClickReadsTheModelPanelsNumbers() {
+    const int index = panel_->newModel("three-mass");
+    const QString text = panel_->frequencyText();
+    const QList<double> notches = listed(text, "Notches"), peaks = listed(text, "peaks");
+    QVERIFY2(notches.size() == 2 && peaks.size() == 2, qPrintable(text));
+    auto* dock = window_->findChild<QDockWidget*>("bodeDock");
+    dock->show();
+    dock->raise();
+    BodePanel* bode = window_->bodePanel();
+    for (int i = 0; i < static_cast<int>(window_->workspace()->models().size()); ++i)
+      bode->setModelShown(i, i == index);
+    QTRY_VERIFY_WITH_TIMEOUT(!bode->isBusy() && bode->curveNames().size() == 1, 30000);
+    QCustomPlot* plot = bode->plot()->plot();
+    QCPAxisRect* rect = bode->plot()->magnitudeRect();
+    QTest::qWait(100);
+    auto readAt = [&](double w) {
+      const QPoint at(qRound(rect->axis(QCPAxis::atBottom)->coordToPixel(w)), rect->center().y());
+      QTest::mousePress(plot, Qt::LeftButton, Qt::NoModifier, at);
+      QTest::mouseRelease(plot, Qt::LeftButton, Qt::NoModifier, at);
+      const auto m = QRegularExpression("(peak|notch) at ([0-9.]+) rad/s").match(bode->plot()->readoutText());
+      return m.hasMatch() ? std::make_pair(m.captured(1), m.captured(2).toDouble()) : std::make_pair(QString(), -1.0);
+    };
+    for (const auto& [kind, list] : {std::pair{QString("notch"), notches}, std::pair{QString("peak"), peaks}})
+      for (double w : list)
+        for (double off : {0.97, 1.0, 1.03}) {  // a click a little beside the extremum snaps to it
+          const auto [readKind, read] = readAt(w * off);
+          QVERIFY2(readKind == kind && std::abs(read - w) <= 1e-3 * w,
+                   qPrintable(QString("Model panel: %1; Bode readout at %2 rad/s: %3")
+                                  .arg(text).arg(w * off).arg(bode->plot()->readoutText())));
+        }
   }
 
   void cleanupTestCase() { delete window_; }

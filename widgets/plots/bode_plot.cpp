@@ -2,9 +2,11 @@
 
 #include <QLabel>
 #include <QVBoxLayout>
+#include <algorithm>
 #include <cmath>
 #include <qcustomplot.h>
 
+#include "core/models/analysis.h"
 #include "widgets/plots/plot_tools.h"
 
 namespace flexarm {
@@ -23,6 +25,33 @@ void setupLogFrequencyAxis(QCPAxis* axis) {
 }
 
 }  // namespace
+
+std::vector<BodeCurve::Extremum> sampledExtrema(const std::vector<double>& omega,
+                                               const std::vector<std::complex<double>>& response) {
+  std::vector<double> magnitude;
+  for (const auto& h : response) magnitude.push_back(std::abs(h));
+  std::vector<BodeCurve::Extremum> out;
+  if (omega.size() < 3 || omega.size() != magnitude.size() || omega.front() <= 0.0) return out;
+  const NotchesPeaks np = magnitudeExtrema(omega, magnitude);
+  // The level at a refined frequency: the magnitude in dB interpolated over log-frequency.
+  auto levelAt = [&](double w) {
+    const auto it = std::lower_bound(omega.begin(), omega.end(), w);
+    const std::size_t i = std::clamp<std::size_t>(static_cast<std::size_t>(it - omega.begin()), 1, omega.size() - 1);
+    const double t = std::log(w / omega[i - 1]) / std::log(omega[i] / omega[i - 1]);
+    return toDb(magnitude[i - 1]) + t * (toDb(magnitude[i]) - toDb(magnitude[i - 1]));
+  };
+  for (double w : np.notches) out.push_back({w, levelAt(w), false});
+  for (double w : np.peaks) out.push_back({w, levelAt(w), true});
+  return out;
+}
+
+std::vector<BodeCurve::Extremum> curveExtrema(const NotchesPeaks& np,
+                                              const std::function<double(double)>& magnitudeAt) {
+  std::vector<BodeCurve::Extremum> out;
+  for (double w : np.notches) out.push_back({w, toDb(magnitudeAt(w)), false});
+  for (double w : np.peaks) out.push_back({w, toDb(magnitudeAt(w)), true});
+  return out;
+}
 
 std::vector<double> unwrappedPhaseDeg(const std::vector<std::complex<double>>& response) {
   std::vector<double> out(response.size());
@@ -102,6 +131,7 @@ int BodePlot::addCurve(const BodeCurve& curve) {
   e.curve = curve;
   for (const auto& h : curve.response) e.magnitudeDb.push_back(toDb(std::abs(h)));
   e.phaseDeg = unwrappedPhaseDeg(curve.response);
+  if (!curve.extremaKnown) e.curve.extrema = sampledExtrema(curve.frequency, curve.response);
   auto qv = [](const std::vector<double>& v) { return QVector<double>(v.begin(), v.end()); };
   const QVector<double> w = qv(curve.frequency);
   QCPAxis* mx = magRect_->axis(QCPAxis::atBottom);
@@ -194,22 +224,13 @@ void BodePlot::rescale() {
   plot_->replot();
 }
 
-std::optional<std::pair<double, double>> BodePlot::extremumNear(int index, double w) const {
+std::optional<BodeCurve::Extremum> BodePlot::extremumNear(int index, double w) const {
   if (index < 0 || index >= curveCount()) return std::nullopt;
-  const Entry& e = curves_[static_cast<std::size_t>(index)];
-  const auto& f = e.curve.frequency;
-  const auto& m = e.magnitudeDb;
-  std::optional<std::pair<double, double>> best;
-  double bestDistance = 1e300;
-  for (std::size_t i = 1; i + 1 < f.size(); ++i) {
-    const bool peak = m[i] > m[i - 1] && m[i] >= m[i + 1];
-    const bool notch = m[i] < m[i - 1] && m[i] <= m[i + 1];
-    if (!peak && !notch) continue;
-    const double distance = std::abs(std::log(f[i] / w));
-    if (distance < std::log(1.5) && distance < bestDistance) {
-      bestDistance = distance;
-      best = std::make_pair(f[i], m[i]);
-    }
+  std::optional<BodeCurve::Extremum> best;
+  double bestDistance = std::log(1.5);
+  for (const auto& x : curves_[static_cast<std::size_t>(index)].curve.extrema) {
+    const double distance = std::abs(std::log(x.frequency / w));
+    if (distance < bestDistance) bestDistance = distance, best = x;
   }
   return best;
 }
@@ -235,16 +256,13 @@ void BodePlot::onClick(QMouseEvent* e) {
   if (chosen < 0) return;
   if (auto x = extremumNear(chosen, w)) {
     const auto& c = curves_[static_cast<std::size_t>(chosen)];
-    const auto it = std::lower_bound(c.curve.frequency.begin(), c.curve.frequency.end(), x->first);
-    const std::size_t i = static_cast<std::size_t>(it - c.curve.frequency.begin());
-    const bool peak = i > 0 && c.magnitudeDb[i] > c.magnitudeDb[i - 1];
     readout_->setText(tr("%1: %2 at %3 rad/s (%4 Hz), %5 dB")
                           .arg(c.curve.name)
-                          .arg(peak ? tr("peak") : tr("notch"))
-                          .arg(x->first, 0, 'f', 1)
-                          .arg(x->first / (2 * kPi), 0, 'f', 2)
-                          .arg(x->second, 0, 'f', 1));
-    emit extremumPicked(chosen, x->first, x->second);
+                          .arg(x->peak ? tr("peak") : tr("notch"))
+                          .arg(x->frequency, 0, 'f', 1)
+                          .arg(x->frequency / (2 * kPi), 0, 'f', 2)
+                          .arg(x->levelDb, 0, 'f', 1));
+    emit extremumPicked(chosen, x->frequency, x->levelDb);
   } else {
     readout_->setText(tr("%1: no peak or notch near %2 rad/s")
                           .arg(curves_[static_cast<std::size_t>(chosen)].curve.name)

@@ -7,6 +7,7 @@
 #include <QString>
 #include <QWidget>
 #include <complex>
+#include <functional>
 #include <optional>
 #include <vector>
 
@@ -17,6 +18,8 @@ class QLabel;
 
 namespace flexarm {
 
+struct NotchesPeaks;
+
 struct BodeCurve {
   QString name;
   QColor color;
@@ -25,6 +28,17 @@ struct BodeCurve {
   // Optional band: magnitude limits (absolute) and phase limits (degrees), same length.
   std::vector<double> magnitudeLow, magnitudeHigh, phaseLowDeg, phaseHighDeg;
   bool points = false;  // scatter instead of a line
+  // The curve's notches and peaks by the core definition (magnitudeExtrema,
+  // core/models/analysis.h), level in dB. With extremaKnown the click snaps to these (the
+  // Bode panel gives a model the values of notchesAndPeaks, exactly what the Model panel
+  // prints); otherwise addCurve finds them on the samples themselves.
+  struct Extremum {
+    double frequency = 0.0;  // rad/s
+    double levelDb = 0.0;
+    bool peak = false;
+  };
+  std::vector<Extremum> extrema;
+  bool extremaKnown = false;
 };
 
 class BodePlot : public QWidget {
@@ -41,9 +55,9 @@ class BodePlot : public QWidget {
   // Rescales both axes to the visible curves.
   void rescale();
 
-  // Finds the peak or notch of curve `index` nearest to frequency w: the local maximum or
-  // minimum of the magnitude within a factor 1.5 of w. Returns its frequency and level (dB).
-  std::optional<std::pair<double, double>> extremumNear(int index, double w) const;
+  // The peak or notch of curve `index` (BodeCurve::extrema) nearest to frequency w, within a
+  // factor 1.5 of it.
+  std::optional<BodeCurve::Extremum> extremumNear(int index, double w) const;
   QString readoutText() const;
   QCustomPlot* plot() const { return plot_; }
   QCPAxisRect* magnitudeRect() const { return magRect_; }
@@ -70,6 +84,16 @@ class BodePlot : public QWidget {
   QLabel* readout_;
   std::vector<Entry> curves_;
 };
+
+// Notches and peaks of a sampled response by magnitudeExtrema (core/models/analysis.h), the
+// level interpolated on the samples: what a click reads on a curve given without extrema.
+std::vector<BodeCurve::Extremum> sampledExtrema(const std::vector<double>& omega,
+                                               const std::vector<std::complex<double>>& response);
+
+// A model's notches and peaks (notchesAndPeaks, core/models/analysis.h) as curve extrema, the
+// level from |G| at each frequency.
+std::vector<BodeCurve::Extremum> curveExtrema(const NotchesPeaks& np,
+                                              const std::function<double(double)>& magnitudeAt);
 
 // Unwrapped phase in degrees of a frequency response.
 std::vector<double> unwrappedPhaseDeg(const std::vector<std::complex<double>>& response);
