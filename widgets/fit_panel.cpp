@@ -2,6 +2,8 @@
 
 #include <QCheckBox>
 #include <QComboBox>
+#include <QFileDialog>
+#include <QFileInfo>
 #include <QFormLayout>
 #include <QGridLayout>
 #include <QGroupBox>
@@ -53,7 +55,7 @@ FitPanel::FitPanel(Workspace* workspace, QWidget* parent)
     : QWidget(parent), workspace_(workspace), model_(new QComboBox(this)),
       na_(new QSpinBox(this)), nb_(new QSpinBox(this)), nc_(new QSpinBox(this)),
       nd_(new QSpinBox(this)), nf_(new QSpinBox(this)), nk_(new QSpinBox(this)),
-      free_(new QListWidget(this)), startsBounds_(new QLineEdit(this)), ranges_(new QLabel(this)), decimation_(new QSpinBox(this)),
+      free_(new QListWidget(this)), startsBounds_(new QLineEdit(this)), more_(new QLineEdit(this)), moreBrowse_(new QPushButton(QStringLiteral("..."), this)), ranges_(new QLabel(this)), decimation_(new QSpinBox(this)),
       noise_(new QComboBox(this)), closedLoop_(new QComboBox(this)), starts_(new QSpinBox(this)), iterations_(new QSpinBox(this)),
       estimate_(new QPushButton(tr("Estimate"), this)),
       cancel_(new QPushButton(tr("Cancel"), this)), progress_(new QProgressBar(this)),
@@ -109,6 +111,16 @@ FitPanel::FitPanel(Workspace* workspace, QWidget* parent)
                                "the gear to the motor side) and bounds P=LO:HI, comma-separated. "
                                "Dampings d_* are non-negative unless bounded otherwise; a parameter "
                                "that ends on a bound is named in the notes"));
+  more_->setObjectName("fitMoreExperimentsEdit");
+  more_->setPlaceholderText(tr("e.g. b.csv@0:10, val: c.csv"));
+  more_->setToolTip(tr("More experiments besides the open log's ranges, comma-separated: FILE or "
+                       "FILE@A:B (seconds) for estimation, val: FILE[@A:B] for validation. Without "
+                       "a range, the range stored in the log, else all of it. The loss sums over "
+                       "every estimation experiment, each simulated from its own first sample; "
+                       "each experiment's fit % is listed (flexarm fit --log / --validation-log)"));
+  moreBrowse_->setObjectName("fitMoreExperimentsBrowse");
+  moreBrowse_->setToolTip(tr("Add log files as estimation experiments"));
+  connect(moreBrowse_, &QPushButton::clicked, this, &FitPanel::chooseExperimentFiles);
   ranges_->setObjectName("fitRangesLabel");
   ranges_->setWordWrap(true);
   decimation_->setRange(1, 100);
@@ -151,6 +163,11 @@ FitPanel::FitPanel(Workspace* workspace, QWidget* parent)
   form->addRow(tr("Free parameters"), free_);
   form->addRow(tr("Starts, bounds"), startsBounds_);
   form->addRow(tr("Ranges"), ranges_);
+  auto* moreRow = new QHBoxLayout;
+  moreRow->setContentsMargins(0, 0, 0, 0);
+  moreRow->addWidget(more_, 1);
+  moreRow->addWidget(moreBrowse_);
+  form->addRow(tr("More experiments"), moreRow);
   form->addRow(tr("Decimation"), decimation_);
   form->addRow(tr("Noise model"), noise_);
   form->addRow(tr("Closed loop"), closedLoop_);
@@ -409,6 +426,8 @@ void FitPanel::updateControls() {
   nk_->setEnabled(s.has_value() && !busy);
   free_->setEnabled(!s && !busy);
   startsBounds_->setEnabled(!s && !busy);
+  more_->setEnabled(!busy);
+  moreBrowse_->setEnabled(!busy);
   effectsBox_->setEnabled(!s && !busy);
   noise_->setEnabled(!s && !busy);
   closedLoop_->setEnabled(!s && !busy && noise_->currentIndex() == 0);
@@ -457,7 +476,7 @@ void FitPanel::cancel() {
 
 // The pipeline's options from the panel's choices and the workspace's data and ranges;
 // nullopt after showing why in the summary.
-std::optional<FitOptions> FitPanel::options(QString* name) {
+std::optional<FitOptions> FitPanel::options(QString* name, std::vector<ExperimentSource>* more) {
   FitOptions o;
   const QString key = modelChoice();
   o.maxIterations = iterations_->value();
@@ -517,18 +536,25 @@ std::optional<FitOptions> FitPanel::options(QString* name) {
     summary_->setPlainText(tr("The fit cannot run: %1").arg(QString::fromStdString(why)));
     return std::nullopt;
   }
+  auto list = experimentListFromText(more_->text().toStdString(), &why);
+  if (!list) {
+    summary_->setPlainText(tr("More experiments: %1.").arg(QString::fromStdString(why)));
+    return std::nullopt;
+  }
+  *more = *list;
   return o;
 }
 
 void FitPanel::estimate() {
   if (isBusy()) return;
   QString name;
-  auto o = options(&name);
+  std::vector<ExperimentSource> more;
+  auto o = options(&name, &more);
   if (!o) {
     emit estimated(false);
     return;
   }
-  start(*o, name);
+  start(*o, name, more);
 }
 
 bool FitPanel::recompute(const FitRequest& request) {
@@ -542,17 +568,31 @@ bool FitPanel::recompute(const FitRequest& request) {
     return false;
   }
   const QString name = QString::fromStdString(request.physical() ? o.model.start->structureName() : request.name);
-  start(o, name);
+  start(o, name, request.experiments);
   return true;
 }
 
-void FitPanel::start(const FitOptions& o, const QString& name) {
+void FitPanel::setMoreExperiments(const QString& text) { more_->setText(text); }
+QString FitPanel::moreExperiments() const { return more_->text(); }
+
+void FitPanel::chooseExperimentFiles() {
+  const QStringList files = QFileDialog::getOpenFileNames(this, tr("More estimation experiments"), QString(),
+                                                          tr("Logs (*.csv *.dat *.txt *.mat);;All files (*)"));
+  if (files.isEmpty()) return;
+  QStringList items;
+  if (!more_->text().trimmed().isEmpty()) items << more_->text().trimmed();
+  items << files;
+  more_->setText(items.join(", "));
+}
+
+void FitPanel::start(const FitOptions& o, const QString& name, const std::vector<ExperimentSource>& more) {
   // The request as a session stores it: the same options and ranges, without the data.
   auto record = std::make_shared<FitRequest>();
   record->options = o;
   record->options.estimation.clear();
   record->options.validation.clear();
   record->estimation = o.estimation.front().range;
+  record->experiments = more;
   if (!o.validation.empty()) record->validation = o.validation.front().range;
   // The data it runs on, with the ranges the fit itself uses.
   record->provenance = workspace_->dataProvenance();
@@ -563,11 +603,18 @@ void FitPanel::start(const FitOptions& o, const QString& name) {
   startProgress();
   const auto progress = progressCallback();
   // The one fit pipeline (core/ident/fit.h), as `flexarm fit` and a session's replay run it.
-  watcher_.setFuture(QtConcurrent::run([options = o, record, name, progress]() {
+  watcher_.setFuture(QtConcurrent::run([options = o, more, record, name, progress]() mutable {
     Outcome out;
     out.request = record;
     out.name = name;
     try {
+      // The more experiments' logs are read here, off the GUI thread (fit_experiments.h).
+      ExperimentLogs logs;
+      std::string why;
+      if (!appendExperiments(options, more, LogReadOptions{}, logs, &why)) {
+        out.error = tr("more experiments: %1").arg(QString::fromStdString(why));
+        return out;
+      }
       out.result = fitModel(options, progress);
     } catch (const std::exception& e) {
       out.error = QString::fromStdString(e.what());
@@ -646,6 +693,37 @@ void FitPanel::onFinished() {
   else if (r.validation.empty()) fits += tr("; no validation range set.");
   else fits += ".";
   lines << fits;
+  // Each experiment's fit % when there are several of a kind, as `flexarm fit` lists them.
+  // Their files: the open log's, then the more experiments' in order.
+  QStringList files[2];
+  files[0] << QString::fromStdString(out.request->provenance->log);
+  if (out.request->validation) files[1] << QString::fromStdString(out.request->provenance->log);
+  for (const auto& e : out.request->experiments)
+    files[e.validation ? 1 : 0] << QFileInfo(QString::fromStdString(e.path)).fileName();
+  auto listFits = [&](const QString& what, const std::vector<FitValidation>& list, bool validation) {
+    if (list.size() < 2) return;
+    for (std::size_t i = 0; i < list.size(); ++i) {
+      const PreparedData& d = list[i].data;
+      const SampleRange& range = validation ? d.validation : d.estimation;
+      const QStringList& names = files[validation ? 1 : 0];
+      const QString where = tr("%1, %2-%3 s")
+                                .arg(static_cast<int>(i) < names.size() ? names[static_cast<int>(i)] : QString())
+                                .arg(d.timeAt(range.begin))
+                                .arg(d.timeAt(range.end - 1));
+      lines << (list[i].fitPercent ? tr("%1 experiment %2 (%3): fit %4 % (5.2), %5 % NRMSE.")
+                                         .arg(what)
+                                         .arg(i + 1)
+                                         .arg(where)
+                                         .arg(*list[i].fitPercent, 0, 'f', 1)
+                                         .arg(list[i].fitPercentNrmse.value_or(NAN), 0, 'f', 1)
+                                   : tr("%1 experiment %2 (%3): no fit % (the simulated output diverges).")
+                                         .arg(what)
+                                         .arg(i + 1)
+                                         .arg(where));
+    }
+  };
+  listFits(tr("Estimation"), r.estimation, false);
+  listFits(tr("Validation"), r.validation, true);
   lines << tr("Notches: %1. Peaks: %2. (rad/s: the minima and maxima of |G(i w)|, what a click on "
               "the Bode plot reads, as flexarm model and the reports give them)")
                .arg(joined(r.notches), joined(r.peaks));

@@ -15,6 +15,7 @@
 #include <memory>
 
 #include "core/ident/fit.h"
+#include "core/ident/fit_experiments.h"
 #include "core/ident/sensitivity.h"
 #include "widgets/workspace.h"
 
@@ -58,6 +59,10 @@ class FitPanel : public QWidget {
   // or indirect.
   void setClosedLoopMethod(ClosedLoopChoice m);
   void setStarts(int randomStarts);
+  // More experiments besides the workspace's ranges: "FILE@A:B, FILE2, val: FILE3@A:B"
+  // (fit_experiments.h), read inside the background fit; each one's fit % is listed.
+  void setMoreExperiments(const QString& text);
+  QString moreExperiments() const;
 
   bool isBusy() const { return watcher_.isRunning() || study_.isRunning(); }
   QTableWidget* resultsTable() const { return table_; }
@@ -99,7 +104,7 @@ class FitPanel : public QWidget {
     MonteCarloResult monteCarlo;
     QString error;
   };
-  std::optional<FitOptions> options(QString* name);
+  std::optional<FitOptions> options(QString* name, std::vector<ExperimentSource>* more);
   void refillModels();
   void refillParameters();
   void refillEffectParameters();
@@ -111,7 +116,9 @@ class FitPanel : public QWidget {
   void onStudyFinished();
   void showRanges();
   // Runs the fit pipeline on options in the background; name is the model's base name.
-  void start(const FitOptions& options, const QString& name);
+  // The more experiments are read there, off the GUI thread.
+  void start(const FitOptions& options, const QString& name, const std::vector<ExperimentSource>& more);
+  void chooseExperimentFiles();
   void startProgress();
   ProgressCallback progressCallback() const;
 
@@ -125,6 +132,8 @@ class FitPanel : public QWidget {
   QSpinBox* nk_;
   QListWidget* free_;
   QLineEdit* startsBounds_;  // start values P=V and bounds P=LO:HI (FitOptions)
+  QLineEdit* more_;          // more experiments (fit_experiments.h)
+  QPushButton* moreBrowse_;
   QWidget* effectsBox_;
   std::vector<std::pair<EffectKind, QCheckBox*>> effectChecks_;
   QLabel* ranges_;

@@ -3,7 +3,6 @@
 
 #include <cmath>
 #include <cstdlib>
-#include <filesystem>
 #include <map>
 #include <nlohmann/json.hpp>
 #include <ostream>
@@ -11,6 +10,7 @@
 
 #include "app/cli/log_args.h"
 #include "core/ident/evaluation.h"
+#include "core/ident/fit_experiments.h"
 
 namespace flexarm::cli {
 
@@ -152,47 +152,25 @@ bool rangeOption(ArgParser& args, const char* option, const IdData& data, const 
   return true;
 }
 
-// A log named by --log or --validation-log: FILE, or FILE@A:B for the part from A to B
-// seconds (a FILE that exists is taken whole, whatever it is named). Without a range, the
-// range stored in the log (stored), else all of it. Exit code, kExitOk when `out` is set.
-// A file named again (LOG@A:B, or one file in several options) is read once (read: by path),
-// so a validation range of an estimation log shares that experiment's means.
+// A log named by --log or --validation-log: FILE or FILE@A:B (fit_experiments.h). Exit code,
+// kExitOk when `out` is set.
 int experimentOption(const std::string& text, const char* option, const LogReadOptions& readOptions,
-                     bool validation, std::map<std::string, std::shared_ptr<const IdData>>& read,
-                     FitExperiment& out, const std::string& pre, std::ostream& err) {
-  std::string path = text, rangeText;
-  const auto at = text.rfind('@');
-  std::error_code ec;
-  if (at != std::string::npos && !std::filesystem::exists(text, ec)) {
-    path = text.substr(0, at);
-    rangeText = text.substr(at + 1);
+                     bool validation, ExperimentLogs& read, FitExperiment& out, std::string& file,
+                     const std::string& pre, std::ostream& err) {
+  std::string why;
+  auto source = experimentSourceFromText(text, validation, &why);
+  if (!source) {
+    err << pre << "--" << option << " " << text << ": " << why << "\n";
+    return kExitUsage;
   }
-  std::shared_ptr<const IdData>& data = read[path];
-  if (!data) {
-    auto loaded = loadLog(path, readOptions, err);
-    if (!loaded) return kExitBadInput;
-    data = std::make_shared<const IdData>(std::move(*loaded));
-    if (!data->input() || !data->output()) {
-      err << "flexarm: " << path << ": the log has no input or no output channel\n";
-      return kExitBadInput;
-    }
+  ExperimentLoad l = loadExperiment(*source, readOptions, read);
+  if (!l.experiment) {
+    if (l.badInput) err << "flexarm: " << l.message << "\n";
+    else err << pre << "--" << option << " " << text << ": " << l.message << "\n";
+    return l.badInput ? kExitBadInput : kExitUsage;
   }
-  out = FitExperiment{data, std::nullopt};
-  const auto& stored = validation ? data->validationRange : data->estimationRange;
-  if (!rangeText.empty()) {
-    std::string why;
-    out.range = secondsRangeFromText(rangeText, &why);
-    if (!out.range) {
-      err << pre << "--" << option << " " << text << ": " << why << "\n";
-      return kExitUsage;
-    }
-    if (samplesIn(*data, *out.range).empty()) {
-      err << pre << "--" << option << " " << text << ": the range " << rangeText << " s holds no samples of the log\n";
-      return kExitUsage;
-    }
-  } else if (stored && !stored->empty()) {
-    out.range = secondsOf(*data, *stored);
-  }
+  out = *l.experiment;
+  file = source->path;
   return kExitOk;
 }
 
@@ -463,14 +441,13 @@ int runFitPipeline(ArgParser& args, const std::string& verb, FitResult& result, 
   FitExperiment est{data, std::nullopt};
   if (!rangeOption(args, "range", *data, data->estimationRange, est.range, pre, err)) return kExitUsage;
   o.estimation = {est};
-  std::map<std::string, std::shared_ptr<const IdData>> read{{args.positional()[0], data}};
+  ExperimentLogs read{{args.positional()[0], data}};
   auto experiment = [&](const std::string& text, const char* option, bool validation) {
     FitExperiment e;
-    const int rc = experimentOption(text, option, *readOptions, validation, read, e, pre, err);
+    std::string file;
+    const int rc = experimentOption(text, option, *readOptions, validation, read, e, file, pre, err);
     if (rc == kExitOk) {
       (validation ? o.validation : o.estimation).push_back(e);
-      std::error_code ec;
-      const std::string file = std::filesystem::exists(text, ec) ? text : text.substr(0, text.rfind('@'));
       if (files) (validation ? files->validation : files->estimation).push_back(file);
     }
     return rc;

@@ -137,6 +137,12 @@ json fitRequestToJson(const FitRequest& r) {
     j["structure"] = toString(o.model.structure);
     j["orders"] = {{"na", q.na}, {"nb", q.nb}, {"nc", q.nc}, {"nd", q.nd}, {"nf", q.nf}, {"nk", q.nk}};
   }
+  if (!r.experiments.empty()) {
+    json more = json::array();
+    for (const auto& e : r.experiments)
+      more.push_back({{"log", e.path}, {"range_s", secondsRangeToJson(e.range)}, {"validation", e.validation}});
+    j["experiments"] = more;
+  }
   if (r.provenance) j["provenance"] = provenanceToJson(*r.provenance);
   if (r.stored) j["result"] = storedFitToJson(*r.stored);
   return j;
@@ -238,6 +244,21 @@ std::optional<FitRequest> fitRequestFromJson(const json& j, std::string* why) {
   } else {
     return fail(where + "kind must be \"physical\" or \"black-box\", not \"" + kind + "\"");
   }
+  if (j.contains("experiments")) {
+    if (!j["experiments"].is_array()) return fail(where + "experiments must be a list");
+    for (const auto& e : j["experiments"]) {
+      ExperimentSource source;
+      if (!e.is_object() || !e.contains("log") || !e["log"].is_string() || e["log"].get<std::string>().empty())
+        return fail(where + "each of its experiments needs a \"log\" file name");
+      source.path = e["log"].get<std::string>();
+      if (!readSecondsRange(e, "range_s", source.range, &reason)) return fail(where + source.path + ": " + reason);
+      if (e.contains("validation")) {
+        if (!e["validation"].is_boolean()) return fail(where + source.path + ": validation must be true or false");
+        source.validation = e["validation"].get<bool>();
+      }
+      r.experiments.push_back(source);
+    }
+  }
   if (j.contains("provenance")) {
     r.provenance = provenanceFromJson(j["provenance"], &reason);
     if (!r.provenance) return fail(where + reason);
@@ -313,7 +334,15 @@ FitResult runFitRequest(const FitRequest& request, const IdData& data, const Pro
   if (!request.isValid(&why)) throw std::invalid_argument(why);
   // The data outlive the call: a non-owning pointer is enough.
   const std::shared_ptr<const IdData> view(&data, [](const IdData*) {});
-  return fitModel(fitOptionsOf(request, view), progress);
+  FitOptions options = fitOptionsOf(request, view);
+  ExperimentLogs logs;
+  if (!appendExperiments(options, request.experiments, LogReadOptions{}, logs, &why)) {
+    FitResult failed;
+    failed.badData = true;
+    failed.message = why;
+    return failed;
+  }
+  return fitModel(options, progress);
 }
 
 }  // namespace flexarm

@@ -11,6 +11,7 @@
 
 #include "core/common/progress.h"
 #include "core/ident/fit.h"
+#include "core/ident/fit_experiments.h"
 #include "core/session/provenance.h"
 #include "core/session/session.h"
 #include "core/session/session_part.h"
@@ -40,6 +41,9 @@ struct FitRequest {
   // The ranges the fit used (seconds); unset: the session's ranges, else the whole log / no
   // validation.
   std::optional<SecondsRange> estimation, validation;
+  // More experiments beyond the analysed log's ranges (files and ranges, fit_experiments.h),
+  // read when the request runs; absent in sessions written before them: none.
+  std::vector<ExperimentSource> experiments;
   // The data the fit ran on and what it computed; absent in sessions written before them.
   std::optional<Provenance> provenance;
   std::optional<StoredFit> stored;
@@ -57,8 +61,8 @@ FitOptions fitOptionsOf(const FitRequest& request, std::shared_ptr<const IdData>
 // [first value free, second value free]; absent without effects), "noise_model", "closed_loop" ("auto", "direct",
 // "two-stage", "indirect"; absent in sessions written before it: "direct"), "random_starts",
 // "seed", optional "start_values" {name: value} and "bounds" {name: [lower, upper], null an
-// open end}; black-box: "structure", "orders"; "provenance" and "result" (StoredFit) when
-// known}.
+// open end}; black-box: "structure", "orders"; "experiments" [{"log", "range_s": [A, B] or
+// null, "validation"}] when there are more; "provenance" and "result" (StoredFit) when known}.
 nlohmann::json fitRequestToJson(const FitRequest& request);
 // The request described by j; nullopt with a sentence for a malformed one.
 std::optional<FitRequest> fitRequestFromJson(const nlohmann::json& j, std::string* why);
@@ -72,7 +76,8 @@ nlohmann::json polynomialEstimateToJson(const PolynomialModel& model);
 std::optional<PolynomialModel> polynomialEstimateFromJson(const nlohmann::json& j, const FitRequest& request,
                                                           std::string* why);
 
-// Runs the request on data (the session's preprocessed log) through the fit pipeline. Data
+// Runs the request on data (the session's preprocessed log) and its more experiments (read
+// here, by their paths) through the fit pipeline. Data
 // failures come back as a termination and a sentence; throws std::invalid_argument for an
 // invalid request.
 FitResult runFitRequest(const FitRequest& request, const IdData& data, const ProgressCallback& progress = {});

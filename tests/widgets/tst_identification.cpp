@@ -23,6 +23,7 @@
 #include "app/cli/cli.h"
 #include "app/main_window.h"
 #include "app/session_controller.h"
+#include "core/io/log_io.h"
 #include "core/models/physical_models.h"
 #include "core/session/fit_request.h"
 #include "widget_test_support.h"
@@ -470,6 +471,70 @@ class IdentificationTest : public QObject {
     coulomb->setChecked(false);
     QVERIFY(fit->setModelChoice("three-mass"));
     QVERIFY(fit->effects().isEmpty());
+  }
+
+  // A second estimation experiment typed in "More experiments" (the chirp log's second half,
+  // read inside the background fit): the summary lists both experiments' fit % (5.2) and
+  // NRMSE, equal to fitModel's on the same options, and the request keeps the experiment.
+  void moreExperimentsListEachFitPercent() {
+    FitPanel* fit = window_->fitPanel();
+    showDock("fitDock");
+    QVERIFY(fit->setModelChoice("oe"));
+    PolyOrders q;
+    q.nb = 2;
+    q.nf = 2;
+    q.nk = 1;
+    fit->setOrders(q);
+    fit->setDecimation(10);
+    auto* edit = fit->findChild<QLineEdit*>("fitMoreExperimentsEdit");
+    QVERIFY(edit && edit->isEnabled());
+    QVERIFY(fit->findChild<QPushButton*>("fitMoreExperimentsBrowse"));
+    edit->setText(kSampleLog + "@9:17.5");
+    QVERIFY2(clickEstimate(fit), qPrintable(fit->summaryText()));
+
+    FitOptions o;
+    o.model.kind = FitModelKind::BlackBox;
+    o.model.structure = PolyStructure::Oe;
+    o.model.orders = q;
+    o.model.orders.na = 0;
+    o.decimation = 10;
+    auto second = std::make_shared<const IdData>(readLog(kSampleLog.toStdString()).data);
+    o.estimation = {{window_->workspace()->currentShared(), SecondsRange{0.5, 9.0}},
+                    {second, SecondsRange{9.0, 17.5}}};
+    o.validation = {{window_->workspace()->currentShared(), SecondsRange{9.0, 17.5}}};
+    const FitResult direct = fitModel(o);
+    QVERIFY2(direct.ok(), direct.message.c_str());
+    QCOMPARE(direct.estimation.size(), std::size_t(2));
+    const QString text = fit->summaryText();
+    for (int i = 0; i < 2; ++i) {
+      const FitValidation& e = direct.estimation[static_cast<std::size_t>(i)];
+      QVERIFY(e.fitPercent && e.fitPercentNrmse);
+      const QString shown = QString("fit %1 % (5.2), %2 % NRMSE.")
+                                .arg(*e.fitPercent, 0, 'f', 1)
+                                .arg(*e.fitPercentNrmse, 0, 'f', 1);
+      const QString line = QString("Estimation experiment %1 (").arg(i + 1);
+      const int at = text.indexOf(line);
+      QVERIFY2(at >= 0, qPrintable(line + " not in " + text));
+      QVERIFY2(text.mid(at, text.indexOf('\n', at) - at).endsWith(shown), qPrintable(shown + " not in " + text));
+    }
+    QVERIFY(std::abs(*direct.estimation[0].fitPercent - *direct.estimation[1].fitPercent) > 0.05);
+    QVERIFY2(!text.contains("Estimation experiment 3"), qPrintable(text));
+    const ModelEntry& entry = window_->workspace()->models().back();
+    QVERIFY(entry.fitRequest);
+    QCOMPARE(entry.fitRequest->experiments.size(), std::size_t(1));
+    QCOMPARE(QString::fromStdString(entry.fitRequest->experiments[0].path), kSampleLog);
+    QVERIFY(entry.fitRequest->experiments[0].range == (SecondsRange{9.0, 17.5}));
+    window_->resize(1366, 768);
+    QTest::qWait(300);
+    test::saveShot(fit->grab().toImage(), "fit_panel_more_experiments");
+    window_->resize(1500, 1000);
+    // A malformed range is refused at once, before anything is read.
+    edit->setText(kSampleLog + "@9:x");
+    QSignalSpy refused(fit, &FitPanel::estimated);
+    QTest::mouseClick(fit->findChild<QPushButton*>("estimateButton"), Qt::LeftButton);
+    QCOMPARE(refused.count(), 1);
+    QVERIFY2(fit->summaryText().startsWith("More experiments:"), qPrintable(fit->summaryText()));
+    edit->clear();
   }
 
   void cleanupTestCase() { delete window_; }
