@@ -86,7 +86,8 @@ TEST(CliRun, PdfTextHasTitlesParametersChecksumAndTheJsonFitPercent) {
   }
   EXPECT_EQ(fits, 6);  // two models and the estimate, each on both ranges
   EXPECT_EQ(stds, 5);  // the estimate's free parameters
-  for (const char* title : {"Estimated parameters (value +- std, 99 % interval)", "Loss and fit % (5.2)",
+  for (const char* title : {"Estimated parameters (value +- std, 99 % interval)",
+                            "Loss and fit %: the seed's (5.2) and MATLAB compare's NRMSE",
                             "Notches and peaks of the estimate: minima and maxima of |G(i w)|", "Residual tests on the validation range",
                             "Bode magnitude, three-mass estimate with its 99 % band",
                             "Measured and simulated output on the validation range",

@@ -41,6 +41,8 @@ FitOptions optionsFor(std::vector<std::shared_ptr<const IdData>> estimation, std
   FitOptions o;
   o.model.kind = FitModelKind::Physical;
   o.model.start = perturbedStart();
+  // The truth's gear damping is the seed's negative d_g (Table 5.7); open its default bound.
+  o.bounds.push_back({"d_g", -INFINITY, INFINITY});
   if (withEffects) {
     FitEffect spring = FitEffect::defaults(EffectKind::NonlinearSpring);
     spring.effect.values[0] = 1e6;  // half the truth

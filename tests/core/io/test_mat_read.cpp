@@ -190,7 +190,9 @@ TEST(MatRead, DoublesStoredAsSmallerTypesReadAsTheirValues) {
     put("y", MAT_T_SINGLE, yf.data());
     put("k", MAT_T_UINT8, t8.data());
     Mat_Close(mat);
-    const LogReadResult r = readLog(p.string());
+    LogReadOptions o;
+    o.sampleTime = 0.001;  // the file stores no time
+    const LogReadResult r = readLog(p.string(), o);
     ASSERT_TRUE(r.ok) << r.error.toString();
     ASSERT_EQ(r.data.samples(), n);
     EXPECT_EQ(r.data.channel("u")->values[0], -15000.0);
@@ -246,7 +248,9 @@ TEST(MatRead, BigEndianLevel5FileReadsTheSameNumbers) {
     std::ofstream out(p, std::ios::binary);
     out << file;
   }
-  const LogReadResult r = readLog(p.string());
+  LogReadOptions o;
+  o.sampleTime = 0.001;  // the file stores no time
+  const LogReadResult r = readLog(p.string(), o);
   ASSERT_TRUE(r.ok) << r.error.toString();
   EXPECT_EQ(r.data.channel("u")->values, (std::vector<double>{1.5, -2.25, 3e-7, 4.0}));
   EXPECT_EQ(r.data.channel("y")->values, (std::vector<double>{0.1, 0.2, 0.3, 1e300}));
