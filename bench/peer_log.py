@@ -19,14 +19,14 @@ def main():
     repeats, mat_path, files = int(sys.argv[1]), sys.argv[2], sys.argv[3:]
     frame = None
     for i, path in enumerate(files):
-        # comment="#" skips the metadata lines; the header follows them.
-        sec, frame = median_seconds(repeats if i < 2 else min(repeats, 3),
-                                    lambda: pd.read_csv(path, comment="#"))
+        # comment="#" skips the metadata lines; the header follows them. As many repeats
+        # as FlexArm's side (bench_log.cpp).
+        sec, frame = median_seconds(repeats, lambda: pd.read_csv(path, comment="#"))
         emit(f"csv{i}", sec, samples=len(frame),
              sums=[float((frame[c] ** 2).sum()) for c in COLUMNS])
     scipy.io.savemat(mat_path, {c: frame[c].to_numpy() for c in ("time_s",) + COLUMNS},
                      oned_as="column")
-    sec, mat = median_seconds(min(repeats, 3), lambda: scipy.io.loadmat(mat_path))
+    sec, mat = median_seconds(repeats, lambda: scipy.io.loadmat(mat_path))
     emit("mat", sec, samples=int(mat["time_s"].size),
          sums=[float(np.sum(mat[c] ** 2)) for c in COLUMNS])
 

@@ -64,27 +64,31 @@ bool parseLineCarefully(std::string_view line, std::size_t nCols, std::vector<st
   return true;
 }
 
-// Parses the data lines of [begin, end) (whole lines) into its own columns.
+// The rows of one part of the log, parsed into its own columns.
 struct Chunk {
-  const char* begin = nullptr;
-  const char* end = nullptr;
   std::vector<std::vector<double>> cols;
   bool failed = false;
   bool holes = false;  // a channel not sampled on some row (NaN there)
-  RowError error;
+  RowError error;      // lineStart: byte offset in the file
+  std::vector<double> row;
+  std::vector<std::string_view> fields;
 };
 
-void parseChunk(Chunk& c, const char* textStart, std::size_t nCols, std::size_t reserve,
-                long holesAt) {
+void prepareColumns(Chunk& c, std::size_t nCols, std::size_t reserve) {
   c.cols.resize(nCols);
   for (auto& col : c.cols) {
     col.reserve(reserve);  // address space only: pages come on use
     preferHugePages(col.data(), reserve * sizeof(double));
   }
-  std::vector<double> row(nCols);
-  std::vector<std::string_view> fields;
-  const char* p = c.begin;
-  const char* const end = c.end;
+  c.row.resize(nCols);
+}
+
+// Parses the whole lines of [begin, end), which start at byte `offset` of the file, appending
+// to the chunk's columns. Stops at the first bad line (c.failed, c.error).
+void parseLines(Chunk& c, const char* begin, const char* end, std::size_t offset, std::size_t nCols,
+                long holesAt) {
+  double* const row = c.row.data();
+  const char* p = begin;
   while (p < end) {
     const char* const lineStart = p;
     // Fast path: number, ',', number, ..., number, end of line. No blanks, no '+'.
@@ -117,9 +121,9 @@ void parseChunk(Chunk& c, const char* textStart, std::size_t nCols, std::size_t 
       if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
       p = nl ? nl + 1 : end;
       bool isRow = false;
-      if (!parseLineCarefully(line, nCols, fields, row.data(), c.error, isRow, holesAt, c.holes)) {
+      if (!parseLineCarefully(line, nCols, c.fields, row, c.error, isRow, holesAt, c.holes)) {
         c.failed = true;
-        c.error.lineStart = static_cast<std::size_t>(lineStart - textStart);
+        c.error.lineStart = offset + static_cast<std::size_t>(lineStart - begin);
         return;
       }
       if (!isRow) continue;
@@ -152,24 +156,42 @@ void inParallel(unsigned n, Work work) {
   for (auto& t : pool) t.join();
 }
 
-}  // namespace
-
-LogReadResult readFlexArmCsvText(std::string_view text, const std::string& path,
-                                 const LogReadOptions& options) {
-  if (std::string enc = textEncodingProblem(text); !enc.empty()) return failure(path, 1, 0, {}, enc);
-  if (text.find_first_not_of(" \t\r\n") == std::string_view::npos)
-    return failure(path, 1, 0, {}, "the file is empty");
-
-  IdData data;
-  io::LineCursor cursor(text);
-  std::string_view line;
-  std::vector<std::string_view> fields;
+// What the lines before the data rows say: metadata, the header, where the rows start.
+struct Head {
+  IdData data;  // metadata only
   std::vector<std::string> header;
   int headerLine = 0;
   int rateLine = 0;
   double declaredRate = 0.0;
+  std::size_t dataStart = 0;  // byte offset of the first line after the header
+  std::size_t timeIndex = 0;
+};
+
+enum class HeadStatus { Ok, Failed, NeedMore };
+
+// Reads metadata and header from text, the whole file (whole) or its first bytes. NeedMore
+// when the first bytes end before the header does.
+HeadStatus parseHead(std::string_view text, bool whole, const std::string& path, Head& h,
+                     LogReadResult& fail) {
+  if (std::string enc = textEncodingProblem(text); !enc.empty()) {
+    fail = failure(path, 1, 0, {}, enc);
+    return HeadStatus::Failed;
+  }
+  if (text.find_first_not_of(" \t\r\n") == std::string_view::npos) {
+    if (!whole) return HeadStatus::NeedMore;
+    fail = failure(path, 1, 0, {}, "the file is empty");
+    return HeadStatus::Failed;
+  }
+  auto fails = [&](LogReadResult r) {
+    fail = std::move(r);
+    return HeadStatus::Failed;
+  };
+  io::LineCursor cursor(text);
+  std::string_view line;
+  std::vector<std::string_view> fields;
   int metadataLines = 0;
   while (cursor.next(line)) {
+    if (!whole && cursor.offset() > text.size()) return HeadStatus::NeedMore;  // a cut line
     if (io::isBlank(line)) continue;
     const std::size_t first = line.find_first_not_of(" \t\r");
     if (line[first] == '#') {
@@ -177,68 +199,80 @@ LogReadResult readFlexArmCsvText(std::string_view text, const std::string& path,
       std::size_t colon = body.find(':');
       if (colon != std::string::npos) {
         if (++metadataLines > LogReadOptions::kMaxMetadata)
-          return failure(path, cursor.number(), 0, {},
-                         "more than " + std::to_string(LogReadOptions::kMaxMetadata) +
-                             " metadata lines ('# key: value'); a FlexArm log has a few");
+          return fails(failure(path, cursor.number(), 0, {},
+                               "more than " + std::to_string(LogReadOptions::kMaxMetadata) +
+                                   " metadata lines ('# key: value'); a FlexArm log has a few"));
         std::string key = io::trim(std::string_view(body).substr(0, colon));
         std::string value = io::trim(std::string_view(body).substr(colon + 1));
-        if (!key.empty()) data.setMeta(key, value);
+        if (!key.empty()) h.data.setMeta(key, value);
         if (key == "sample_rate_hz") {
           double v = 0;
           if (io::parseNumber(value, v) != FieldStatus::Ok || !(v > 0))
-            return failure(path, cursor.number(), 0, "sample_rate_hz",
-                           "'" + value + "' is not a positive sample rate");
-          declaredRate = v;
-          rateLine = cursor.number();
+            return fails(failure(path, cursor.number(), 0, "sample_rate_hz",
+                                 "'" + value + "' is not a positive sample rate"));
+          h.declaredRate = v;
+          h.rateLine = cursor.number();
         }
       }
       continue;
     }
-    headerLine = cursor.number();
+    h.headerLine = cursor.number();
     io::splitFields(line, ',', fields);
     if (fields.size() > static_cast<std::size_t>(LogReadOptions::kMaxColumns))
-      return failure(path, headerLine, 0, {},
-                     "the header has more than " + std::to_string(LogReadOptions::kMaxColumns) +
-                         " columns, more than FlexArm reads");
+      return fails(failure(path, h.headerLine, 0, {},
+                           "the header has more than " + std::to_string(LogReadOptions::kMaxColumns) +
+                               " columns, more than FlexArm reads"));
     std::unordered_set<std::string> seen;
     seen.reserve(fields.size());
     for (std::size_t i = 0; i < fields.size(); ++i) {
       std::string name = io::trim(fields[i]);
       if (name.empty())
-        return failure(path, headerLine, static_cast<int>(i + 1), {},
-                       "the header has an empty column name");
+        return fails(failure(path, h.headerLine, static_cast<int>(i + 1), {},
+                             "the header has an empty column name"));
       if (!seen.insert(name).second)
-        return failure(path, headerLine, static_cast<int>(i + 1), name,
-                       "the column name appears twice in the header");
-      header.push_back(std::move(name));
+        return fails(failure(path, h.headerLine, static_cast<int>(i + 1), name,
+                             "the column name appears twice in the header"));
+      h.header.push_back(std::move(name));
     }
     break;
   }
-  if (headerLine == 0)
-    return failure(path, cursor.number(), 0, {}, "no header line: the file holds only comments");
+  if (h.headerLine == 0) {
+    if (!whole) return HeadStatus::NeedMore;
+    return fails(failure(path, cursor.number(), 0, {}, "no header line: the file holds only comments"));
+  }
   double probe = 0;
-  if (io::parseNumber(header[0], probe) == FieldStatus::Ok)
-    return failure(path, headerLine, 1, {},
-                   "expected a header of column names (time_s,torque_ref_nm,motor_angle_rad,"
-                   "...) but found numbers; open it as a headerless table instead");
+  if (io::parseNumber(h.header[0], probe) == FieldStatus::Ok)
+    return fails(failure(path, h.headerLine, 1, {},
+                         "expected a header of column names (time_s,torque_ref_nm,motor_angle_rad,"
+                         "...) but found numbers; open it as a headerless table instead"));
   for (const char* required : {columns::kTime, columns::kTorqueRef, columns::kMotorAngle})
-    if (std::find(header.begin(), header.end(), required) == header.end())
-      return failure(path, headerLine, 0, required,
-                     std::string("the required column '") + required + "' is missing");
-  const auto timeIndex = static_cast<std::size_t>(
-      std::find(header.begin(), header.end(), columns::kTime) - header.begin());
+    if (std::find(h.header.begin(), h.header.end(), required) == h.header.end())
+      return fails(failure(path, h.headerLine, 0, required,
+                           std::string("the required column '") + required + "' is missing"));
+  h.timeIndex = static_cast<std::size_t>(
+      std::find(h.header.begin(), h.header.end(), columns::kTime) - h.header.begin());
+  h.dataStart = std::min(cursor.offset(), text.size());
+  return HeadStatus::Ok;
+}
 
-  // Data rows: split into chunks of whole lines, one per thread for large logs.
-  const std::size_t nCols = header.size();
-  const std::size_t dataStart = std::min(cursor.offset(), text.size());
-  const char* const textStart = text.data();
-  const char* const dataBegin = textStart + dataStart;
-  const char* const dataEnd = textStart + text.size();
-  const std::size_t dataBytes = text.size() - dataStart;
-  unsigned threads = 1;
-  if (dataBytes > (4u << 20))
-    threads = std::clamp(std::thread::hardware_concurrency(), 1u, 8u);
+// Threads for `bytes` of data rows: one per core for large logs.
+unsigned threadsFor(std::size_t bytes) {
+  return bytes > (4u << 20) ? std::clamp(std::thread::hardware_concurrency(), 1u, 8u) : 1u;
+}
+
+long holesColumn(const Head& h, const LogReadOptions& options) {
+  return options.keepIrregularTime ? static_cast<long>(h.timeIndex) : -1L;
+}
+
+// Parses the rows of text (the whole file) from h.dataStart, in parts of whole lines.
+std::vector<Chunk> parseRowsInMemory(std::string_view text, const Head& h, const LogReadOptions& options) {
+  const std::size_t nCols = h.header.size();
+  const char* const dataBegin = text.data() + h.dataStart;
+  const char* const dataEnd = text.data() + text.size();
+  const std::size_t dataBytes = text.size() - h.dataStart;
+  const unsigned threads = threadsFor(dataBytes);
   std::vector<Chunk> chunks(threads);
+  std::vector<std::pair<const char*, const char*>> parts(threads);
   const char* b = dataBegin;
   for (unsigned k = 0; k < threads; ++k) {
     const char* e = k + 1 == threads ? dataEnd : dataBegin + dataBytes * (k + 1) / threads;
@@ -247,62 +281,173 @@ LogReadResult readFlexArmCsvText(std::string_view text, const std::string& path,
       const void* nl = std::memchr(e, '\n', static_cast<std::size_t>(dataEnd - e));
       e = nl ? static_cast<const char*>(nl) + 1 : dataEnd;
     }
-    chunks[k].begin = b;
-    chunks[k].end = e;
+    parts[k] = {b, e};
     b = e;
   }
-  // Every chunk parses into its own columns; the first reserves room for the whole log, so
-  // the others are appended to it without moving it.
+  // The first part reserves room for the whole log, so the others are appended to it
+  // without moving it.
   inParallel(threads, [&](unsigned k) {
-    const auto bytes = static_cast<std::size_t>(k == 0 ? dataBytes : chunks[k].end - chunks[k].begin);
-    parseChunk(chunks[k], textStart, nCols, expectedRows(dataBegin, dataEnd, bytes, nCols),
-               options.keepIrregularTime ? static_cast<long>(timeIndex) : -1L);
+    const auto bytes = static_cast<std::size_t>(k == 0 ? dataBytes : parts[k].second - parts[k].first);
+    prepareColumns(chunks[k], nCols, expectedRows(dataBegin, dataEnd, bytes, nCols));
+    parseLines(chunks[k], parts[k].first, parts[k].second,
+               static_cast<std::size_t>(parts[k].first - text.data()), nCols, holesColumn(h, options));
   });
+  return chunks;
+}
+
+// Parses the rows straight from the file, each thread its part, in pieces small enough to
+// stay in the processor's cache: a large log is never copied whole into fresh memory (which
+// the kernel zeroes page by page before it can be filled). `head` holds the file's first
+// bytes (for the row-length estimate). False when the file must be read whole after all: it
+// shrank meanwhile or a read failed.
+bool parseRowsFromFile(const InputFile& file, std::string_view head, const Head& h,
+                       const LogReadOptions& options, std::vector<Chunk>& chunks) {
+  constexpr std::size_t kPiece = 256u << 10;
+  const std::size_t nCols = h.header.size();
+  const std::size_t size = static_cast<std::size_t>(file.size());
+  const std::size_t dataBytes = size - h.dataStart;
+  const unsigned threads = threadsFor(dataBytes);
+  chunks.assign(threads, Chunk{});
+  std::vector<char> trouble(threads, 0);
+  const char* const sampleBegin = head.data() + std::min(h.dataStart, head.size());
+  const char* const sampleEnd = head.data() + head.size();
+  inParallel(threads, [&](unsigned k) {
+    Chunk& c = chunks[k];
+    // This thread parses the lines that start in [from, to).
+    const std::size_t from = h.dataStart + dataBytes * k / threads;
+    const std::size_t to = k + 1 == threads ? size : h.dataStart + dataBytes * (k + 1) / threads;
+    prepareColumns(c, nCols, expectedRows(sampleBegin, sampleEnd, k == 0 ? dataBytes : to - from, nCols));
+    std::vector<char> buf(kPiece);
+    std::size_t bufOffset = k == 0 ? from : from - 1;  // file offset of buf[0]
+    std::size_t have = 0;                               // bytes in buf
+    bool skipping = k > 0;  // to the end of the line before `from` (the previous thread's)
+    for (;;) {
+      if (buf.size() - have < kPiece / 2) buf.resize(buf.size() * 2);  // a line longer than a piece
+      const std::size_t at = bufOffset + have;
+      const long long r = at < size ? file.readAt(at, buf.data() + have, std::min(buf.size() - have, size - at)) : 0;
+      if (r < 0 || (r == 0 && at < size)) {  // a failed read, or the file shrank
+        trouble[k] = 1;
+        return;
+      }
+      have += static_cast<std::size_t>(r);
+      const bool atEnd = bufOffset + have >= size;
+      const char* p = buf.data();
+      const char* const end = buf.data() + have;
+      if (skipping) {
+        const char* nl = static_cast<const char*>(std::memchr(p, '\n', have));
+        if (!nl) {
+          if (atEnd) return;
+          bufOffset += have;
+          have = 0;
+          continue;
+        }
+        p = nl + 1;
+        skipping = false;
+      }
+      // Whole lines that start before `to`: up to the newline ending the line at to - 1.
+      const std::size_t pAt = bufOffset + static_cast<std::size_t>(p - buf.data());
+      if (pAt >= to) return;
+      const char* stop = end;
+      bool last = atEnd;
+      const std::size_t limit = to - 1 - bufOffset;  // index in buf of the byte at to - 1
+      if (limit < have) {
+        const char* nl = static_cast<const char*>(std::memchr(buf.data() + limit, '\n', have - limit));
+        if (nl) {
+          stop = nl + 1;
+          last = true;
+        }
+      }
+      if (!last) {  // parse up to the last whole line, keep the rest for the next piece
+        const char* nl = static_cast<const char*>(::memrchr(p, '\n', static_cast<std::size_t>(end - p)));
+        stop = nl ? nl + 1 : p;
+      }
+      parseLines(c, p, stop, pAt, nCols, holesColumn(h, options));
+      if (c.failed || last) return;
+      const std::size_t rest = static_cast<std::size_t>(end - stop);
+      std::memmove(buf.data(), stop, rest);
+      bufOffset += have - rest;
+      have = rest;
+    }
+  });
+  return std::none_of(trouble.begin(), trouble.end(), [](char t) { return t != 0; });
+}
+
+// Turns parsed rows into the log, with every check. With haveText, text is the whole file,
+// for line numbers; without (the rows were read from the file in parts), a result that needs
+// line numbers (a bad line, an irregular time column) sets needText instead.
+LogReadResult finishLog(Head& h, std::vector<Chunk>& chunks, bool haveText, std::string_view text,
+                        const std::string& path, const LogReadOptions& options, bool& needText) {
+  needText = false;
+  auto wantText = [&] {
+    needText = true;
+    return LogReadResult{};
+  };
   for (const auto& c : chunks)
-    if (c.failed)
+    if (c.failed) {
+      if (!haveText) return wantText();
       return failure(path, io::lineAt(text, c.error.lineStart), c.error.column,
-                     c.error.column > 0 ? header[static_cast<std::size_t>(c.error.column - 1)]
+                     c.error.column > 0 ? h.header[static_cast<std::size_t>(c.error.column - 1)]
                                         : std::string(),
                      c.error.problem);
+    }
+  const std::size_t nCols = h.header.size();
   std::vector<std::vector<double>> cols = std::move(chunks[0].cols);
-  for (unsigned k = 1; k < threads; ++k)
+  for (std::size_t k = 1; k < chunks.size(); ++k)
     for (std::size_t i = 0; i < nCols; ++i) {
       cols[i].insert(cols[i].end(), chunks[k].cols[i].begin(), chunks[k].cols[i].end());
       std::vector<double>().swap(chunks[k].cols[i]);
     }
   const std::size_t rows = cols[0].size();
-
-  auto lineOf = [&](std::size_t row) { return io::lineOfRow(text, dataStart, headerLine + 1, row, "#"); };
+  if (rows < 2 && !haveText) return wantText();
+  const int firstLine = h.headerLine + 1;
+  auto lineOf = [&](std::size_t row) { return io::lineOfRow(text, h.dataStart, firstLine, row, "#"); };
   if (rows == 0)
-    return failure(path, headerLine, 0, {}, "the header is not followed by any data rows");
+    return failure(path, h.headerLine, 0, {}, "the header is not followed by any data rows");
   if (rows < 2)
     return failure(path, lineOf(0), 0, {}, "only one data row: at least two samples are needed");
 
-  auto allLines = [&] { return io::linesOfRows(text, dataStart, headerLine + 1, "#"); };
+  bool lineless = false;  // line numbers were asked for without the text
+  auto allLines = [&] {
+    if (!haveText) {
+      lineless = true;
+      return std::vector<int>(rows, 0);
+    }
+    return io::linesOfRows(text, h.dataStart, firstLine, "#");
+  };
+  auto lineOfChecked = [&](std::size_t row) {
+    if (!haveText) {
+      lineless = true;
+      return 0;
+    }
+    return lineOf(row);
+  };
   bool holes = false;
   for (const auto& c : chunks) holes = holes || c.holes;
+  IdData& data = h.data;
   LogReadResult fail;
-  if (!io::checkTime(path, cols[timeIndex], lineOf, allLines, static_cast<int>(timeIndex + 1),
-                     columns::kTime, options, data, fail))
-    return fail;
+  const bool timeOk = io::checkTime(path, cols[h.timeIndex], lineOfChecked, allLines,
+                                    static_cast<int>(h.timeIndex + 1), columns::kTime, options, data, fail);
+  if (lineless) return wantText();
+  if (!timeOk) return fail;
   if (holes && data.timeStamps.empty()) {  // channels at different rates: stamps and NaN holes
-    data.timeStamps = cols[timeIndex];
+    if (!haveText) return wantText();
+    data.timeStamps = cols[h.timeIndex];
     data.sourceLines = allLines();
   }
-  if (declaredRate > 0 && data.timeStamps.empty()) {
+  if (h.declaredRate > 0 && data.timeStamps.empty()) {
     const double measured = 1.0 / data.sampleTime;
-    if (std::abs(measured - declaredRate) > options.maxSampleJitter * declaredRate) {
+    if (std::abs(measured - h.declaredRate) > options.maxSampleJitter * h.declaredRate) {
       char buf[200];
       std::snprintf(buf, sizeof buf,
                     "the header says %.6g Hz but the time column is sampled at %.6g Hz",
-                    declaredRate, measured);
-      return failure(path, rateLine, 0, "sample_rate_hz", buf);
+                    h.declaredRate, measured);
+      return failure(path, h.rateLine, 0, "sample_rate_hz", buf);
     }
   }
   for (std::size_t i = 0; i < nCols; ++i) {
-    if (i == timeIndex) continue;
+    if (i == h.timeIndex) continue;
     Channel c;
-    c.name = header[i];
+    c.name = h.header[i];
     c.unit = unitFromColumnName(c.name);
     c.values = std::move(cols[i]);
     data.channels.push_back(std::move(c));
@@ -316,12 +461,59 @@ LogReadResult readFlexArmCsvText(std::string_view text, const std::string& path,
   return ok;
 }
 
-LogReadResult readFlexArmCsv(const std::string& path, const LogReadOptions& options) {
+LogReadResult readWholeFile(const std::string& path, const LogReadOptions& options) {
   FileBytes bytes;
   std::string problem;
   if (!readInputFile(path, options.maxFileBytes, bytes, &problem))
     return failure(path, 0, 0, {}, problem);
   return readFlexArmCsvText(bytes.view(), path, options);
+}
+
+}  // namespace
+
+LogReadResult readFlexArmCsvText(std::string_view text, const std::string& path,
+                                 const LogReadOptions& options) {
+  Head h;
+  LogReadResult fail;
+  if (parseHead(text, true, path, h, fail) != HeadStatus::Ok) return fail;
+  std::vector<Chunk> chunks = parseRowsInMemory(text, h, options);
+  bool needText = false;
+  return finishLog(h, chunks, true, text, path, options, needText);
+}
+
+LogReadResult readFlexArmCsv(const std::string& path, const LogReadOptions& options, bool* readWhole) {
+  // The first bytes give metadata and header; a small file is then parsed in memory, a large
+  // one straight from the file. Whatever needs the text as a whole (a bad line's number, an
+  // irregular time column, a header beyond the first bytes, a file that changed while read)
+  // is read again the simple way, so both ways give the same result.
+  constexpr std::size_t kHead = 64u << 10;
+  if (readWhole) *readWhole = true;
+  InputFile file;
+  std::string problem;
+  if (!file.open(path, options.maxFileBytes, &problem)) return failure(path, 0, 0, {}, problem);
+  const std::size_t size = static_cast<std::size_t>(file.size());
+  if (size <= kHead) return readWholeFile(path, options);
+  std::string head(kHead, '\0');
+  std::size_t got = 0;
+  while (got < kHead) {
+    const long long r = file.readAt(got, head.data() + got, kHead - got);
+    if (r <= 0) return readWholeFile(path, options);
+    got += static_cast<std::size_t>(r);
+  }
+  Head h;
+  LogReadResult fail;
+  switch (parseHead(head, false, path, h, fail)) {
+    case HeadStatus::Failed: return fail;
+    case HeadStatus::NeedMore: return readWholeFile(path, options);
+    case HeadStatus::Ok: break;
+  }
+  std::vector<Chunk> chunks;
+  if (!parseRowsFromFile(file, head, h, options, chunks)) return readWholeFile(path, options);
+  bool needText = false;
+  LogReadResult r = finishLog(h, chunks, false, {}, path, options, needText);
+  if (needText) return readWholeFile(path, options);
+  if (readWhole) *readWhole = false;
+  return r;
 }
 
 }  // namespace flexarm

@@ -118,21 +118,43 @@ bool checkInputFile(const std::string& path, std::uint64_t maxBytes, std::uint64
   return true;
 }
 
-bool readInputFile(const std::string& path, std::uint64_t maxBytes, FileBytes& out,
-                   std::string* problem) {
+InputFile::~InputFile() {
+  if (fd_ >= 0) ::close(fd_);
+}
+
+bool InputFile::open(const std::string& path, std::uint64_t maxBytes, std::string* problem) {
+  if (fd_ >= 0) ::close(fd_);
+  fd_ = -1;
+  size_ = 0;
   // O_NONBLOCK: opening a pipe must not wait for a writer; it is refused just below.
   const int fd = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC);
   if (fd < 0) {
     if (problem) *problem = openProblem(errno);
     return false;
   }
-  struct Close {
-    int fd;
-    ~Close() { ::close(fd); }
-  } closer{fd};
   struct stat st {};
-  std::uint64_t bytes = 0;
-  if (!acceptable(::fstat(fd, &st), st, maxBytes, bytes, problem)) return false;
+  if (!acceptable(::fstat(fd, &st), st, maxBytes, size_, problem)) {
+    ::close(fd);
+    size_ = 0;
+    return false;
+  }
+  fd_ = fd;
+  return true;
+}
+
+long long InputFile::readAt(std::uint64_t offset, char* dst, std::size_t n) const {
+  for (;;) {
+    const ssize_t r = ::pread(fd_, dst, n, static_cast<off_t>(offset));
+    if (r < 0 && errno == EINTR) continue;
+    return r;
+  }
+}
+
+bool readInputFile(const std::string& path, std::uint64_t maxBytes, FileBytes& out,
+                   std::string* problem) {
+  InputFile file;
+  if (!file.open(path, maxBytes, problem)) return false;
+  const std::uint64_t bytes = file.size();
   out.size = 0;
   out.data = allocateBuffer(static_cast<std::size_t>(bytes));
   // A large file is read in parts by several threads at once: copying from the disk cache is
@@ -145,9 +167,7 @@ bool readInputFile(const std::string& path, std::uint64_t maxBytes, FileBytes& o
     const std::size_t begin = static_cast<std::size_t>(bytes * k / parts);
     const std::size_t end = static_cast<std::size_t>(bytes * (k + 1) / parts);
     while (begin + got[k] < end) {
-      const ssize_t r = ::pread(fd, out.data.get() + begin + got[k], end - begin - got[k],
-                                static_cast<off_t>(begin + got[k]));
-      if (r < 0 && errno == EINTR) continue;
+      const long long r = file.readAt(begin + got[k], out.data.get() + begin + got[k], end - begin - got[k]);
       if (r < 0) {
         errors[k] = errno;
         return;

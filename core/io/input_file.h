@@ -39,6 +39,26 @@ bool checkInputFile(const std::string& path, std::uint64_t maxBytes, std::uint64
 bool readInputFile(const std::string& path, std::uint64_t maxBytes, FileBytes& out,
                    std::string* problem);
 
+// An open regular file of at most maxBytes, for readers that take it in parts rather than
+// whole (the same checks as readInputFile). Closed when destroyed.
+class InputFile {
+ public:
+  InputFile() = default;
+  ~InputFile();
+  InputFile(const InputFile&) = delete;
+  InputFile& operator=(const InputFile&) = delete;
+  // False with a sentence as readInputFile gives.
+  bool open(const std::string& path, std::uint64_t maxBytes, std::string* problem);
+  std::uint64_t size() const { return size_; }  // as it was when opened
+  // Reads up to n bytes at offset into dst (retrying interrupted reads); the count read, 0 at
+  // the end of the file, or -1 with errno set.
+  long long readAt(std::uint64_t offset, char* dst, std::size_t n) const;
+
+ private:
+  int fd_ = -1;
+  std::uint64_t size_ = 0;
+};
+
 // A sentence naming the encoding of text that is not plain ASCII/UTF-8 without BOM (UTF-16
 // or UTF-32 with or without BOM, a UTF-8 BOM, binary data with NUL bytes), judged from the
 // first bytes; empty for plain text.

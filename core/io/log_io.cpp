@@ -17,6 +17,31 @@ bool hasExtension(const std::string& path, const char* ext) {
   return e == ext;
 }
 
+enum class Sniffed { FlexArmCsv, Table, Undecided };
+
+// The format text names on its first lines (up to 1000): '# flexarm-log' or a first
+// non-comment line of names means a FlexArm log, numbers a table. Undecided when only
+// comments come before the end of the first bytes (whole: text is the whole file, and then
+// a file of comments only is a FlexArm log, whose reader names the problem).
+Sniffed sniffText(std::string_view text, bool whole) {
+  io::LineCursor cursor(text);
+  std::string_view line;
+  for (int count = 0; count < 1000 && cursor.next(line); ++count) {
+    if (!whole && cursor.offset() > text.size()) return Sniffed::Undecided;  // a cut line
+    const std::string t = io::trim(line.substr(0, std::min<std::size_t>(line.size(), 4096)));
+    if (t.empty()) continue;
+    if (t[0] == '#') {
+      if (t.find("flexarm-log") != std::string::npos) return Sniffed::FlexArmCsv;
+      continue;
+    }
+    if (t[0] == '%') continue;
+    const char c = t[0];
+    const bool numeric = (c >= '0' && c <= '9') || c == '-' || c == '+' || c == '.';
+    return numeric ? Sniffed::Table : Sniffed::FlexArmCsv;
+  }
+  return whole || cursor.offset() < text.size() ? Sniffed::FlexArmCsv : Sniffed::Undecided;
+}
+
 }  // namespace
 
 std::string ReadError::toString() const {
@@ -67,32 +92,34 @@ LogReadResult readLog(const std::string& path, const LogReadOptions& options) {
     case LogFormat::Auto: break;
   }
   if (hasExtension(path, ".mat")) return readMat(path, options);
-  // The file is read once (a regular file within the size limit), then sniffed: the MATLAB
-  // magic means .mat, names on the first non-comment line a FlexArm log, numbers a table.
-  FileBytes bytes;
+  // The format is sniffed from the first bytes: the MATLAB magic means .mat, names on the
+  // first non-comment line a FlexArm log, numbers a table. The chosen reader then reads the
+  // file its own way (a large FlexArm log straight from the file, in parts).
+  constexpr std::size_t kSniff = 64u << 10;
+  InputFile file;
   std::string problem;
+  if (!file.open(path, options.maxFileBytes, &problem)) return io::failure(path, 0, 0, {}, problem);
+  std::string head(static_cast<std::size_t>(std::min<std::uint64_t>(file.size(), kSniff)), '\0');
+  std::size_t got = 0;
+  while (got < head.size()) {
+    const long long r = file.readAt(got, head.data() + got, head.size() - got);
+    if (r <= 0) break;
+    got += static_cast<std::size_t>(r);
+  }
+  head.resize(got);
+  if (head.compare(0, 6, "MATLAB") == 0) return readMat(path, options);
+  switch (sniffText(head, got >= file.size())) {
+    case Sniffed::FlexArmCsv: return readFlexArmCsv(path, options);
+    case Sniffed::Table: return readTable(path, options);
+    case Sniffed::Undecided: break;
+  }
+  // Comments beyond the first bytes: decided on the whole text.
+  FileBytes bytes;
   if (!readInputFile(path, options.maxFileBytes, bytes, &problem))
     return io::failure(path, 0, 0, {}, problem);
   const std::string_view text = bytes.view();
-  if (text.compare(0, 6, "MATLAB") == 0) {
-    bytes = {};
-    return readMat(path, options);
-  }
-  io::LineCursor cursor(text);
-  std::string_view line;
-  for (int count = 0; count < 1000 && cursor.next(line); ++count) {
-    const std::string t = io::trim(line.substr(0, std::min<std::size_t>(line.size(), 4096)));
-    if (t.empty()) continue;
-    if (t[0] == '#') {
-      if (t.find("flexarm-log") != std::string::npos) return readFlexArmCsvText(text, path, options);
-      continue;
-    }
-    if (t[0] == '%') continue;
-    const char c = t[0];
-    const bool numeric = (c >= '0' && c <= '9') || c == '-' || c == '+' || c == '.';
-    return numeric ? readTableText(text, path, options) : readFlexArmCsvText(text, path, options);
-  }
-  return readFlexArmCsvText(text, path, options);  // reports the empty or comment-only file
+  if (sniffText(text, true) == Sniffed::Table) return readTableText(text, path, options);
+  return readFlexArmCsvText(text, path, options);  // also reports the empty or comment-only file
 }
 
 }  // namespace flexarm

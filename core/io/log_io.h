@@ -74,7 +74,11 @@ struct LogReadOptions {
 // or pipe is refused before reading), never more than options.maxFileBytes, and memory stays
 // within a few times the file's size.
 LogReadResult readLog(const std::string& path, const LogReadOptions& options = {});
-LogReadResult readFlexArmCsv(const std::string& path, const LogReadOptions& options = {});
+// A large FlexArm log is parsed straight from the file in parts; whatever needs the text
+// whole (a small file, a bad line's number, irregular time) reads it whole. readWhole, when
+// given, says which way was taken.
+LogReadResult readFlexArmCsv(const std::string& path, const LogReadOptions& options = {},
+                             bool* readWhole = nullptr);
 LogReadResult readTable(const std::string& path, const LogReadOptions& options = {});
 LogReadResult readMat(const std::string& path, const LogReadOptions& options = {});
 // The same readers on text already in memory; `name` is what messages call the file.

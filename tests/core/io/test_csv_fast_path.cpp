@@ -3,8 +3,12 @@
 // problem, wherever in a large file it is.
 #include <gtest/gtest.h>
 
+#include <unistd.h>
+
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
+#include <fstream>
 #include <string>
 #include <vector>
 
@@ -58,7 +62,103 @@ Expected makeLog(std::size_t n) {
   return e;
 }
 
+// A folder of this test process's own, removed at the end.
+struct ScratchDir {
+  std::filesystem::path path;
+  explicit ScratchDir(const std::string& stem)
+      : path(std::filesystem::temp_directory_path() / (stem + "_" + std::to_string(::getpid()))) {
+    std::filesystem::create_directories(path);
+  }
+  ~ScratchDir() {
+    std::error_code ec;
+    std::filesystem::remove_all(path, ec);
+  }
+  std::string write(const std::string& name, const std::string& text) const {
+    const std::string f = (path / name).string();
+    std::ofstream(f, std::ios::binary) << text;
+    return f;
+  }
+};
+
+// What reading the file gives equals what reading its text gives: values, or the error.
+void expectSameAsText(const std::string& file, const std::string& text) {
+  const LogReadResult fromFile = readLog(file);
+  bool readWhole = false;
+  EXPECT_EQ(readFlexArmCsv(file, {}, &readWhole).ok, fromFile.ok);
+  EXPECT_TRUE(readWhole) << "line numbers come from the whole text";
+  const LogReadResult fromText = readFlexArmCsvText(text, file);
+  ASSERT_EQ(fromFile.ok, fromText.ok) << fromFile.error.toString() << " / " << fromText.error.toString();
+  if (!fromText.ok) {
+    EXPECT_EQ(fromFile.error.toString(), fromText.error.toString());
+    return;
+  }
+  ASSERT_EQ(fromFile.data.samples(), fromText.data.samples());
+  for (const char* name : {columns::kTorqueRef, columns::kMotorAngle})
+    EXPECT_EQ(fromFile.data.channel(name)->values, fromText.data.channel(name)->values) << name;
+  EXPECT_EQ(fromFile.data.sampleTime, fromText.data.sampleTime);
+  EXPECT_EQ(fromFile.data.timeStamps, fromText.data.timeStamps);
+}
+
 }  // namespace
+
+// A large log is read from the file in parts, one per thread, in pieces of a fixed size: the
+// lines cut by those borders are read once and whole wherever a border falls in a line
+// (before, in or after a '\r\n', in a number), and the result is the text path's.
+TEST(CsvFastPath, ReadingALargeFileInPartsGivesWhatItsTextGives) {
+  const Expected e = makeLog(150000);
+  ASSERT_GT(e.text.size(), 4u << 20) << "large enough to be split over threads";
+  const std::size_t firstRow = e.text.find("0.000,");
+  ASSERT_NE(firstRow, std::string::npos);
+  ScratchDir dir("flexarm_csv_parts");
+  // Zeros appended to the first time stamp shift every later border by one byte: 60 shifts
+  // move the borders across a whole line (about 50 bytes).
+  for (int shift = 0; shift < 60; shift += 1) {
+    SCOPED_TRACE(shift);
+    std::string text = e.text;
+    text.insert(firstRow + 5, static_cast<std::size_t>(shift), '0');
+    const std::string file = dir.write("log.csv", text);
+    const LogReadResult r = readLog(file);
+    ASSERT_TRUE(r.ok) << r.error.toString();
+    bool readWhole = true;
+    ASSERT_TRUE(readFlexArmCsv(file, {}, &readWhole).ok);
+    ASSERT_FALSE(readWhole) << "read from the file in parts, not again as a whole";
+    ASSERT_EQ(r.data.samples(), e.t.size());
+    ASSERT_EQ(r.data.channel(columns::kTorqueRef)->values, e.u);
+    ASSERT_EQ(r.data.channel(columns::kMotorAngle)->values, e.y);
+  }
+}
+
+// Whatever needs the whole text (a bad line's number, a sampling gap, a comment line longer
+// than a piece) gives the same answer from a file as from its text.
+TEST(CsvFastPath, BadLinesGapsAndLongLinesInALargeFileAnswerAsTheText) {
+  const Expected e = makeLog(150000);
+  ScratchDir dir("flexarm_csv_parts_bad");
+  auto lineStart = [&](const std::string& text, int line) {
+    std::size_t p = 0;
+    for (int l = 1; l < line; ++l) p = text.find('\n', p) + 1;
+    return p;
+  };
+  std::string bad = e.text;
+  const std::size_t p1 = lineStart(bad, e.lineOfRow[120000]);
+  bad.insert(bad.find(',', p1) + 1, "x");
+  expectSameAsText(dir.write("bad.csv", bad), bad);
+
+  std::string gap = e.text;
+  const std::size_t p2 = lineStart(gap, e.lineOfRow[140000]);
+  gap.replace(p2, gap.find(',', p2) - p2, "140.0005");
+  expectSameAsText(dir.write("gap.csv", gap), gap);
+
+  std::string longLine = e.text;
+  longLine.insert(lineStart(longLine, e.lineOfRow[100000]), "# " + std::string(700000, 'c') + "\n");
+  const std::string longFile = dir.write("long.csv", longLine);
+  const LogReadResult r = readLog(longFile);
+  ASSERT_TRUE(r.ok) << r.error.toString();
+  EXPECT_EQ(r.data.samples(), e.t.size());
+  EXPECT_EQ(r.data.channel(columns::kMotorAngle)->values, e.y);
+  bool readWhole = true;
+  ASSERT_TRUE(readFlexArmCsv(longFile, {}, &readWhole).ok);
+  EXPECT_FALSE(readWhole) << "a line longer than a piece is read in parts too";
+}
 
 TEST(CsvFastPath, LargeMixedLogReadsExactlyAsWritten) {
   const Expected e = makeLog(200000);
