@@ -278,8 +278,9 @@ def plot(rows, info, stem):
         ax.text(v * 1.08, yi, fmt_ratio(v), va="center", fontsize=7)
     ax.set_xlim(min(0.5, min(values) / 2), max(values) * 4)
     ax.set_title(wrap(f"FlexArm against its peers ({info['cpu']}, {info['cores']} cores)", 60) +
-                 "\nblue: results agree, red: they do not, grey: not compared\n"
-                 "(the closed-loop bias and coverage study has no peer and is not shown)",
+                 "\nblue: results agree, red: they do not, grey: not compared" +
+                 ("\n(the closed-loop bias and coverage study has no peer and is not shown)"
+                  if study_rows(rows) else ""),
                  fontsize=8)
     files = []
     for ext in ("png", "svg"):
