@@ -3,7 +3,8 @@
 Usage: peer_signal.py gradient IN OUT REPEATS N
          numpy.gradient (second order inside and at the ends) of the second channel
        peer_signal.py decimate IN OUT REPEATS N FACTOR
-         scipy.signal.decimate(ftype="fir", zero_phase=True) of each channel
+         scipy.signal.decimate(ftype="fir", zero_phase=True) of each channel; the taps of
+         the filter it uses (firwin(20 FACTOR + 1, 1 / FACTOR, hamming)) go to OUT.taps
        peer_signal.py resample IN OUT REPEATS N UP DOWN
          scipy.signal.resample_poly(up, down) of each channel
 Writes the result to OUT (raw float64) and prints {"name", "seconds"}."""
@@ -29,6 +30,8 @@ def main():
         q = int(sys.argv[6])
         sec, out = median_seconds(repeats, lambda: np.concatenate(
             [signal.decimate(c, q, ftype="fir", zero_phase=True) for c in x]))
+        # The filter scipy.signal.decimate designs for ftype="fir" (its source: n = 20 q).
+        signal.firwin(20 * q + 1, 1.0 / q, window="hamming").tofile(dst + ".taps")
     np.asarray(out, dtype=np.float64).tofile(dst)
     emit(mode, sec)
 
