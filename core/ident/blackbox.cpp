@@ -469,10 +469,38 @@ PolyEstimate refinePolynomial(const Eigen::VectorXd& u, const Eigen::VectorXd& y
   predictors.reserve(segments.size());
   Eigen::Index used = 0;  // the rows in the criterion
   for (const auto& g : segments) {
-    us.push_back(u.segment(g.from, g.n));
-    ys.push_back(y.segment(g.from, g.n));
-    predictors.emplace_back(us.back(), ys.back(), initial.orders);
+    if (segments.size() == 1) {  // the record itself, not a copy
+      predictors.emplace_back(u, y, initial.orders);
+    } else {
+      us.push_back(u.segment(g.from, g.n));
+      ys.push_back(y.segment(g.from, g.n));
+      predictors.emplace_back(us.back(), ys.back(), initial.orders);
+    }
     used += std::max<Eigen::Index>(0, g.n - predictors.back().criterionStart());
+  }
+  // Coarse to fine: on one long record the search first runs on its first samples (at least
+  // 4000, at most a quarter of the record), whose minimum lies within the statistical spread
+  // of the whole record's, and then continues on the whole record from there: only the last
+  // few iterations cost a pass over every sample. That start is taken only when the whole
+  // record's loss there is lower than at the given start; the answer is the whole record's
+  // minimum either way.
+  PolynomialModel start = initial;
+  const Eigen::Index coarse = std::max<Eigen::Index>(4000, n / 16);
+  if (segments.size() == 1 && options.maxIterations > 0 && coarse * 4 <= n) {
+    PolyEstimateOptions first = options;
+    first.relativeTolerance = std::max(options.relativeTolerance, 1e-6);
+    const PolyEstimate c = refinePolynomial(u.head(coarse), y.head(coarse), initial, first);
+    if (c.summary.termination == Termination::Converged ||
+        c.summary.termination == Termination::MaxIterations) {
+      const double there = predictors.front().run(c.model);
+      if (std::isfinite(there) && predictors.front().run(initial, nullptr, nullptr, there) > there)
+        start = c.model;
+    }
+    if (reportProgress(progress, 0.0, "iterating")) {
+      s.termination = Termination::Cancelled;
+      s.message = "cancelled by the user";
+      return r;
+    }
   }
   // Several experiments: each one's squared errors weighted by lambda / lambda_k once a first
   // fit has estimated its noise variance (empty: unweighted), as pem does.
@@ -507,7 +535,7 @@ PolyEstimate refinePolynomial(const Eigen::VectorXd& u, const Eigen::VectorXd& y
       work.setParameterVector(th);
       if (stabilize(work)) th = work.parameterVector();
     };
-  LeastSquaresSolution sol = levenbergMarquardt(problem, initial.parameterVector(),
+  LeastSquaresSolution sol = levenbergMarquardt(problem, start.parameterVector(),
                                                 options.maxIterations, options.relativeTolerance,
                                                 options.initialDamping, progress);
   if (predictors.size() > 1 && sol.summary.termination != Termination::Failed &&

@@ -159,6 +159,34 @@ TEST(Bj, PredictorIsKeptStableFromAnUnstableStart) {
   EXPECT_LT(maxRootMagnitude(r.model.f), 1.0);
 }
 
+// A long record is searched coarse to fine (first on its first samples, then on all of
+// them): from a far start it reaches the whole record's minimum, the same one a search from
+// the truth reaches, and only the last few iterations run over all samples.
+TEST(Oe, LongRecordReachesTheWholeRecordsMinimumInFewFullIterations) {
+  auto s = simulateSystem(kOne, kB, kOne, kOne, kA, 64000, 0.5, 1);
+  PolyEstimateOptions tight;
+  tight.relativeTolerance = 1e-12;
+  PolynomialModel far = PolynomialModel::zero(PolyStructure::Oe, {0, 2, 0, 0, 2, 1}, 1.0);
+  far.b = {0.0, 0.8, 0.3};
+  far.f = {1.0, -1.2, 0.5};
+  PolynomialModel truth = far;
+  truth.b = kB;
+  truth.f = kA;
+  const PolyEstimate fromFar = refinePolynomial(s.u, s.y, far, tight);
+  const PolyEstimate fromTruth = refinePolynomial(s.u, s.y, truth, tight);
+  ASSERT_EQ(fromFar.summary.termination, Termination::Converged) << fromFar.summary.message;
+  EXPECT_LE((fromFar.model.parameterVector() - fromTruth.model.parameterVector()).cwiseAbs().maxCoeff(), 1e-7);
+  EXPECT_NEAR(fromFar.summary.loss, fromTruth.summary.loss, 1e-12 * fromTruth.summary.loss);
+  // The first 4000 samples alone take 8 iterations from this start.
+  EXPECT_LE(fromFar.summary.iterations, 5);
+  // The same search on several experiments (no coarse stage) reaches the same minimum.
+  PolyEstimateOptions halves = tight;
+  halves.experimentLengths = {32000, 32000};
+  const PolyEstimate split = refinePolynomial(s.u, s.y, far, halves);
+  ASSERT_TRUE(split.summary.ok()) << split.summary.message;
+  EXPECT_LE((split.model.parameterVector() - fromTruth.model.parameterVector()).cwiseAbs().maxCoeff(), 2e-3);
+}
+
 TEST(Evaluation, KStepPredictionLimitsAreOneStepAndSimulation) {
   auto s = simulateSystem(kA, kB, kC, kOne, kOne, 300, 0.5, 11);
   PolynomialModel m = PolynomialModel::zero(PolyStructure::Armax, {2, 2, 1, 0, 0, 1}, 1.0);
