@@ -1,5 +1,7 @@
 #include "core/ident/nonparametric.h"
 
+#include "core/common/parallel.h"
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -132,9 +134,13 @@ NonparametricEstimate etfe(const Eigen::VectorXd& u, const Eigen::VectorXd& y, d
   if (!checkSignals(u, y, ts, r, 8)) return r;
   const int n = static_cast<int>(u.size());
   // DFTs of u and y (4.24); their scaling cancels in the ratios.
+  // On a long record the two transforms, and below the three smoothings, run at once.
+  const unsigned threads = threadsFor(static_cast<std::size_t>(n), 16384);
   std::vector<std::complex<double>> U(static_cast<std::size_t>(n / 2 + 1)), Y(U.size());
-  realDft(u.data(), n, U.data());
-  realDft(y.data(), n, Y.data());
+  inParallel(std::min(threads, 2u), [&](unsigned k) {
+    if (k == 0 || threads == 1) realDft(u.data(), n, U.data());
+    if (k == 1 || threads == 1) realDft(y.data(), n, Y.data());
+  });
   const int nb = n / 2;
   const double dw = 2.0 * M_PI / (n * ts);
   const int width = std::max(1, options.smoothingWidth);
@@ -163,9 +169,11 @@ NonparametricEstimate etfe(const Eigen::VectorXd& u, const Eigen::VectorXd& y, d
     // The smoothed spectra of bins 1..nb replace the raw ones in place, from index 1 on.
     double *num = cross.data() + 1, *numIm = crossIm.data() + 1, *den = power.data() + 1;
     const int taps = static_cast<int>(weight.size());
-    correlate(num, weight.data(), taps, num, nb);
-    correlate(numIm, weight.data(), taps, numIm, nb);
-    correlate(den, weight.data(), taps, den, nb);
+    double* const spectra[] = {num, numIm, den};
+    const unsigned parts = std::min(threads, 3u);
+    inParallel(parts, [&](unsigned k) {
+      for (unsigned j = k; j < 3; j += parts) correlate(spectra[j], weight.data(), taps, spectra[j], nb);
+    });
     response.omega.resize(static_cast<std::size_t>(nb));
     response.value.resize(response.omega.size());
     for (int k = 1; k <= nb; ++k) {

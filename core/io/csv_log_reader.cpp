@@ -9,9 +9,9 @@
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
-#include <thread>
 #include <unordered_set>
 
+#include "core/common/parallel.h"
 #include "core/io/input_file.h"
 #include "core/io/log_io.h"
 #include "core/io/reader_support.h"
@@ -147,15 +147,6 @@ std::size_t expectedRows(const char* b, const char* e, std::size_t bytes, std::s
   return static_cast<std::size_t>(1.05 * static_cast<double>(bytes) / mean) + 16;
 }
 
-// Runs work(0..n-1), each on its own thread (the last on the calling one).
-template <class Work>
-void inParallel(unsigned n, Work work) {
-  std::vector<std::thread> pool;
-  for (unsigned k = 0; k + 1 < n; ++k) pool.emplace_back(work, k);
-  work(n - 1);
-  for (auto& t : pool) t.join();
-}
-
 // What the lines before the data rows say: metadata, the header, where the rows start.
 struct Head {
   IdData data;  // metadata only
@@ -256,9 +247,7 @@ HeadStatus parseHead(std::string_view text, bool whole, const std::string& path,
 }
 
 // Threads for `bytes` of data rows: one per core for large logs.
-unsigned threadsFor(std::size_t bytes) {
-  return bytes > (4u << 20) ? std::clamp(std::thread::hardware_concurrency(), 1u, 8u) : 1u;
-}
+unsigned rowThreads(std::size_t bytes) { return bytes > (4u << 20) ? threadsFor(bytes, 1) : 1u; }
 
 long holesColumn(const Head& h, const LogReadOptions& options) {
   return options.keepIrregularTime ? static_cast<long>(h.timeIndex) : -1L;
@@ -270,7 +259,7 @@ std::vector<Chunk> parseRowsInMemory(std::string_view text, const Head& h, const
   const char* const dataBegin = text.data() + h.dataStart;
   const char* const dataEnd = text.data() + text.size();
   const std::size_t dataBytes = text.size() - h.dataStart;
-  const unsigned threads = threadsFor(dataBytes);
+  const unsigned threads = rowThreads(dataBytes);
   std::vector<Chunk> chunks(threads);
   std::vector<std::pair<const char*, const char*>> parts(threads);
   const char* b = dataBegin;
@@ -306,7 +295,7 @@ bool parseRowsFromFile(const InputFile& file, std::string_view head, const Head&
   const std::size_t nCols = h.header.size();
   const std::size_t size = static_cast<std::size_t>(file.size());
   const std::size_t dataBytes = size - h.dataStart;
-  const unsigned threads = threadsFor(dataBytes);
+  const unsigned threads = rowThreads(dataBytes);
   chunks.assign(threads, Chunk{});
   std::vector<char> trouble(threads, 0);
   const char* const sampleBegin = head.data() + std::min(h.dataStart, head.size());
