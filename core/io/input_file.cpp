@@ -86,6 +86,16 @@ std::unique_ptr<char, FileBufferDeleter> allocateBuffer(std::size_t n) {
 
 }  // namespace
 
+std::unique_ptr<char, FileBufferDeleter> sparseFileBuffer(std::size_t n) {
+  if (n >= (1u << 20)) {  // a private anonymous mapping: no page is zeroed before it is used
+    const std::size_t len = n + 1;
+    void* p = ::mmap(nullptr, len, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
+    if (p != MAP_FAILED)
+      return std::unique_ptr<char, FileBufferDeleter>(static_cast<char*>(p), FileBufferDeleter{len});
+  }
+  return std::unique_ptr<char, FileBufferDeleter>(new char[n + 1](), FileBufferDeleter{0});
+}
+
 namespace {
 
 // The checks on what stat says: a regular file of at most maxBytes.

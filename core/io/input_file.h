@@ -24,6 +24,10 @@ struct FileBytes {
   std::string_view view() const { return {data.get(), size}; }
 };
 
+// A buffer of n + 1 bytes whose pages cost nothing until first written, for a file of n bytes
+// read only in the parts that are needed.
+std::unique_ptr<char, FileBufferDeleter> sparseFileBuffer(std::size_t n);
+
 // Asks the kernel to back [p, p + bytes) with huge pages where it can (a large buffer then
 // costs hundreds of page faults instead of hundreds of thousands); no effect on small ones.
 void preferHugePages(void* p, std::size_t bytes);

@@ -20,8 +20,9 @@ constexpr std::uint64_t kMaxElements = 1ull << 40;
 
 const char* const kNotMat = "not a readable MATLAB .mat file (damaged, or not a .mat file at all)";
 
-// Bytes per element of a level-5 data type; 0 when the type holds no numbers.
-std::uint64_t typeSize(std::uint32_t t) {
+}  // namespace
+
+std::uint64_t matTypeSize(std::uint32_t t) {
   switch (t) {
     case 1: case 2: case 16: return 1;       // int8, uint8, utf8
     case 3: case 4: case 17: return 2;       // int16, uint16, utf16
@@ -30,6 +31,8 @@ std::uint64_t typeSize(std::uint32_t t) {
     default: return 0;
   }
 }
+
+namespace {
 
 std::string sprintfString(const char* format, unsigned long long a, unsigned long long b) {
   char buf[200];
@@ -46,9 +49,19 @@ struct Tag {
 
 class Level5 {
  public:
-  Level5(bool swap, std::uint64_t budget, MatCheck& found)
-      : swap_(swap), inflateLeft_(budget), found_(found) {}
+  Level5(bool swap, std::uint64_t budget, MatCheck& found, const Byte* base, std::uint64_t size,
+         const MatLoad& load)
+      : swap_(swap), inflateLeft_(budget), found_(found), base_(base), size_(size), load_(load) {}
   std::string problem;
+
+  // Makes [p, p + n) readable: with a loader, bytes of the file not read yet are read (an
+  // inflated body is in memory already).
+  bool need(const Byte* p, std::uint64_t n) {
+    if (!load_ || n == 0 || p < base_ || p >= base_ + size_) return true;
+    const auto off = static_cast<std::uint64_t>(p - base_);
+    if (load_(off, std::min(n, size_ - off))) return true;
+    return fail("the file cannot be read (it changed or shrank while being read)");
+  }
 
   std::uint32_t u32(const Byte* p) const {
     std::uint32_t v;
@@ -59,6 +72,7 @@ class Level5 {
   // The sub-element at p (small or normal form); false when it does not fit before end.
   bool tag(const Byte* p, const Byte* end, Tag& t, const std::string& where) {
     if (end - p < 8) return fail(where + ": an element is cut short");
+    if (!need(p, 8)) return false;
     const std::uint32_t first = u32(p);
     if (first >> 16) {  // small data element: type and size in one word, data in the next
       t.type = first & 0xffff;
@@ -90,6 +104,7 @@ class Level5 {
     if (!tag(p, end, flags, where0)) return false;
     if (flags.type != kMiUint32 || flags.nbytes != 8)
       return fail(where0 + ": the array flags are damaged");
+    if (!need(flags.data, 8)) return false;
     const std::uint32_t word = u32(flags.data);
     const std::uint32_t cls = word & 0xff;
     const bool complex = (word & (1u << 11)) != 0;
@@ -97,6 +112,7 @@ class Level5 {
     if (!tag(p, end, dims, where0)) return false;
     if (dims.type != kMiInt32 || dims.nbytes % 4 != 0 || dims.nbytes < 8 || dims.nbytes > 4 * 32)
       return fail(where0 + ": the dimensions are damaged");
+    if (!need(dims.data, dims.nbytes)) return false;
     std::uint64_t count = 1;
     for (std::uint64_t i = 0; i < dims.nbytes / 4; ++i) {
       const auto d = static_cast<std::int32_t>(u32(dims.data + 4 * i));
@@ -109,6 +125,7 @@ class Level5 {
     if (!tag(p, end, name, where0)) return false;
     if (name.type != kMiInt8 || name.nbytes > kMaxName)
       return fail(where0 + ": the variable name is damaged or longer than 4096 characters");
+    if (!need(name.data, name.nbytes)) return false;
     const std::string where =
         name.nbytes ? "variable '" + std::string(reinterpret_cast<const char*>(name.data), name.nbytes) + "'"
                     : where0;
@@ -132,6 +149,7 @@ class Level5 {
         Tag len, names;
         if (!tag(p, end, len, where)) return false;
         if (len.type != kMiInt32 || len.nbytes != 4) return fail(where + ": the struct is damaged");
+        if (!need(len.data, 4)) return false;
         const std::uint64_t l = u32(len.data);
         p += len.total;
         if (!tag(p, end, names, where)) return false;
@@ -153,7 +171,7 @@ class Level5 {
           if (p == end && count == 0) return true;
           Tag data;
           if (!tag(p, end, data, where)) return false;
-          const std::uint64_t size = typeSize(data.type);
+          const std::uint64_t size = matTypeSize(data.type);
           if (size == 0) return fail(where + ": the data have an unknown number type");
           if (count > data.nbytes / size)
             return fail(where + sprintfString(": the array claims %llu elements but its data hold %llu",
@@ -182,6 +200,7 @@ class Level5 {
 
   // A compressed variable: inflated within the budget, then checked as an array.
   bool compressed(const Byte* p, std::uint64_t n, const std::string& where) {
+    if (!need(p, n)) return false;
     z_stream z{};
     if (inflateInit(&z) != Z_OK) return fail(where + ": cannot start decompressing");
     struct End {
@@ -223,6 +242,7 @@ class Level5 {
     int index = 0;
     while (n - off >= 8) {
       const std::string where = "variable " + std::to_string(++index);
+      if (!need(p + off, 8)) return false;
       const std::uint32_t type = u32(p + off);
       const std::uint64_t nbytes = u32(p + off + 4);
       if (nbytes > n - off - 8)
@@ -252,6 +272,9 @@ class Level5 {
   bool swap_;
   std::uint64_t inflateLeft_;
   MatCheck& found_;
+  const Byte* base_;
+  std::uint64_t size_;
+  const MatLoad& load_;
 };
 
 // Level 4: records of five int32 (type MOPT, rows, columns, imaginary flag, name length),
@@ -295,10 +318,14 @@ bool level4(const Byte* p, std::uint64_t n, std::string& problem) {
 
 }  // namespace
 
-MatCheck checkMatFile(std::string_view bytes, std::uint64_t inflateBudget) {
+MatCheck checkMatFile(std::string_view bytes, std::uint64_t inflateBudget, const MatLoad& load) {
   MatCheck r;
   const auto* p = reinterpret_cast<const Byte*>(bytes.data());
   const std::uint64_t n = bytes.size();
+  if (load && !load(0, std::min<std::uint64_t>(n, 128))) {
+    r.problem = "the file cannot be read";
+    return r;
+  }
   if (n >= 128 && ((p[126] == 'I' && p[127] == 'M') || (p[126] == 'M' && p[127] == 'I'))) {
     // Written as a 16-bit 'MI': read back as "IM" the file has this machine's byte order.
     const bool swap = p[126] == 'M';
@@ -311,7 +338,7 @@ MatCheck checkMatFile(std::string_view bytes, std::uint64_t inflateBudget) {
     if (version == 0x0100) {
       r.kind = MatKind::V5;
       r.swapBytes = swap;
-      Level5 walker(swap, inflateBudget, r);
+      Level5 walker(swap, inflateBudget, r, p, n, load);
       r.ok = walker.file(p, n);
       r.problem = walker.problem;
       if (!r.ok) {
@@ -322,6 +349,10 @@ MatCheck checkMatFile(std::string_view bytes, std::uint64_t inflateBudget) {
     }
   }
   r.kind = MatKind::V4;
+  if (load && !load(0, n)) {  // a level-4 file is walked whole
+    r.problem = "the file cannot be read";
+    return r;
+  }
   if (n == 0) {
     r.problem = kNotMat;
     return r;

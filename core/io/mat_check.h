@@ -7,6 +7,7 @@
 // size, and only what FlexArm can use is let through (numeric, logical, char, cell and struct
 // arrays; sparse matrices and objects are refused by name).
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <string>
 #include <string_view>
@@ -41,10 +42,20 @@ struct MatCheck {
   std::vector<std::unique_ptr<unsigned char[]>> inflated;  // bodies of compressed variables
 };
 
+// Bytes per element of a level-5 data type; 0 when the type holds no numbers.
+std::uint64_t matTypeSize(std::uint32_t type);
+
+// Brings the file's bytes [offset, offset + n) into the same place of the memory the check
+// walks; false when they cannot be read.
+using MatLoad = std::function<bool(std::uint64_t offset, std::uint64_t n)>;
+
 // Checks the bytes of a whole .mat file (level 4, level 5 / v7, or the HDF5-based v7.3 whose
 // variables are bounded later from their dimensions). inflateBudget bounds the bytes the
 // compressed variables of a v7 file may inflate to, all together. For a level-5 file the
 // result lists its variables, pointing into `bytes` (which must outlive their use).
-MatCheck checkMatFile(std::string_view bytes, std::uint64_t inflateBudget);
+// With load, `bytes` is memory of the file's size that holds only what load brought in: the
+// check loads every byte it reads first, and leaves a level-5 file's numeric data (nearly all
+// of a log) to the reader, which can then read them straight to where they go.
+MatCheck checkMatFile(std::string_view bytes, std::uint64_t inflateBudget, const MatLoad& load = {});
 
 }  // namespace flexarm

@@ -6,6 +6,7 @@
 #include <Eigen/Core>
 
 #include <algorithm>
+#include <atomic>
 #include <climits>
 #include <cmath>
 #include <cstdint>
@@ -16,6 +17,7 @@
 #include <type_traits>
 #include <vector>
 
+#include "core/common/parallel.h"
 #include "core/io/input_file.h"
 #include "core/io/log_io.h"
 #include "core/io/mat_check.h"
@@ -96,9 +98,31 @@ bool decodeLevel5(const MatVariable& v, bool swap, double* out, std::size_t n) {
 
 // The variables of a checked file: a level-5 file is decoded from the bytes the check has
 // just walked (one read of the file); level 4 and the HDF5-based v7.3 are read by matio.
+// Where a checked level-5 file's bytes are: `base` holds what the check loaded, and the rest
+// (numeric data) is read from the file when a variable is read.
+struct Level5Source {
+  const InputFile* file = nullptr;  // null: base holds the whole file
+  const unsigned char* base = nullptr;
+  std::uint64_t size = 0;
+  MatLoad load;
+};
+
+// Reads the file's bytes [offset, offset + n) to `into`; false when they cannot all be read.
+bool readExactly(const InputFile& file, std::uint64_t offset, unsigned char* into, std::uint64_t n) {
+  while (n > 0) {
+    const long long r = file.readAt(offset, reinterpret_cast<char*>(into), static_cast<std::size_t>(n));
+    if (r <= 0) return false;
+    offset += static_cast<std::uint64_t>(r);
+    into += r;
+    n -= static_cast<std::uint64_t>(r);
+  }
+  return true;
+}
+
 class MatVariables {
  public:
-  MatVariables(const MatCheck& check, mat_t* mat) : check_(check), mat_(mat) {}
+  MatVariables(const MatCheck& check, mat_t* mat, Level5Source source = {})
+      : check_(check), mat_(mat), source_(std::move(source)) {}
   ~MatVariables() { Mat_VarFree(var_); }
   MatVariables(const MatVariables&) = delete;
   MatVariables& operator=(const MatVariables&) = delete;
@@ -167,7 +191,29 @@ class MatVariables {
  private:
   template <class T>
   bool readAs(double* out, std::size_t n) {
-    if (!mat_) return decodeLevel5<T>(*level5_, check_.swapBytes, out, n);
+    if (!mat_) {
+      const MatVariable& v = *level5_;
+      const unsigned char* base = source_.base;
+      if (source_.file && v.data >= base && v.data < base + source_.size) {
+        // Data the check left in the file: doubles in this machine's byte order go straight
+        // to `out` (a large variable in parts on every core: one core does not saturate the
+        // memory), anything else is loaded and decoded.
+        const auto offset = static_cast<std::uint64_t>(v.data - base);
+        const std::uint64_t bytes = n * matTypeSize(v.dataType);
+        if (bytes > source_.size - offset) return false;
+        if (std::is_same_v<T, double> && v.dataType == 9 && !check_.swapBytes) {
+          std::atomic<bool> ok{true};
+          parallelRanges(n, threadsFor(bytes, 2u << 20), [&](std::size_t from, std::size_t to) {
+            if (!readExactly(*source_.file, offset + from * sizeof(double),
+                             reinterpret_cast<unsigned char*>(out + from), (to - from) * sizeof(double)))
+              ok = false;
+          });
+          return ok;
+        }
+        if (!source_.load(offset, bytes)) return false;
+      }
+      return decodeLevel5<T>(v, check_.swapBytes, out, n);
+    }
     constexpr bool direct = std::is_same_v<T, double>;
     std::vector<T> own(direct ? 0 : n);
     void* into = direct ? static_cast<void*>(out) : static_cast<void*>(own.data());
@@ -180,6 +226,7 @@ class MatVariables {
 
   const MatCheck& check_;
   mat_t* mat_ = nullptr;
+  Level5Source source_;
   matvar_t* var_ = nullptr;
   const MatVariable* level5_ = nullptr;
 };
@@ -227,18 +274,35 @@ bool readMatVector(MatVariables& vars, const std::string& path, const std::strin
 
 LogReadResult readMat(const std::string& path, const LogReadOptions& options) {
   LogReadResult fail;
-  // The structure is checked on the bytes, which a level-5 file is then decoded from.
-  FileBytes bytes;
+  // The structure is checked on the file's bytes, which a level-5 file is then decoded from.
+  // Only the parts the check reads (tags, names, dimensions, compressed variables) are read
+  // into memory, in blocks; the numeric data go straight from the file to the signals.
+  InputFile file;
   std::string problem;
-  if (!readInputFile(path, options.maxFileBytes, bytes, &problem))
-    return failure(path, 0, 0, {}, problem);
+  if (!file.open(path, options.maxFileBytes, &problem)) return failure(path, 0, 0, {}, problem);
+  const auto size = static_cast<std::size_t>(file.size());
+  std::unique_ptr<char, FileBufferDeleter> bytes = sparseFileBuffer(size);
+  constexpr std::uint64_t kBlock = 64u << 10;
+  std::vector<char> loaded((size + kBlock - 1) / kBlock, 0);
+  MatLoad load = [&](std::uint64_t offset, std::uint64_t n) {
+    if (n == 0) return true;
+    if (offset > size || n > size - offset) return false;
+    for (std::uint64_t b = offset / kBlock; b <= (offset + n - 1) / kBlock; ++b) {
+      if (loaded[b]) continue;
+      const std::uint64_t from = b * kBlock, count = std::min<std::uint64_t>(kBlock, size - from);
+      if (!readExactly(file, from, reinterpret_cast<unsigned char*>(bytes.get()) + from, count)) return false;
+      loaded[b] = 1;
+    }
+    return true;
+  };
+  const std::string_view view(bytes.get(), size);
   // zlib inflates at most 1032 times its input: no honest variable is larger than that.
-  const std::uint64_t budget = std::min<std::uint64_t>(options.maxFileBytes, 1032ull * bytes.size + 65536);
-  const MatCheck check = checkMatFile(bytes.view(), budget);
+  const std::uint64_t budget = std::min<std::uint64_t>(options.maxFileBytes, 1032ull * size + 65536);
+  const MatCheck check = checkMatFile(view, budget, load);
   if (!check.ok) return failure(path, 0, 0, {}, check.problem);
   mat_t* mat = nullptr;
   if (check.kind != MatKind::V5) {
-    bytes = FileBytes{};  // matio reads the file itself
+    bytes.reset();  // matio reads the file itself
     // matio prints its own complaints to stderr; FlexArm reports one sentence instead.
     Mat_LogInitFunc("flexarm", [](int, char*) {});
     mat = Mat_Open(path.c_str(), MAT_ACC_RDONLY);
@@ -252,7 +316,8 @@ LogReadResult readMat(const std::string& path, const LogReadOptions& options) {
       if (m) Mat_Close(m);
     }
   } guard{mat};
-  MatVariables vars(check, mat);
+  MatVariables vars(check, mat,
+                    Level5Source{&file, reinterpret_cast<const unsigned char*>(bytes.get()), size, load});
 
   // Variable names: the FlexArm column names, or u/y, or the user's mapping; with the bytes
   // their elements take.

@@ -104,6 +104,32 @@ TEST(MatRead, EveryClassLayoutAndCompressionGivesTheSameDoubles) {
   fs::remove_all(tempDir());
 }
 
+// A large level-5 file is checked on the parts the check reads and its numbers are read
+// straight from the file (over several threads for a long double variable): every element
+// arrives, across every block border.
+TEST(MatRead, LargeFileReadsEveryElementStraightFromTheFile) {
+  const std::size_t n = 600001;  // 4.8 MB per double variable
+  const fs::path p = tempDir() / "large.mat";
+  writeMat(p, MAT_FT_MAT5, MAT_COMPRESSION_NONE, false, n);
+  const LogReadResult r = readLog(p.string());
+  ASSERT_TRUE(r.ok) << r.error.toString();
+  ASSERT_EQ(r.data.samples(), n);
+  const Channel* u = r.data.channel("u");
+  const Channel* y = r.data.channel("y");
+  const Channel* k = r.data.channel("k");
+  const Channel* j = r.data.channel("j");
+  ASSERT_TRUE(u && y && k && j);
+  std::size_t wrong = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    wrong += u->values[i] != std::sin(0.3 * static_cast<double>(i)) + 1e-9 * static_cast<double>(i);
+    wrong += y->values[i] != static_cast<double>(static_cast<float>(0.25 * static_cast<double>(i)));
+    wrong += k->values[i] != static_cast<double>(static_cast<int>(i % 700) - 350);
+    wrong += j->values[i] != static_cast<double>(static_cast<std::int32_t>(i * 1000));
+  }
+  EXPECT_EQ(wrong, 0u);
+  fs::remove_all(tempDir());
+}
+
 TEST(MatRead, NonFiniteElementsMatricesAndTextAreRefusedByName) {
   const fs::path p = tempDir() / "refused.mat";
   const std::size_t n = 100;
