@@ -57,7 +57,8 @@ class Level5 {
   // Makes [p, p + n) readable: with a loader, bytes of the file not read yet are read (an
   // inflated body is in memory already).
   bool need(const Byte* p, std::uint64_t n) {
-    if (!load_ || n == 0 || p < base_ || p >= base_ + size_) return true;
+    const std::less<const Byte*> before;  // a total order, also for an inflated body's pointers
+    if (!load_ || n == 0 || before(p, base_) || !before(p, base_ + size_)) return true;
     const auto off = static_cast<std::uint64_t>(p - base_);
     if (load_(off, std::min(n, size_ - off))) return true;
     return fail("the file cannot be read (it changed or shrank while being read)");

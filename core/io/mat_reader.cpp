@@ -194,7 +194,8 @@ class MatVariables {
     if (!mat_) {
       const MatVariable& v = *level5_;
       const unsigned char* base = source_.base;
-      if (source_.file && v.data >= base && v.data < base + source_.size) {
+      const std::less<const unsigned char*> before;  // a total order, also for inflated bodies
+      if (source_.file && !before(v.data, base) && before(v.data, base + source_.size)) {
         // Data the check left in the file: doubles in this machine's byte order go straight
         // to `out` (a large variable in parts on every core: one core does not saturate the
         // memory), anything else is loaded and decoded.
