@@ -3,9 +3,12 @@
 // straightforward NumPy/SciPy implementation (scipy.linalg.expm of the extended matrix each
 // sample) on the same data, start and P(0); and the whole `flexarm recursive` process against
 // the log's duration (no peer has it: the row gives the real-time factor), on the chapter-6
-// sample log (24 s at 2 kHz) and on ten minutes logged at 200 Hz.
+// sample log (24 s at 2 kHz) and on ten minutes logged at 200 Hz; and the whole chapter-7
+// `flexarm diagnose` process on the step logs, its verdict against each log's truth.
 #include <cmath>
 #include <fstream>
+#include <utility>
+#include <vector>
 
 #include "bench_common.h"
 #include "core/io/log_io.h"
@@ -148,10 +151,58 @@ void wholeProcess(const std::string& log, const std::string& size) {
   emit(row);
 }
 
+// Diagnosis (chapter 7), the whole `flexarm diagnose` process on the 24 s sample logs with a
+// step at 12 s (or none) against the fault-free reference log: the verdict against the log's
+// truth, and the time against the log's duration.
+void diagnosisProcess() {
+  const std::string logs = std::string(FLEXARM_SOURCE_DIR) + "/sample_logs/";
+  const LogReadResult read = readLog(logs + "diagnosis_step_none.csv");
+  const double duration = read.ok ? read.data.duration() : 0.0;
+  const double samples = read.ok ? static_cast<double>(read.data.samples()) : 0.0;
+  for (const auto& [file, truth] : std::vector<std::pair<std::string, std::string>>{
+           {"k_T", "k_T"}, {"J_a_inv", "J_a"}, {"f_m", "f_m"}, {"none", "none"}}) {
+    bool ok = true;
+    std::string out;
+    const double t = medianSeconds(repeats(3), [&] {
+      out = capture(std::string(FLEXARM_EXECUTABLE) + " diagnose '" + logs + "diagnosis_step_" + file +
+                        ".csv' --reference-log '" + logs + "diagnosis_no_fault.csv' --model three-mass --json",
+                    &ok);
+    }, true);
+    Row row;
+    row.group = "diagnosis (chapter 7)";
+    row.task = "flexarm diagnose, whole process (reference fit, P(0), tests): " +
+               (truth == "none" ? std::string("no fault") : "a 20 % step in " + truth + " at 12 s");
+    row.size = "24 s log at 2 kHz and a 24 s reference";
+    row.flexarmSeconds = t;
+    row.peer = "none (no peer has it)";
+    row.extra["times_real_time"] = duration / t;
+    if (samples > 0) row.extra["us_per_sample"] = 1e6 * t / samples;
+    std::string verdict = "no answer";
+    double at = NAN;
+    try {
+      const Json j = Json::parse(out.substr(out.find('{')));
+      verdict = j["verdict"].get<std::string>();
+      if (j.contains("alarm_time_s") && j["alarm_time_s"].is_number()) at = j["alarm_time_s"].get<double>();
+    } catch (const std::exception&) {
+      ok = false;
+    }
+    row.agree = ok && verdict == truth && (truth == "none" || at > 12.0);
+    std::ostringstream s;
+    s.precision(3);
+    s << "verdict " << verdict;
+    if (std::isfinite(at)) s << " at " << at << " s";
+    s << " (the log's truth: " << (truth == "none" ? "no fault" : truth + " from 12 s") << "); "
+      << duration / t << "x real time";
+    row.agreement = s.str();
+    emit(row);
+  }
+}
+
 }  // namespace
 
 int main() {
   perSample();
+  diagnosisProcess();
   wholeProcess(std::string(FLEXARM_SOURCE_DIR) + "/sample_logs/diagnosis_no_fault.csv",
                "24 s log at 2 kHz (the chapter-6 sample log)");
   // Ten minutes logged at 200 Hz: the seed's rate, nothing to decimate.
