@@ -450,11 +450,11 @@ LogReadResult finishLog(Head& h, std::vector<Chunk>& chunks, bool haveText, std:
   return ok;
 }
 
-LogReadResult readWholeFile(const std::string& path, const LogReadOptions& options) {
+// The file read whole and parsed as text.
+LogReadResult readWholeFile(const InputFile& file, const std::string& path, const LogReadOptions& options) {
   FileBytes bytes;
   std::string problem;
-  if (!readInputFile(path, options.maxFileBytes, bytes, &problem))
-    return failure(path, 0, 0, {}, problem);
+  if (!file.readAll(bytes, &problem)) return failure(path, 0, 0, {}, problem);
   return readFlexArmCsvText(bytes.view(), path, options);
 }
 
@@ -471,36 +471,36 @@ LogReadResult readFlexArmCsvText(std::string_view text, const std::string& path,
 }
 
 LogReadResult readFlexArmCsv(const std::string& path, const LogReadOptions& options, bool* readWhole) {
+  InputFile file;
+  std::string problem;
+  if (!file.open(path, options.maxFileBytes, &problem)) return failure(path, 0, 0, {}, problem);
+  return io::readFlexArmCsvFile(file, path, options, readWhole);
+}
+
+LogReadResult io::readFlexArmCsvFile(const InputFile& file, const std::string& path,
+                                     const LogReadOptions& options, bool* readWhole) {
   // The first bytes give metadata and header; a small file is then parsed in memory, a large
   // one straight from the file. Whatever needs the text as a whole (a bad line's number, an
   // irregular time column, a header beyond the first bytes, a file that changed while read)
   // is read again the simple way, so both ways give the same result.
   constexpr std::size_t kHead = 64u << 10;
   if (readWhole) *readWhole = true;
-  InputFile file;
-  std::string problem;
-  if (!file.open(path, options.maxFileBytes, &problem)) return failure(path, 0, 0, {}, problem);
-  const std::size_t size = static_cast<std::size_t>(file.size());
-  if (size <= kHead) return readWholeFile(path, options);
+  const auto size = static_cast<std::size_t>(file.size());
+  if (size <= kHead) return readWholeFile(file, path, options);
   std::string head(kHead, '\0');
-  std::size_t got = 0;
-  while (got < kHead) {
-    const long long r = file.readAt(got, head.data() + got, kHead - got);
-    if (r <= 0) return readWholeFile(path, options);
-    got += static_cast<std::size_t>(r);
-  }
+  if (file.readFully(0, head.data(), kHead) < kHead) return readWholeFile(file, path, options);
   Head h;
   LogReadResult fail;
   switch (parseHead(head, false, path, h, fail)) {
     case HeadStatus::Failed: return fail;
-    case HeadStatus::NeedMore: return readWholeFile(path, options);
+    case HeadStatus::NeedMore: return readWholeFile(file, path, options);
     case HeadStatus::Ok: break;
   }
   std::vector<Chunk> chunks;
-  if (!parseRowsFromFile(file, head, h, options, chunks)) return readWholeFile(path, options);
+  if (!parseRowsFromFile(file, head, h, options, chunks)) return readWholeFile(file, path, options);
   bool needText = false;
   LogReadResult r = finishLog(h, chunks, false, {}, path, options, needText);
-  if (needText) return readWholeFile(path, options);
+  if (needText) return readWholeFile(file, path, options);
   if (readWhole) *readWhole = false;
   return r;
 }

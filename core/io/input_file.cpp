@@ -160,11 +160,25 @@ long long InputFile::readAt(std::uint64_t offset, char* dst, std::size_t n) cons
   }
 }
 
+std::size_t InputFile::readFully(std::uint64_t offset, char* dst, std::size_t n) const {
+  std::size_t got = 0;
+  while (got < n) {
+    const long long r = readAt(offset + got, dst + got, n - got);
+    if (r <= 0) break;
+    got += static_cast<std::size_t>(r);
+  }
+  return got;
+}
+
 bool readInputFile(const std::string& path, std::uint64_t maxBytes, FileBytes& out,
                    std::string* problem) {
   InputFile file;
-  if (!file.open(path, maxBytes, problem)) return false;
-  const std::uint64_t bytes = file.size();
+  return file.open(path, maxBytes, problem) && file.readAll(out, problem);
+}
+
+bool InputFile::readAll(FileBytes& out, std::string* problem) const {
+  const InputFile& file = *this;
+  const std::uint64_t bytes = size_;
   out.size = 0;
   out.data = allocateBuffer(static_cast<std::size_t>(bytes));
   // A large file is read in parts by several threads at once: copying from the disk cache is

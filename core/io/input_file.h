@@ -57,6 +57,12 @@ class InputFile {
   // Reads up to n bytes at offset into dst (retrying interrupted reads); the count read, 0 at
   // the end of the file, or -1 with errno set.
   long long readAt(std::uint64_t offset, char* dst, std::size_t n) const;
+  // Reads n bytes at offset into dst, as many calls as it takes; the count read, less than n
+  // only at the end of the file or on a failed read.
+  std::size_t readFully(std::uint64_t offset, char* dst, std::size_t n) const;
+  // The whole file as it is now (at most the size it had when opened), as readInputFile gives
+  // it; false with a sentence when a read fails.
+  bool readAll(FileBytes& out, std::string* problem) const;
 
  private:
   int fd_ = -1;

@@ -91,32 +91,26 @@ LogReadResult readLog(const std::string& path, const LogReadOptions& options) {
     case LogFormat::Mat: return readMat(path, options);
     case LogFormat::Auto: break;
   }
-  if (hasExtension(path, ".mat")) return readMat(path, options);
-  // The format is sniffed from the first bytes: the MATLAB magic means .mat, names on the
-  // first non-comment line a FlexArm log, numbers a table. The chosen reader then reads the
-  // file its own way (a large FlexArm log straight from the file, in parts).
-  constexpr std::size_t kSniff = 64u << 10;
+  // The file is opened once and handed to its reader. The format is sniffed from the first
+  // bytes: the MATLAB magic means .mat, names on the first non-comment line a FlexArm log,
+  // numbers a table; each reader then reads the file its own way (a large FlexArm log
+  // straight from the file in parts, a .mat file where its structure says).
   InputFile file;
   std::string problem;
   if (!file.open(path, options.maxFileBytes, &problem)) return io::failure(path, 0, 0, {}, problem);
+  if (hasExtension(path, ".mat")) return io::readMatFile(file, path, options);
+  constexpr std::size_t kSniff = 64u << 10;
   std::string head(static_cast<std::size_t>(std::min<std::uint64_t>(file.size(), kSniff)), '\0');
-  std::size_t got = 0;
-  while (got < head.size()) {
-    const long long r = file.readAt(got, head.data() + got, head.size() - got);
-    if (r <= 0) break;
-    got += static_cast<std::size_t>(r);
-  }
-  head.resize(got);
-  if (head.compare(0, 6, "MATLAB") == 0) return readMat(path, options);
-  switch (sniffText(head, got >= file.size())) {
-    case Sniffed::FlexArmCsv: return readFlexArmCsv(path, options);
-    case Sniffed::Table: return readTable(path, options);
+  head.resize(file.readFully(0, head.data(), head.size()));
+  if (head.compare(0, 6, "MATLAB") == 0) return io::readMatFile(file, path, options);
+  switch (sniffText(head, head.size() >= file.size())) {
+    case Sniffed::FlexArmCsv: return io::readFlexArmCsvFile(file, path, options);
+    case Sniffed::Table: return io::readTableFile(file, path, options);
     case Sniffed::Undecided: break;
   }
   // Comments beyond the first bytes: decided on the whole text.
   FileBytes bytes;
-  if (!readInputFile(path, options.maxFileBytes, bytes, &problem))
-    return io::failure(path, 0, 0, {}, problem);
+  if (!file.readAll(bytes, &problem)) return io::failure(path, 0, 0, {}, problem);
   const std::string_view text = bytes.view();
   if (sniffText(text, true) == Sniffed::Table) return readTableText(text, path, options);
   return readFlexArmCsvText(text, path, options);  // also reports the empty or comment-only file

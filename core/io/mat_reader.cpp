@@ -107,18 +107,6 @@ struct Level5Source {
   MatLoad load;
 };
 
-// Reads the file's bytes [offset, offset + n) to `into`; false when they cannot all be read.
-bool readExactly(const InputFile& file, std::uint64_t offset, unsigned char* into, std::uint64_t n) {
-  while (n > 0) {
-    const long long r = file.readAt(offset, reinterpret_cast<char*>(into), static_cast<std::size_t>(n));
-    if (r <= 0) return false;
-    offset += static_cast<std::uint64_t>(r);
-    into += r;
-    n -= static_cast<std::uint64_t>(r);
-  }
-  return true;
-}
-
 class MatVariables {
  public:
   MatVariables(const MatCheck& check, mat_t* mat, Level5Source source = {})
@@ -205,8 +193,9 @@ class MatVariables {
         if (std::is_same_v<T, double> && v.dataType == 9 && !check_.swapBytes) {
           std::atomic<bool> ok{true};
           parallelRanges(n, threadsFor(bytes, 2u << 20), [&](std::size_t from, std::size_t to) {
-            if (!readExactly(*source_.file, offset + from * sizeof(double),
-                             reinterpret_cast<unsigned char*>(out + from), (to - from) * sizeof(double)))
+            const std::size_t bytesHere = (to - from) * sizeof(double);
+            if (source_.file->readFully(offset + from * sizeof(double), reinterpret_cast<char*>(out + from),
+                                        bytesHere) != bytesHere)
               ok = false;
           });
           return ok;
@@ -274,13 +263,17 @@ bool readMatVector(MatVariables& vars, const std::string& path, const std::strin
 }  // namespace
 
 LogReadResult readMat(const std::string& path, const LogReadOptions& options) {
+  InputFile file;
+  std::string problem;
+  if (!file.open(path, options.maxFileBytes, &problem)) return failure(path, 0, 0, {}, problem);
+  return io::readMatFile(file, path, options);
+}
+
+LogReadResult io::readMatFile(const InputFile& file, const std::string& path, const LogReadOptions& options) {
   LogReadResult fail;
   // The structure is checked on the file's bytes, which a level-5 file is then decoded from.
   // Only the parts the check reads (tags, names, dimensions, compressed variables) are read
   // into memory, in blocks; the numeric data go straight from the file to the signals.
-  InputFile file;
-  std::string problem;
-  if (!file.open(path, options.maxFileBytes, &problem)) return failure(path, 0, 0, {}, problem);
   const auto size = static_cast<std::size_t>(file.size());
   std::unique_ptr<char, FileBufferDeleter> bytes = sparseFileBuffer(size);
   constexpr std::uint64_t kBlock = 64u << 10;
@@ -291,7 +284,7 @@ LogReadResult readMat(const std::string& path, const LogReadOptions& options) {
     for (std::uint64_t b = offset / kBlock; b <= (offset + n - 1) / kBlock; ++b) {
       if (loaded[b]) continue;
       const std::uint64_t from = b * kBlock, count = std::min<std::uint64_t>(kBlock, size - from);
-      if (!readExactly(file, from, reinterpret_cast<unsigned char*>(bytes.get()) + from, count)) return false;
+      if (file.readFully(from, bytes.get() + from, count) != count) return false;
       loaded[b] = 1;
     }
     return true;

@@ -18,7 +18,18 @@
 #define FLEXARM_HAVE_FAST_FLOAT 0
 #endif
 
+namespace flexarm {
+class InputFile;
+}
+
 namespace flexarm::io {
+
+// The readers on a file already open and checked: readLog opens a file once, sniffs its first
+// bytes and hands it to one of these; readFlexArmCsv, readTable and readMat open and call them.
+LogReadResult readFlexArmCsvFile(const InputFile& file, const std::string& path,
+                                 const LogReadOptions& options, bool* readWhole = nullptr);
+LogReadResult readTableFile(const InputFile& file, const std::string& path, const LogReadOptions& options);
+LogReadResult readMatFile(const InputFile& file, const std::string& path, const LogReadOptions& options);
 
 LogReadResult failure(const std::string& file, int line, int column, std::string columnName,
                       std::string problem);

@@ -126,8 +126,15 @@ LogReadResult readTableText(std::string_view text, const std::string& path,
 LogReadResult readTable(const std::string& path, const LogReadOptions& options) {
   std::string why;
   if (!options.isValid(&why)) return failure(path, 0, 0, {}, "bad column mapping: " + why);
+  InputFile file;
+  if (!file.open(path, options.maxFileBytes, &why)) return failure(path, 0, 0, {}, why);
+  return io::readTableFile(file, path, options);
+}
+
+LogReadResult io::readTableFile(const InputFile& file, const std::string& path, const LogReadOptions& options) {
+  std::string why;
   FileBytes bytes;
-  if (!readInputFile(path, options.maxFileBytes, bytes, &why)) return failure(path, 0, 0, {}, why);
+  if (!file.readAll(bytes, &why)) return failure(path, 0, 0, {}, why);
   return readTableText(bytes.view(), path, options);
 }
 
