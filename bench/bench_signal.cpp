@@ -43,28 +43,37 @@ std::vector<double> readRaw(const std::string& path) {
   return v;
 }
 
-// Largest over channels of RMS(mine - theirs) / RMS(mine), ignoring `skip` samples at each
-// end (where the peers' edge handling differs); theirs holds the channels one after another,
-// each as long as mine or (a grid that ends one sample later or earlier) one sample longer
-// or shorter.
-double relativeRms(const std::vector<std::vector<double>>& mine, const std::vector<double>& theirs,
-                   std::size_t skip) {
+// The largest over channels of relative(m, t, n), where m is one of FlexArm's channels and t
+// the peer's same channel in `theirs` (the channels one after another, each as long as mine
+// or, a grid that ends one sample later or earlier, one sample longer or shorter) and n the
+// samples both have; infinite when the shapes do not match.
+template <class Relative>
+double worstChannel(const std::vector<std::vector<double>>& mine, const std::vector<double>& theirs,
+                    Relative relative) {
   if (mine.empty() || theirs.size() % mine.size() != 0) return INFINITY;
   const std::size_t each = theirs.size() / mine.size();
   double worst = 0.0;
   std::size_t at = 0;
   for (const auto& m : mine) {
     if (each + 1 < m.size() || m.size() + 1 < each) return INFINITY;
-    const std::size_t n = std::min(m.size(), each);
-    double d2 = 0.0, s2 = 0.0;
-    for (std::size_t i = skip; i + skip < n; ++i) {
-      d2 += (m[i] - theirs[at + i]) * (m[i] - theirs[at + i]);
-      s2 += m[i] * m[i];
-    }
-    worst = std::max(worst, std::sqrt(d2 / std::max(s2, 1e-300)));
+    worst = std::max(worst, relative(m, theirs.data() + at, std::min(m.size(), each)));
     at += each;
   }
   return worst;
+}
+
+// Largest over channels of RMS(mine - theirs) / RMS(mine), ignoring `skip` samples at each
+// end (where the peers' edge handling differs).
+double relativeRms(const std::vector<std::vector<double>>& mine, const std::vector<double>& theirs,
+                   std::size_t skip) {
+  return worstChannel(mine, theirs, [&](const std::vector<double>& m, const double* t, std::size_t n) {
+    double d2 = 0.0, s2 = 0.0;
+    for (std::size_t i = skip; i + skip < n; ++i) {
+      d2 += (m[i] - t[i]) * (m[i] - t[i]);
+      s2 += m[i] * m[i];
+    }
+    return std::sqrt(d2 / std::max(s2, 1e-300));
+  });
 }
 
 // The peers' decimation filters are short windowed FIRs whose passband is not flat: Octave's
@@ -84,21 +93,16 @@ double relativeRms(const std::vector<std::vector<double>>& mine, const std::vect
 // Largest over channels of RMS(theirs - H mine) / RMS(mine); `theirs` as in relativeRms.
 double relativeRmsThroughFilter(const std::vector<std::vector<double>>& mine, const std::vector<double>& theirs,
                                 const std::vector<double>& taps, int factor, std::size_t skip, std::size_t taper) {
-  if (mine.empty() || taps.empty() || theirs.size() % mine.size() != 0) return INFINITY;
-  const std::size_t each = theirs.size() / mine.size();
-  double worst = 0.0;
-  std::size_t at = 0;
-  for (const auto& m : mine) {
-    if (each + 1 < m.size() || m.size() + 1 < each) return INFINITY;
-    const std::size_t n = std::min(m.size(), each);
-    if (n < 2 * (skip + taper) + 2) return INFINITY;
+  if (taps.empty()) return INFINITY;
+  return worstChannel(mine, theirs, [&](const std::vector<double>& m, const double* t, std::size_t n) {
+    if (n < 2 * (skip + taper) + 2) return static_cast<double>(INFINITY);
     const std::size_t len = n - 2 * skip;
     std::vector<double> a(len), b(len);
     for (std::size_t i = 0; i < len; ++i) {
       const std::size_t fromEnd = std::min(i, len - 1 - i);
       const double w = fromEnd >= taper ? 1.0 : 0.5 - 0.5 * std::cos(M_PI * static_cast<double>(fromEnd) / static_cast<double>(taper));
       a[i] = w * m[skip + i];
-      b[i] = w * theirs[at + skip + i];
+      b[i] = w * t[skip + i];
     }
     const std::size_t bins = len / 2 + 1;
     std::vector<std::complex<double>> A(bins), B(bins);
@@ -114,10 +118,8 @@ double relativeRmsThroughFilter(const std::vector<std::vector<double>>& mine, co
       d2 += weight * std::norm(B[k] - h * A[k]);
       s2 += weight * std::norm(A[k]);
     }
-    worst = std::max(worst, std::sqrt(d2 / std::max(s2, 1e-300)));
-    at += each;
-  }
-  return worst;
+    return std::sqrt(d2 / std::max(s2, 1e-300));
+  });
 }
 
 std::string percent(const std::string& what, double rel) {
