@@ -18,6 +18,10 @@ inline constexpr const char* kMotorAngle = "motor_angle_rad";
 inline constexpr const char* kMotorVelocity = "motor_velocity_rad_s";
 inline constexpr const char* kAngleRef = "angle_ref_rad";
 inline constexpr const char* kArmAccel = "arm_accel_rad_s2";
+// A secondary, arm-side encoder: the arm angle itself (not scaled to the motor side).
+inline constexpr const char* kArmAngle = "arm_angle_rad";
+// Motor or gearbox temperature.
+inline constexpr const char* kTemperature = "temperature_c";
 }  // namespace columns
 
 enum class ChannelRole { None, Input, Output, Reference };

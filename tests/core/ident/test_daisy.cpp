@@ -14,7 +14,7 @@ namespace {
 TEST(Daisy, RobotArmGetsNonparametricBlackBoxAndResidualAnalysis) {
   LogReadOptions opt;
   opt.format = LogFormat::Table;
-  const auto read = readTable(FLEXARM_SHARED_DATA_DIR "/daisy_robot_arm.dat", opt);
+  const auto read = readTable(FLEXARM_SAMPLE_DIR "/daisy_robot_arm.dat", opt);
   ASSERT_TRUE(read.ok) << read.error.toString();
   Eigen::VectorXd u, y;
   inputOutput(read.data, u, y);

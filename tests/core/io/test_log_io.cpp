@@ -164,7 +164,7 @@ TEST(LogIo, HeaderlessTableWithMappingAndSampleTime) {
   o.inputColumn = 1;
   o.outputColumn = 2;
   o.sampleTime = 0.01;
-  LogReadResult r = readLog(std::string(FLEXARM_SHARED_DATA_DIR) + "/daisy_robot_arm.dat", o);
+  LogReadResult r = readLog(std::string(FLEXARM_SAMPLE_DIR) + "/daisy_robot_arm.dat", o);
   ASSERT_TRUE(r.ok) << r.error.toString();
   EXPECT_EQ(r.data.samples(), 1024u);
   EXPECT_DOUBLE_EQ(r.data.sampleTime, 0.01);
@@ -175,12 +175,12 @@ TEST(LogIo, HeaderlessTableWithMappingAndSampleTime) {
   // Swapping the mapping swaps the roles.
   o.inputColumn = 2;
   o.outputColumn = 1;
-  LogReadResult s = readLog(std::string(FLEXARM_SHARED_DATA_DIR) + "/daisy_robot_arm.dat", o);
+  LogReadResult s = readLog(std::string(FLEXARM_SAMPLE_DIR) + "/daisy_robot_arm.dat", o);
   ASSERT_TRUE(s.ok);
   EXPECT_DOUBLE_EQ(s.data.input()->values[0], -1.7703630e-01);
   // A mapping beyond the table's columns is refused.
   o.inputColumn = 3;
-  LogReadResult t = readLog(std::string(FLEXARM_SHARED_DATA_DIR) + "/daisy_robot_arm.dat", o);
+  LogReadResult t = readLog(std::string(FLEXARM_SAMPLE_DIR) + "/daisy_robot_arm.dat", o);
   ASSERT_FALSE(t.ok);
   EXPECT_NE(t.error.problem.find("uses column 3"), std::string::npos) << t.error.toString();
 }
