@@ -176,6 +176,12 @@ void PlotTools::exportDialog() {
 
 void PlotTools::copyData() const { QApplication::clipboard()->setText(dataAsCsv()); }
 
+void keepRectsTall(QCustomPlot* plot, int perRect) {
+  const int rects = static_cast<int>(plot->axisRects().size());
+  // What is not a rect (title, legend rows, the last time axis' labels) on top.
+  plot->setMinimumHeight(std::max(1, rects) * perRect + 40);
+}
+
 void placeLegendAbove(QCustomPlot* plot, QCPAxisRect* rect) {
   QCPLegend* legend = plot->legend;
   if (!rect) rect = plot->axisRect();
