@@ -290,9 +290,13 @@ void MainWindow::createMenus() {
 void MainWindow::showWholeTabTitles() {
   // Eleven panels share one dock area: their tabs keep whole titles and scroll, rather than
   // reading "Prepr...", "M...".
+  // A point smaller than the window's text, so that on a laptop's dock all eleven fit.
+  QFont small = font();
+  small.setPointSizeF(std::max(7.0, small.pointSizeF() - 1.0));
   for (QTabBar* bar : findChildren<QTabBar*>(Qt::FindDirectChildrenOnly)) {
     bar->setElideMode(Qt::ElideNone);
     bar->setUsesScrollButtons(true);
+    bar->setFont(small);
   }
 }
 

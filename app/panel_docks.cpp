@@ -45,6 +45,8 @@ class SwitcherKeys : public QObject {
 
 PanelDocks::PanelDocks(QMainWindow* window, QMenu* viewMenu)
     : QObject(window), window_(window), viewMenu_(viewMenu) {
+  // The tabs above the panels, where a tabbed window has them.
+  window_->setTabPosition(Qt::AllDockWidgetAreas, QTabWidget::North);
   QAction* find = viewMenu_->addAction(tr("&Panels..."), this, &PanelDocks::openSwitcher);
   find->setObjectName("panelSwitcherAction");
   find->setShortcut(QKeySequence("Ctrl+K"));

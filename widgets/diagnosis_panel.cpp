@@ -114,7 +114,7 @@ DiagnosisPanel::DiagnosisPanel(Workspace* workspace, QWidget* parent)
   estimates_->setMinimumHeight(170);
   setupPlot(cusum_, tr("g / h [-]"));
   setupPlot(hypothesis_, tr("T [-]"));
-  for (QCustomPlot* p : {cusum_, hypothesis_}) placeLegendAbove(p);  // no curve under a legend
+  for (QCustomPlot* p : {cusum_, hypothesis_}) showLegendAbove(p);  // none until a result
   setupPlot(timeline_, "");
   timeline_->legend->setVisible(false);
   timeline_->yAxis->setRange(-0.3, 5.0);
@@ -369,6 +369,7 @@ void DiagnosisPanel::clearResult() {
   for (QCustomPlot* p : {estimates_, cusum_, hypothesis_, timeline_}) {
     p->clearGraphs();
     p->clearItems();
+    showLegendAbove(p);  // without entries: out of the layout
     p->replot();
   }
   shown_.clear();

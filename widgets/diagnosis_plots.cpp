@@ -158,6 +158,7 @@ void DiagnosisPanel::buildPlots() {
                                  : QString::fromStdString(defaultThresholdsProvenance());
   thresholds_->setText(tr("Thresholds (sigma units, CUSUM alpha_2, level): %1. %2. Reference: %3.")
                            .arg(th.join("; "), from, QString::fromStdString(r.referenceSource)));
+  for (QCustomPlot* p : {cusum_, hypothesis_}) showLegendAbove(p);  // above the data, no curve under it
   for (QCustomPlot* p : {estimates_, cusum_, hypothesis_, timeline_}) p->replot();
 }
 

@@ -103,6 +103,15 @@ class DiagnosisPanelTest : public QObject {
     QTest::qWait(200);
     test::saveShot(window_->grab().toImage(), "diagnosis_window_at_alarm");
     test::saveShot(panel()->grab().toImage(), "diagnosis_panel_at_alarm");
+    // Issue 31, problem 4: each parameter's estimate gets a plot tall enough for its labels,
+    // and no legend lies over the data.
+    const auto rects = panel()->estimatesPlot()->axisRects();
+    QCOMPARE(rects.size(), 3);
+    for (QCPAxisRect* rect : rects) QVERIFY2(rect->height() >= 60, qPrintable(QString::number(rect->height())));
+    for (QCustomPlot* p : {panel()->cusumPlot(), panel()->hypothesisPlot()}) {
+      QVERIFY(p->legend->visible() && !qobject_cast<QCPLayoutInset*>(p->legend->layout()));
+      QVERIFY(!p->legend->outerRect().intersects(p->axisRect()->rect()));
+    }
   }
 
   void sessionKeepsTheRequest() {

@@ -27,6 +27,7 @@
 #include "core/session/report.h"
 #include "widget_test_support.h"
 #include "widgets/arm_panel.h"
+#include "widgets/diagnosis_panel.h"
 #include "widgets/log_panel.h"
 #include "widgets/model_panel.h"
 #include "widgets/plots/bode_plot.h"
@@ -164,6 +165,10 @@ class LaptopTest : public QObject {
     QVERIFY(!switcher->isVisible());
     QVERIFY(inFront(dock("diagnosisDock")));
     test::saveShot(window_->grab().toImage(), "laptop_switcher_diagnosis");
+    // Its plots span the dock before any result (no empty legend row narrowing them).
+    for (QCustomPlot* p : window_->diagnosisPanel()->findChildren<QCustomPlot*>())
+      QVERIFY2(p->axisRect()->width() > p->width() / 2,
+               qPrintable(QString("%1 of %2 px").arg(p->axisRect()->width()).arg(p->width())));
   }
 
   // A panel floated and docked again is the tab in front, not another one.

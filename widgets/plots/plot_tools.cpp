@@ -182,6 +182,19 @@ void keepRectsTall(QCustomPlot* plot, int perRect) {
   plot->setMinimumHeight(std::max(1, rects) * perRect + 40);
 }
 
+void showLegendAbove(QCustomPlot* plot) {
+  QCPLegend* legend = plot->legend;
+  if (!legend) return;
+  const bool entries = legend->itemCount() > 0;
+  auto* grid = qobject_cast<QCPLayoutGrid*>(legend->layout());
+  if (entries && !grid) placeLegendAbove(plot);
+  if (!entries && grid) {
+    grid->take(legend);
+    grid->simplify();
+  }
+  legend->setVisible(entries);
+}
+
 void placeLegendAbove(QCustomPlot* plot, QCPAxisRect* rect) {
   QCPLegend* legend = plot->legend;
   if (!rect) rect = plot->axisRect();
