@@ -16,6 +16,7 @@
 #include <QSpinBox>
 #include <QLineEdit>
 #include <QTableWidget>
+#include <QEvent>
 #include <QTimer>
 #include <QVBoxLayout>
 #include <QtConcurrent>
@@ -211,7 +212,7 @@ FitPanel::FitPanel(Workspace* workspace, QWidget* parent)
   summary_->setTextFormat(Qt::PlainText);
   summary_->setTextInteractionFlags(Qt::TextSelectableByMouse);
   summary_->setAlignment(Qt::AlignLeft | Qt::AlignTop);
-  summary_->setMinimumHeight(4 * summary_->fontMetrics().lineSpacing());
+  summary_->installEventFilter(this);  // its height follows its text (eventFilter)
 
   auto* studyBox = new QGroupBox(tr("Sensitivity study (Section 5.3.3)"), this);
   studyRuns_->setRange(1, 100000);
@@ -485,7 +486,7 @@ void FitPanel::startProgress() {
 
 void FitPanel::cancel() {
   abort_->store(true);
-  summary_->setText(tr("Cancelling..."));
+  setSummary(tr("Cancelling..."));
 }
 
 // The pipeline's options from the panel's choices and the workspace's data and ranges;
@@ -523,7 +524,7 @@ std::optional<FitOptions> FitPanel::options(QString* name, std::vector<Experimen
     auto start = clonePhysical(*base);
     const QStringList names = freeParameters();
     if (names.isEmpty()) {
-      summary_->setText(tr("Check at least one parameter to estimate."));
+      setSummary(tr("Check at least one parameter to estimate."));
       return std::nullopt;
     }
     for (const auto& p : base->parameters()) start->setFree(p.name, names.contains(QString::fromStdString(p.name)));
@@ -536,23 +537,23 @@ std::optional<FitOptions> FitPanel::options(QString* name, std::vector<Experimen
     o.randomStarts = starts_->value();
     std::string bad;
     if (!startsAndBoundsFromText(startsBounds_->text().toStdString(), o.startValues, o.bounds, &bad)) {
-      summary_->setText(tr("Starts and bounds: %1.").arg(QString::fromStdString(bad)));
+      setSummary(tr("Starts and bounds: %1.").arg(QString::fromStdString(bad)));
       return std::nullopt;
     }
   }
   if (!workspace_->current()) {
-    summary_->setText(tr("Open a log with an input and an output channel first."));
+    setSummary(tr("Open a log with an input and an output channel first."));
     return std::nullopt;
   }
   useWorkspaceData(*workspace_, o);
   std::string why;
   if (!o.isValid(&why)) {
-    summary_->setText(tr("The fit cannot run: %1").arg(QString::fromStdString(why)));
+    setSummary(tr("The fit cannot run: %1").arg(QString::fromStdString(why)));
     return std::nullopt;
   }
   auto list = experimentListFromText(more_->text().toStdString(), &why);
   if (!list) {
-    summary_->setText(tr("More experiments: %1.").arg(QString::fromStdString(why)));
+    setSummary(tr("More experiments: %1.").arg(QString::fromStdString(why)));
     return std::nullopt;
   }
   *more = *list;
@@ -577,7 +578,7 @@ bool FitPanel::recompute(const FitRequest& request) {
   useWorkspaceData(*workspace_, o);
   std::string why;
   if (!o.isValid(&why)) {
-    summary_->setText(tr("%1 cannot be recomputed on the open data: %2")
+    setSummary(tr("%1 cannot be recomputed on the open data: %2")
                                .arg(QString::fromStdString(request.name), QString::fromStdString(why)));
     return false;
   }
@@ -614,7 +615,7 @@ void FitPanel::start(const FitOptions& o, const QString& name, const std::vector
   record->provenance->validation = record->validation;
   table_->setRowCount(0);
   workspace_->forgetResult("fit");
-  summary_->setText(tr("Estimating %1...").arg(QString::fromStdString(o.model.name())));
+  setSummary(tr("Estimating %1...").arg(QString::fromStdString(o.model.name())));
   startProgress();
   const auto progress = progressCallback();
   // The one fit pipeline (core/ident/fit.h), as `flexarm fit` and a session's replay run it.
@@ -647,7 +648,7 @@ void FitPanel::onFinished() {
   progress_->setValue(ok ? 1000 : 0);
   if (!ok) {
     const QString reason = !out.error.isEmpty() ? out.error : QString::fromStdString(r.message);
-    summary_->setText(r.termination == Termination::Cancelled ? tr("Cancelled: %1").arg(reason)
+    setSummary(r.termination == Termination::Cancelled ? tr("Cancelled: %1").arg(reason)
                                                               : tr("The fit failed: %1").arg(reason));
     updateControls();
     emit estimated(false);
@@ -737,7 +738,7 @@ void FitPanel::onFinished() {
   out.request->stored = storedFitOf(r);
   entry.fitRequest = out.request;
   lines << tr("Added to the model list as \"%1\".").arg(name);
-  summary_->setText(lines.join("\n"));
+  setSummary(lines.join("\n"));
   lastIndex_ = workspace_->addModel(entry);
   lastName_ = name;
   // Shown only beside its data: the open data changed while it ran, it stays in the list.
@@ -824,7 +825,7 @@ void FitPanel::showStored(const FitRequest& request, int modelIndex) {
     lines << tr("The session keeps no numbers of this fit: Estimate computes them again.");
   }
   lines << tr("Estimate runs the fit again with these choices; the sensitivity study needs a new estimate.");
-  summary_->setText(lines.join("\n"));
+  setSummary(lines.join("\n"));
   if (!workspace_->recordResult("fit", request.provenance.value_or(workspace_->dataProvenance()))) withdraw();
   updateControls();
 }
@@ -841,12 +842,29 @@ void FitPanel::withdraw() {
   studyTable_->setRowCount(0);
   studySummary_->clear();
   progress_->setValue(0);
-  summary_->setText(lastName_.isEmpty()
+  setSummary(lastName_.isEmpty()
                              ? QString()
                              : tr("The last estimate, \"%1\", was computed on other data than the open "
                                   "ones: it stays in the model list under its name. Estimate again to fit "
                                   "these data.").arg(lastName_));
   updateControls();
+}
+
+void FitPanel::setSummary(const QString& text) {
+  summary_->setText(text);
+  fitSummaryHeight();
+}
+
+// A scroll area lays the panel out by its minimum height, which knows nothing of wrapped
+// text: the summary asks for the height its lines need at its width.
+void FitPanel::fitSummaryHeight() {
+  const int need = std::max(4 * summary_->fontMetrics().lineSpacing(), summary_->heightForWidth(summary_->width()));
+  if (summary_->minimumHeight() != need) summary_->setMinimumHeight(need);
+}
+
+bool FitPanel::eventFilter(QObject* watched, QEvent* event) {
+  if (watched == summary_ && event->type() == QEvent::Resize) fitSummaryHeight();
+  return QWidget::eventFilter(watched, event);
 }
 
 QString FitPanel::summaryText() const { return summary_->text(); }

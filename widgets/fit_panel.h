@@ -78,6 +78,10 @@ class FitPanel : public QWidget {
   QString studyText() const;
   void setStudyRuns(int runs);
 
+ protected:
+  // Keeps the summary as tall as its wrapped text at the width it has.
+  bool eventFilter(QObject* watched, QEvent* event) override;
+
  public slots:
   void estimate();
   // Runs a stored fit again (its model, start values, free parameters and options) on the
@@ -120,6 +124,8 @@ class FitPanel : public QWidget {
   void onFinished();
   void onStudyFinished();
   void fillTable(const std::vector<FitParameter>& parameters);
+  void setSummary(const QString& text);
+  void fitSummaryHeight();
   // Sets the controls to what a request asked.
   void setChoices(const FitRequest& request);
   // The result shown was of other data than the open ones (Workspace::resultWithdrawn).

@@ -630,6 +630,7 @@ void RecursivePanel::buildPlot() {
   plot_->setMinimumHeight(std::max(340, plot_->minimumHeight()));
   drawOverlay();
   buildLegend();
+  if (graphs_.empty()) plot_->plotLayout()->simplify();  // no legend: no empty row above
   cursor_->attach();
   shown_ = 0;
   plot_->replot();
