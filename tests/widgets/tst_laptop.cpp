@@ -27,6 +27,7 @@
 #include "core/session/report.h"
 #include "widget_test_support.h"
 #include "widgets/arm_panel.h"
+#include "widgets/bode_panel.h"
 #include "widgets/diagnosis_panel.h"
 #include "widgets/log_panel.h"
 #include "widgets/model_panel.h"
@@ -40,6 +41,13 @@ namespace {
 
 const QString kSampleLog = QString(FLEXARM_SAMPLE_DIR) + "/three_mass_estimation_chirp.csv";
 const QSize kLaptop(1366, 768 - 40), kDesktop(1920, 1080 - 40);
+
+// Waits (handling events) until done() holds, at most 60 s.
+template <class Done>
+bool waitUntil(Done done) {
+  for (int waited = 0; !done() && waited < 60000; waited += 20) QTest::qWait(20);
+  return done();
+}
 
 // The dock can be seen: shown, docked, and not behind another tab.
 bool inFront(const QDockWidget* d) { return d->isVisible() && !d->isFloating() && !d->visibleRegion().isEmpty(); }
@@ -254,6 +262,16 @@ class LaptopTest : public QObject {
     plot.addCurve(notchCurve("small", 1.0));
     QCOMPARE(plot.isCurveVisible(plot.addCurve(notchCurve("large", 1e4))), false);
     QVERIFY(mag->range().upper < 0.0);
+    // In the panel: a model's curve hidden from its legend stays hidden when SPA is ticked.
+    QVERIFY(window_->modelPanel()->newModel("three-mass") >= 0);
+    BodePanel* bode = window_->bodePanel();
+    QVERIFY(waitUntil([bode] { return !bode->isBusy() && bode->plot()->curveCount() >= 1; }));
+    bode->plot()->setCurveVisible(0, false);
+    bode->setNonparametricShown(true, false);
+    QVERIFY(waitUntil([bode] { return !bode->isBusy() && bode->plot()->curveCount() >= 2; }));
+    QVERIFY(!bode->plot()->isCurveVisible(0));
+    QVERIFY(bode->plot()->isCurveVisible(1));  // SPA
+    bode->setNonparametricShown(false, false);
   }
 
   // Problem 9: a report plot's legend sits outside the data and names each curve once (the
