@@ -38,14 +38,15 @@ json withProvenance(json section, const MainWindow& w, const char* key) {
 // A restored section's data become the panel's result record, so that saving again keeps
 // them and opening another log withdraws the result; a section without them (written
 // before provenance) is of the session's data. Raw: the part computes on the log as read.
-void keepProvenance(const json& section, MainWindow& w, const char* key, bool raw) {
+// False when the section names other data than the open ones: it is not to be shown.
+bool keepProvenance(const json& section, MainWindow& w, const char* key, bool raw) {
   Workspace* ws = w.workspace();
   if (section.is_null()) {
     ws->forgetResult(key);
-    return;
+    return true;
   }
   const auto stored = provenanceIn(section);
-  ws->recordResult(key, stored.value_or(ws->dataProvenance()), raw);
+  return ws->recordResult(key, stored.value_or(ws->dataProvenance()), raw);
 }
 
 json captureModels(const MainWindow& w) {
@@ -179,7 +180,7 @@ void restoreDiscovery(const json& section, MainWindow& w) {
     result = discoveryResultFromJson(section["result"], &why);
   if (w.discoveryPanel() && request && result) w.discoveryPanel()->showStored(*request, *result);
   else w.setProperty(kKeptDiscovery, QByteArray::fromStdString(section.dump()));
-  keepProvenance(section, w, "discovery", false);
+  if (!keepProvenance(section, w, "discovery", false)) resetDiscovery(w);  // of other data
 }
 
 // The LQG panel's design: parameters and where they came from, weights, saturation.
@@ -235,6 +236,11 @@ std::vector<LogReference> diagnosisLogs(const MainWindow& w) {
   return {l};
 }
 
+void resetDiagnosis(MainWindow& w) {
+  keepProvenance(nullptr, w, "diagnosis", true);
+  if (w.diagnosisPanel()) w.diagnosisPanel()->clearResult();
+}
+
 void restoreDiagnosis(const json& section, MainWindow& w) {
   std::string why;
   const auto request = diagnosisRequestFromJson(section["request"], &why);
@@ -243,13 +249,9 @@ void restoreDiagnosis(const json& section, MainWindow& w) {
                            ? QString()
                            : w.sessionController()->sessionLogPath(request->referenceLog);
   w.diagnosisPanel()->setRequest(*request, path, section.contains("result") ? section["result"] : json());
-  keepProvenance(section, w, "diagnosis", true);
+  if (!keepProvenance(section, w, "diagnosis", true)) resetDiagnosis(w);  // of another log
 }
 
-void resetDiagnosis(MainWindow& w) {
-  keepProvenance(nullptr, w, "diagnosis", true);
-  if (w.diagnosisPanel()) w.diagnosisPanel()->clearResult();
-}
 
 // The Recursive panel's runs (the overlaid previous one and the current one): each request
 // with the summary of its result when it ran to the end. Opening a session sets the panel's
@@ -302,7 +304,7 @@ void restoreRecursive(const json& section, MainWindow& w) {
                 .arg(finals.isEmpty() ? QObject::tr("estimates not stored") : finals.join(", ")));
       }
     }
-  keepProvenance(section, w, "recursive", true);
+  if (!keepProvenance(section, w, "recursive", true)) resetRecursive(w);  // of another log
 }
 
 json captureView(const MainWindow& w) {

@@ -143,6 +143,19 @@ class DiagnosisPanelTest : public QObject {
     QVERIFY(again.parts.contains("diagnosis"));
     QCOMPARE(again.parts["diagnosis"]["result"]["verdict"].get<std::string>(), std::string("k_T"));
     QVERIFY(again.parts["diagnosis"].contains("provenance"));
+    // A stored diagnosis of another log is not shown beside this one.
+    Session edited = loadSession(path.toStdString()).session;
+    edited.parts["diagnosis"]["provenance"]["sha256"] = std::string(64, '0');
+    const QString otherPath = dir.filePath("other_log.json");
+    std::string message;
+    QVERIFY2(saveSession(edited, otherPath.toStdString(), &message), message.c_str());
+    MainWindow third;
+    third.sessionController()->setOfferRecovery(false);
+    QSignalSpy reopened(third.sessionController(), &SessionController::sessionOpened);
+    third.sessionController()->open(otherPath);
+    QVERIFY(reopened.wait(30000));
+    QVERIFY2(!third.diagnosisPanel()->verdictText().contains("k_T"), qPrintable(third.diagnosisPanel()->verdictText()));
+    QVERIFY(!third.sessionController()->capture(otherPath).parts.contains("diagnosis"));
   }
 
   // Issue 31, problem 1: another log opened (Discard) shows no fault of the diagnosed one, and
