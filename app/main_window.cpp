@@ -192,8 +192,11 @@ MainWindow::MainWindow(QWidget* parent)
   // and are arranged for the screen's size. A layout kept from the last run comes back when
   // it was made for a screen of the same kind.
   const QRect screenRect = screen() ? screen()->availableGeometry() : QRect(0, 0, 1280, 860);
-  resize(std::min(1280, screenRect.width()), std::min(860, screenRect.height()));
-  docks_->arrange(PanelDocks::layoutFor(screenRect.size()));
+  const PanelDocks::Layout layout = PanelDocks::layoutFor(screenRect.size());
+  // A laptop's whole screen; nine tenths of a larger one.
+  if (layout == PanelDocks::Layout::Compact) resize(screenRect.size());
+  else resize(screenRect.width() * 9 / 10, screenRect.height() * 9 / 10);
+  docks_->arrange(layout);
   showWholeTabTitles();
   connect(this, &QMainWindow::tabifiedDockWidgetActivated, this, &MainWindow::showWholeTabTitles);
 
