@@ -15,6 +15,7 @@
 #include <qcustomplot.h>
 
 #include "app/main_window.h"
+#include "app/panel_docks.h"
 #include "app/session_controller.h"
 #include "core/session/session.h"
 #include "widget_test_support.h"
@@ -59,6 +60,7 @@ class DiagnosisPanelTest : public QObject {
   void initTestCase() {
     window_ = new MainWindow;
     window_->resize(1366, 768);
+    window_->docks()->arrange(PanelDocks::Layout::Compact);  // as on a 1366x768 laptop
     window_->show();
     QVERIFY(QTest::qWaitForWindowExposed(window_));
     auto* dock = window_->findChild<QDockWidget*>("diagnosisDock");
