@@ -189,6 +189,10 @@ def v73_small(out):
         log_variables(f, compression="gzip")
         s = f.create_group("settings")  # a struct: named and ignored
         matlab_class(s, "struct")
+        # Its field names as MATLAB and matio keep them: variable-length strings in the global heap.
+        names = numpy.empty(1, dtype=object)
+        names[0] = numpy.frombuffer(b"kp", dtype="S1")
+        s.attrs.create("MATLAB_fields", names, dtype=h5py.vlen_dtype(numpy.dtype("S1")))
         matlab_class(s.create_dataset("kp", data=numpy.array([[40.0]])), "double")
         refs = f.create_group("#refs#")
         cell = refs.create_dataset("a", data=numpy.array([[1.0, 2.0]]))

@@ -527,6 +527,7 @@ class Walker {
   void filters(Cursor& c, Object& o, const std::string& path) {
     const unsigned version = c.u8();
     const unsigned count = c.u8();
+    if (count > 32) refuse(path + " names " + std::to_string(count) + " filters, more than HDF5 allows (32)");
     if (version == 1) c.skip(6);
     else if (version != 2) refuse(path + " has a filter pipeline of unknown version");
     for (unsigned f = 0; f < count; ++f) {
@@ -792,6 +793,9 @@ class Walker {
   void chunked(Object& o, const std::string& path) {
     const Layout& l = o.layout;
     const std::uint64_t chunk = chunkBytes(o, path);
+    if (l.chunk.size() != o.dims.size() + 1)
+      refuse(path + "'s chunks have " + std::to_string(l.chunk.size() - 1) + " dimensions but its data " +
+             std::to_string(o.dims.size()) + " (the file is damaged)");
     const bool filtered = !o.filters.empty();
     if (l.index == 1) {
       chunkStored(l.address, filtered ? l.filteredSize : chunk, chunk, filtered, path);
@@ -801,16 +805,13 @@ class Walker {
       if (filtered) refuse(path + " has an implicit chunk index with filters (the file is damaged)");
       if (l.address != kUndefined) {
         std::uint64_t count = 1;
-        for (std::size_t d = 0; d < o.dims.size() && d < l.chunk.size(); ++d)
+        for (std::size_t d = 0; d < o.dims.size(); ++d)
           count = saturatingProduct(count, (o.dims[d] + l.chunk[d] - 1) / l.chunk[d]);
         atAddress(l.address, saturatingProduct(count, chunk), "the data of " + path);
       }
       return;
     }
     if (l.address == kUndefined) return;  // nothing written yet: fill values
-    if (l.chunk.size() != o.dims.size() + 1)
-      refuse(path + "'s chunks have " + std::to_string(l.chunk.size() - 1) + " dimensions but its data " +
-             std::to_string(o.dims.size()) + " (the file is damaged)");
     std::set<std::uint64_t> nodes;
     btreeChunks(l.address, o, path, chunk, filtered, nodes, 0, nullptr);
   }
@@ -837,7 +838,8 @@ class Walker {
       for (std::size_t d = 0; d + 1 < rank; ++d)
         if (offsets[d] % o.layout.chunk[d] != 0 || offsets[d] >= std::max<std::uint64_t>(o.dims[d], 1))
           refuse("a chunk of " + path + " lies outside its data (the file is damaged)");
-      const bool applied = filtered && (mask & ((1u << o.filters.size()) - 1)) != ((1u << o.filters.size()) - 1);
+      const std::uint64_t all = (std::uint64_t{1} << o.filters.size()) - 1;  // at most 32 filters
+      const bool applied = filtered && (mask & all) != all;
       chunkStored(child, stored, chunk, applied, path);
       if (sink) (*sink)(child, stored, mask, offsets);
     }

@@ -187,6 +187,26 @@ TEST(HostileTwo, CalibrationRunsBeyondTheBudgetAreRefusedBeforeSettingUp) {
                  "--runs expects a whole number from 1 to 100000, got '1000000'", 100);
 }
 
+TEST(HostileTwo, SessionCalibrationRunsBeyondTheBudgetWarnInsteadOfExhaustingMemory) {
+  // calibration_runs of a session's diagnosis part go through the same budget.
+  const fs::path session = flexarm::test::scratchDir() / "calibration_runs.json";
+  {
+    std::ofstream f(session);
+    f << R"({"format": "flexarm-session", "version": 1, "written_by": "FlexArm 0.1.0",
+            "logs": [{"name": "healthy", "path": ")" << kHealthy << R"(", "sha256": ")" << std::string(64, '0')
+      << R"(", "read": {"format": "auto"}}],
+            "preprocessing": {"applied": false, "differentiate_angle": false, "range_samples": null,
+                              "decimation": {"factor": 1, "filter": "fir", "stopband_db": 80.0}, "detrend": "none"},
+            "ranges": {"estimation_s": null, "validation_s": null},
+            "parts": {"diagnosis": {"request": {"log": "healthy", "reference_log": "healthy",
+                                                "structure": "three-mass", "seed_fault": null, "calibrate": true,
+                                                "calibration_runs": 100000}}}})";
+  }
+  const MeasuredRun r = confined({"run", session.string(), "--json"}, 120);
+  expectConfined(r, 0, "flexarm run: warning: diagnosis: could not run: the calibration is refused: ", 600);
+  EXPECT_NE(r.err.find("runs of 24 s would hold"), std::string::npos) << r.err;
+}
+
 TEST(HostileTwo, ResampleRateBeyondTheBudgetIsRefusedBeforeAllocating) {
   // 1e7 Hz built 2.86 GB before the rate was refused.
   const auto out = (flexarm::test::scratchDir() / "fine.csv").string();
