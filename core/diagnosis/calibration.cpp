@@ -230,7 +230,7 @@ CalibrationResult calibrateUnder(const DiagnosisReference& reference, const LogC
     for (DiagnosisTest t : options.tests)
       columns += t == DiagnosisTest::Hypothesis ? 1.0 : static_cast<double>(options.parameters.size());
     const double perRun = duration * rate * columns * sizeof(double) +
-                          static_cast<double>(conditions.simulation.referenceSignal.size()) * sizeof(double) * 2.0;
+                          static_cast<double>(conditions.simulation.referenceSignal.size()) * sizeof(double);
     const double total = static_cast<double>(calibration.healthyRuns) +
                          static_cast<double>(calibration.faultyRuns) * static_cast<double>(options.parameters.size());
     if (total * perRun > CalibrationOptions::kMaxCalibrationBytes) {
@@ -290,8 +290,9 @@ CalibrationResult monteCarlo(const std::vector<MonteCarloRun>& plan, const Diagn
   result.faults = options.parameters;
 
   // Runs of one arm share its reference: fitted first, once per arm, then every run; both in
-  // parallel, with progress and cancellation from this thread.
-  std::vector<MonteCarloRun> filled = plan;
+  // parallel, with progress and cancellation from this thread. The plan is not copied: each
+  // run is drawn from it with its reference when its turn comes.
+  std::vector<std::shared_ptr<const DiagnosisReference>> references(plan.size());
   std::vector<std::size_t> owner(plan.size());  // the first run of each arm fits its reference
   for (std::size_t i = 0; i < plan.size(); ++i) {
     owner[i] = i;
@@ -329,18 +330,24 @@ CalibrationResult monteCarlo(const std::vector<MonteCarloRun>& plan, const Diagn
     for (auto& t : pool) t.join();
   };
   parallel(plan.size(), [&](std::size_t i) {
+    references[i] = plan[i].reference;
     if (owner[i] != i || plan[i].reference) return;
     std::string problem;
-    filled[i].reference = referenceFor(plan[i], options, &problem);
-    if (!filled[i].reference) failures[i] = problem;
+    references[i] = referenceFor(plan[i], options, &problem);
+    if (!references[i]) failures[i] = problem;
   }, 0.0, 0.2);
   for (std::size_t i = 0; i < plan.size(); ++i)
     if (!failures[owner[i]].empty())
       return finish(Termination::Failed, "a simulated arm could not be referenced: " + failures[owner[i]]);
-    else if (!filled[i].reference)
-      filled[i].reference = filled[owner[i]].reference;
+    else if (!references[i])
+      references[i] = references[owner[i]];
   std::vector<RunTrace> runs(plan.size());
-  if (!cancel) parallel(plan.size(), [&](std::size_t i) { runs[i] = runOnce(filled[i], options); }, 0.2, 1.0);
+  if (!cancel)
+    parallel(plan.size(), [&](std::size_t i) {
+      MonteCarloRun run = plan[i];
+      run.reference = references[i];
+      runs[i] = runOnce(run, options);
+    }, 0.2, 1.0);
   if (cancel) return finish(Termination::Cancelled, "cancelled");
   for (std::size_t i = 0; i < runs.size(); ++i)
     if (!failures[i].empty()) runs[i].message = failures[i];

@@ -55,6 +55,18 @@ void expectConfined(const MeasuredRun& r, int code, const std::string& needle, l
   EXPECT_TRUE(r.outsideAccess.empty()) << joined(r.outsideAccess);
 }
 
+// A session of one log (its checksum unknown: the replay warns) and the given parts.
+void writeSession(const fs::path& path, const std::string& logName, const std::string& logPath,
+                  const std::string& parts) {
+  std::ofstream f(path);
+  f << R"({"format": "flexarm-session", "version": 1, "written_by": "FlexArm 0.1.0", "logs": [{"name": ")"
+    << logName << R"(", "path": ")" << logPath << R"(", "sha256": ")" << std::string(64, '0')
+    << R"(", "read": {"format": "auto"}}], "preprocessing": {"applied": false, "differentiate_angle": false,
+    "range_samples": null, "decimation": {"factor": 1, "filter": "fir", "stopband_db": 80.0}, "detrend": "none"},
+    "ranges": {"estimation_s": null, "validation_s": null}, "parts": )"
+    << parts << "}";
+}
+
 std::string bigFile(const std::string& name, const std::string& extension) {
   std::string file = flexarm::test::bigHostileFile(name, extension);
   if (file.empty()) ADD_FAILURE() << "scripts/make_hostile_data.py --big could not make " << name;
@@ -190,18 +202,9 @@ TEST(HostileTwo, CalibrationRunsBeyondTheBudgetAreRefusedBeforeSettingUp) {
 TEST(HostileTwo, SessionCalibrationRunsBeyondTheBudgetWarnInsteadOfExhaustingMemory) {
   // calibration_runs of a session's diagnosis part go through the same budget.
   const fs::path session = flexarm::test::scratchDir() / "calibration_runs.json";
-  {
-    std::ofstream f(session);
-    f << R"({"format": "flexarm-session", "version": 1, "written_by": "FlexArm 0.1.0",
-            "logs": [{"name": "healthy", "path": ")" << kHealthy << R"(", "sha256": ")" << std::string(64, '0')
-      << R"(", "read": {"format": "auto"}}],
-            "preprocessing": {"applied": false, "differentiate_angle": false, "range_samples": null,
-                              "decimation": {"factor": 1, "filter": "fir", "stopband_db": 80.0}, "detrend": "none"},
-            "ranges": {"estimation_s": null, "validation_s": null},
-            "parts": {"diagnosis": {"request": {"log": "healthy", "reference_log": "healthy",
-                                                "structure": "three-mass", "seed_fault": null, "calibrate": true,
-                                                "calibration_runs": 100000}}}})";
-  }
+  writeSession(session, "healthy", kHealthy,
+               R"({"diagnosis": {"request": {"log": "healthy", "reference_log": "healthy", "structure": "three-mass",
+                                             "seed_fault": null, "calibrate": true, "calibration_runs": 100000}}})");
   const MeasuredRun r = confined({"run", session.string(), "--json"}, 120);
   expectConfined(r, 0, "flexarm run: warning: diagnosis: could not run: the calibration is refused: ", 600);
   EXPECT_NE(r.err.find("runs of 24 s would hold"), std::string::npos) << r.err;
@@ -283,15 +286,7 @@ TEST(HostileTwo, ReportIsWrittenExclusivelyUnderAnUnpredictableName) {
   { std::ofstream(victim) << "keep me\n"; }
   fs::create_symlink(victim, dir / "report.pdf.part");
   const fs::path session = dir / "session.json";
-  {
-    std::ofstream f(session);
-    f << R"({"format": "flexarm-session", "version": 1, "written_by": "FlexArm 0.1.0",
-            "logs": [{"name": "estimation", "path": ")" << kSample << R"(", "sha256": ")" << std::string(64, '0')
-      << R"(", "read": {"format": "auto"}}],
-            "preprocessing": {"applied": false, "differentiate_angle": false, "range_samples": null,
-                              "decimation": {"factor": 1, "filter": "fir", "stopband_db": 80.0}, "detrend": "none"},
-            "ranges": {"estimation_s": null, "validation_s": null}, "parts": {"models": []}})";
-  }
+  writeSession(session, "estimation", kSample, R"({"models": []})");
   RunLimits limits;
   limits.timeoutSeconds = 120;
   limits.traceFiles = true;
