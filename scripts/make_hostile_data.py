@@ -269,6 +269,27 @@ def v73_small(out):
         whole = f.read()
     write(os.path.join(out, "v73_truncated.mat"), whole[:len(whole) // 2])
 
+    # The global heap's free space made 0 bytes long (found by fuzz_mat73): HDF5, reading the
+    # struct's field names from that heap, looped forever.
+    bad = bytearray(whole)
+    at = bad.find(b"GCOL")
+    size = struct.unpack_from("<Q", bad, at + 8)[0]
+    pos = at + 16
+    while pos + 16 <= at + size:
+        index, _, _, length = struct.unpack_from("<HHIQ", bad, pos)
+        if index == 0:
+            struct.pack_into("<Q", bad, pos + 8, 0)
+            break
+        pos += 16 + (length + 7) // 8 * 8
+    write(os.path.join(out, "v73_heap_no_progress.mat"), bytes(bad))
+
+    # A local heap's free list that points back at itself: HDF5 would follow it forever.
+    bad = bytearray(whole)
+    at = bad.find(b"HEAP")
+    _, free, data = struct.unpack_from("<QQQ", bad, at + 8)
+    struct.pack_into("<Q", bad, 512 + data + free, free)
+    write(os.path.join(out, "v73_free_list_cycle.mat"), bytes(bad))
+
 
 def v73_nested_3000(path):
     """3000 structs, each inside the one before."""

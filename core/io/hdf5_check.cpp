@@ -607,9 +607,22 @@ class Walker {
     if (std::memcmp(h.take(4), "HEAP", 4) != 0) refuse(heapWhat + " is not a local heap (the file is damaged)");
     h.skip(4);
     const std::uint64_t heapSize = lengthField(h);
-    lengthField(h);
+    const std::uint64_t freeList = lengthField(h);
     const std::uint64_t data = address(h);
     const Byte* names = atAddress(data, heapSize, heapWhat);
+    // Its free list, as HDF5 follows it: blocks inside the heap, each once (a cycle would make
+    // HDF5 walk it forever).
+    std::set<std::uint64_t> blocks;
+    for (std::uint64_t b = normalized(freeList, sl_); b != kUndefined && b != 1;) {
+      if (b > heapSize || 2 * static_cast<std::uint64_t>(sl_) > heapSize - b || !blocks.insert(b).second)
+        refuse(heapWhat + " has a free list that leaves the heap or runs in a circle (the file is damaged)");
+      Cursor f(names + b, 2 * static_cast<std::uint64_t>(sl_), heapWhat);
+      const std::uint64_t next = normalized(lengthField(f), sl_);
+      const std::uint64_t length = lengthField(f);
+      if (length < 2 * static_cast<std::uint64_t>(sl_) || length > heapSize - b)
+        refuse(heapWhat + " has a free block reaching past its end (the file is damaged)");
+      b = next;
+    }
     std::set<std::uint64_t> nodes;
     btreeGroup(btree, names, heapSize, o, path, nodes, 0);
   }
@@ -722,16 +735,20 @@ class Walker {
     auto& objects = heaps_[collection];
     if (objects.empty()) {
       objects[0] = 0;  // walked
+      // As HDF5 walks it: each object's header, then its data rounded up to 8 bytes; the free
+      // space (object 0) counts its header in its size. An object that does not move the walk
+      // on (a free space of size 0) made HDF5 loop forever.
+      const std::uint64_t header = 8 + static_cast<std::uint64_t>(sl_);
       Cursor c(atAddress(collection, size, heapWhat) + head, size - head, heapWhat);
-      while (c.left() >= 8 + static_cast<std::uint64_t>(sl_)) {
+      while (c.left() >= header) {
         const unsigned id = c.u16();
         c.skip(6);
         const std::uint64_t n = lengthField(c);
-        if (id == 0) break;  // free space to the end
-        const std::uint64_t padded = (n + 7) / 8 * 8;
-        if (padded > c.left() || n > padded) refuse(heapWhat + " holds an object reaching past its end (the file is damaged)");
-        c.skip(padded);
-        objects[id] = n;
+        const std::uint64_t need = id > 0 ? header + (n + 7) / 8 * 8 : n;
+        if (need < header || n > need || need - header > c.left())
+          refuse(heapWhat + " holds an object that reaches past its end or does not advance (the file is damaged)");
+        c.skip(need - header);
+        if (id > 0) objects[id] = n;
       }
     }
     const auto it = objects.find(index);

@@ -185,6 +185,10 @@ inline MeasuredRun runFlexarmMeasured(const std::vector<std::string>& args, RunL
       rlimit fs{static_cast<rlim_t>(limits.fileSizeBlocks) * 512, static_cast<rlim_t>(limits.fileSizeBlocks) * 512};
       ::setrlimit(RLIMIT_FSIZE, &fs);
     }
+    if (traced && kUnderAddressSanitizer) {  // LeakSanitizer cannot run under ptrace; untraced runs check leaks
+      const char* asan = std::getenv("ASAN_OPTIONS");
+      ::setenv("ASAN_OPTIONS", (std::string(asan ? asan : "") + ":detect_leaks=0").c_str(), 1);
+    }
     std::vector<std::string> command;
     if (traced)  // the calls that open, create, rename or remove a file, of every thread and child
       command = {"/usr/bin/env", "strace", "-ff", "-qq", "-o", trace, "-e",

@@ -176,6 +176,17 @@ TEST(HostileTwo, V73PluginFiltersAndDamageAreRefused) {
   expectConfined(confined({"info", hostile("v73_truncated.mat")}), 3, "points outside the file", 100);
 }
 
+TEST(HostileTwo, V73HeapsThatMadeHdf5LoopForeverAreRefused) {
+  // A global heap whose free space does not advance (found by fuzz_mat73: HDF5 spun in
+  // H5HG_read reading a struct's field names) and a local heap whose free list is a circle.
+  expectConfined(confined({"info", hostile("v73_heap_no_progress.mat")}, 20), 3,
+                 "the global heap /settings's attribute MATLAB_fields points into holds an object that reaches past "
+                 "its end or does not advance",
+                 100);
+  expectConfined(confined({"info", hostile("v73_free_list_cycle.mat")}, 20), 3,
+                 "the name heap of / has a free list that leaves the heap or runs in a circle", 100);
+}
+
 TEST(HostileTwo, V73LogOpensAndNamesTheVariablesItSkips) {
   const MeasuredRun r = confined({"info", hostile("v73_good.mat")});
   expectConfined(r, 0, "", 100);

@@ -59,6 +59,9 @@ TEST(Hdf5Check, HostileFilesAreRefusedByName) {
       {"v73_gzip_bomb.mat", "/zeros would take 128.0 MiB in memory uncompressed"},
       {"v73_plugin_filter.mat", "is compressed with filter 32000"},
       {"v73_truncated.mat", "points outside the file"},
+      // Both made HDF5 loop forever (the first found by fuzz_mat73).
+      {"v73_heap_no_progress.mat", "holds an object that reaches past its end or does not advance"},
+      {"v73_free_list_cycle.mat", "has a free list that leaves the heap or runs in a circle"},
   };
   for (const auto& [file, message] : cases) {
     SCOPED_TRACE(file);
