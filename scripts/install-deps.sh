@@ -13,10 +13,12 @@ PACKAGES=(
   xvfb xauth libgl1-mesa-dri
   poppler-utils python3-scipy zlib1g-dev libfast-float-dev
   clang libclang-rt-14-dev
+  python3-h5py strace
 )
 # clang and libclang-rt-14-dev (its sanitizer and libFuzzer runtimes, only recommended by
 # clang-14) build the AddressSanitizer/UBSan tests and the fuzz targets (scripts/sanitize.sh,
-# scripts/fuzz.sh).
+# scripts/fuzz.sh). python3-h5py writes the hostile v7.3 .mat files (scripts/make_hostile_data.py);
+# strace lets the hostile-input tests see every file a run opens.
 
 if [ "${1:-}" = "--bench" ]; then
   PACKAGES=(python3-numpy python3-scipy python3-pandas python3-matplotlib

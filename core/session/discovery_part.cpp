@@ -201,6 +201,7 @@ class DiscoveryPart : public SessionPart {
                            " % or more.");
     s.values = {{"base_model", baseName}};
     auto fail = [&](const std::string& text) {
+      report.warnings.push_back("discovery: could not run: " + text);  // e.g. a log the session lacks
       s.paragraphs.push_back("Discovery could not run: " + text + ".");
       s.values["effect"] = nullptr;
       s.values["message"] = text;
