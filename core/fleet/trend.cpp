@@ -15,6 +15,15 @@ namespace {
 
 constexpr double kZ99 = 2.5758;  // two-sided 99 % normal quantile
 
+// The two-sided 99 % quantile of Student's t with dof degrees of freedom (the Cornish-Fisher
+// expansion about the normal one; within 0.3 % from 5 degrees of freedom on): the scatter
+// behind an interval is itself estimated from the logs.
+double t99(double dof) {
+  const double z = kZ99, z3 = z * z * z, z5 = z3 * z * z;
+  dof = std::max(dof, 3.0);
+  return z + (z3 + z) / (4.0 * dof) + (5.0 * z5 + 16.0 * z3 + 3.0 * z) / (96.0 * dof * dof);
+}
+
 double median(std::vector<double> v) {
   if (v.empty()) return 0.0;
   const std::size_t m = v.size() / 2;
@@ -57,11 +66,19 @@ StepFit bestStep(const std::vector<double>& y, std::size_t minBefore, std::size_
 }
 
 struct DriftFit {
-  double t0 = 0.0, a = 0.0, b = 0.0, se = 0.0, z = 0.0, rss = std::numeric_limits<double>::infinity();
+  double t0 = 0.0, a = 0.0, b = 0.0, z = 0.0, rss = std::numeric_limits<double>::infinity();
+  double slope = 0.0, slopeSe = 0.0;  // from the logs after t0 alone (see bestDrift)
+  double level = 0.0, levelSe = 0.0;  // that line at the last log
+  double dof = 1.0;                   // of the residual variance
 };
 
 // y = a + b max(0, t - t0) by least squares for each start t0 (every log's day and the
 // midpoints between them, leaving minAfter logs after it); the one with the smallest residual.
+// Its z is b over b's standard error in that model. The slope reported, and its standard
+// error, come from a straight line through the logs after t0 alone (intercept free), with the
+// hinge model's residual variance: choosing t0 by the smallest residual makes the hinge's own
+// standard error too small (the 99 % interval held the truth in about 91 % of simulated axes),
+// the line after t0 does not lean on the choice.
 DriftFit bestDrift(const std::vector<double>& t, const std::vector<double>& y, std::size_t minAfter) {
   DriftFit best;
   const std::size_t n = y.size();
@@ -89,7 +106,27 @@ DriftFit bestDrift(const std::vector<double>& t, const std::vector<double>& y, s
     if (rss >= best.rss) continue;
     const double s2 = rss / std::max(1.0, nn - 3.0);  // a, b and t0
     const double se = std::sqrt(s2 * nn / det);
-    best = {t0, a, b, se, b / std::max(1e-15, se), rss};
+    best = {t0, a, b, b / std::max(1e-15, se), rss, b, se, 0.0, 0.0, std::max(1.0, nn - 3.0)};
+  }
+  if (!std::isfinite(best.rss)) return best;
+  // The line through the logs after t0.
+  double m = 0, sx = 0, sy = 0, sxx = 0, sxy = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    if (!(t[i] > best.t0)) continue;
+    const double x = t[i] - best.t0;
+    m += 1; sx += x; sy += y[i]; sxx += x * x; sxy += x * y[i];
+  }
+  const double det = m * sxx - sx * sx;
+  if (m >= 3 && det > 0.0) {
+    const double s2 = best.rss / std::max(1.0, static_cast<double>(n) - 3.0);
+    best.slope = (m * sxy - sx * sy) / det;
+    best.slopeSe = std::sqrt(s2 * m / det);
+    const double mean = sx / m, last = t.back() - best.t0;
+    best.level = (sy - best.slope * sx) / m + best.slope * last;
+    best.levelSe = std::sqrt(s2 * (1.0 / m + (last - mean) * (last - mean) * m / det));
+  } else {
+    best.level = best.a + best.b * (t.back() - best.t0);
+    best.levelSe = best.slopeSe * (t.back() - best.t0);
   }
   return best;
 }
@@ -134,8 +171,21 @@ ParameterSeries seriesOf(const std::string& name, const std::vector<TrendPoint>&
   return s;
 }
 
-// Finds a step (any parameter) or a drift (the wear parameter) in the series.
-void detectChange(ParameterSeries& s, bool wear, const TrendOptions& o) {
+// Finds a step (any parameter) or a drift (the wear parameter) in the series; alphaStd (of the
+// temperature correction applied) adds to the uncertainty of a drift's level at the last log.
+void detectChange(ParameterSeries& s, bool wear, const TrendOptions& o, const FrictionTemperatureModel* temperature) {
+  // The temperature's own trend over the logs from `from` on (degC per day): alpha's error
+  // times it adds to a drift's slope.
+  auto temperatureSlope = [&](double from) {
+    double m = 0, sx = 0, sy = 0, sxx = 0, sxy = 0;
+    for (std::size_t i = 0; i < s.day.size(); ++i)
+      if (s.day[i] > from && s.temperatureC[i]) {
+        const double x = s.day[i] - from, y = *s.temperatureC[i];
+        m += 1; sx += x; sy += y; sxx += x * x; sxy += x * y;
+      }
+    const double det = m * sxx - sx * sx;
+    return m >= 2 && det > 0.0 ? (m * sxy - sx * sy) / det : 0.0;
+  };
   const std::size_t n = s.value.size();
   s.scatter = scatterOf(s.value);
   const double mean = n ? std::accumulate(s.value.begin(), s.value.end(), 0.0) / static_cast<double>(n) : 0.0;
@@ -163,11 +213,20 @@ void detectChange(ParameterSeries& s, bool wear, const TrendOptions& o) {
     s.kind = "drift";
     s.since = drift.t0;
     s.z = drift.z;
-    s.slope = drift.b;
-    s.slopeLow = drift.b - kZ99 * drift.se;
-    s.slopeHigh = drift.b + kZ99 * drift.se;
+    double slopeSe = drift.slopeSe;
+    if (temperature) slopeSe = std::hypot(slopeSe, temperature->alphaStd * temperatureSlope(drift.t0));
+    const double q = t99(drift.dof);
+    s.slope = drift.slope;
+    s.slopeLow = drift.slope - q * slopeSe;
+    s.slopeHigh = drift.slope + q * slopeSe;
+    s.quantile = q;
     for (std::size_t i = 0; i < n; ++i) s.fitted[i] = drift.a + drift.b * std::max(0.0, s.day[i] - drift.t0);
-    s.level = s.fitted.back();
+    s.level = drift.level;
+    s.levelSe = drift.levelSe;
+    if (temperature && s.temperatureC.back()) {
+      const double dT = (*s.temperatureC.back() - temperature->referenceC) * temperature->alphaStd;
+      s.levelSe = std::sqrt(s.levelSe * s.levelSe + dT * dT);
+    }
   }
 }
 
@@ -241,8 +300,9 @@ AxisTrend analyseAxisTrend(const std::vector<TrendPoint>& input, std::optional<d
     t.series.clear();
     for (const auto& name : o.parameters) {
       const bool wear = name == o.wearParameter;
-      t.series.push_back(seriesOf(name, points, wear && corrected ? &t.temperature.model : nullptr));
-      detectChange(t.series.back(), wear, o);
+      const FrictionTemperatureModel* model = wear && corrected ? &t.temperature.model : nullptr;
+      t.series.push_back(seriesOf(name, points, model));
+      detectChange(t.series.back(), wear, o, model);
     }
     double earliest = std::numeric_limits<double>::infinity();
     for (const auto& s : t.series)
@@ -304,14 +364,15 @@ AxisTrend analyseAxisTrend(const std::vector<TrendPoint>& input, std::optional<d
     t.slopePerDay = changed->slope;
     t.slopeLow = changed->slopeLow;
     t.slopeHigh = changed->slopeHigh;
+    // Days until the threshold, and their 99 % range from the extremes of the level's and the
+    // slope's 99 % intervals.
     const double level = changed->level;
-    if (level >= o.threshold) {
-      t.daysToThreshold = t.daysLow = t.daysHigh = 0.0;
-    } else {
-      t.daysToThreshold = (o.threshold - level) / changed->slope;
-      t.daysLow = (o.threshold - level) / changed->slopeHigh;
-      if (changed->slopeLow > 0.0) t.daysHigh = (o.threshold - level) / changed->slopeLow;
-    }
+    const double levelHigh = level + changed->quantile * changed->levelSe;
+    const double levelLow = level - changed->quantile * changed->levelSe;
+    auto daysAt = [&](double from, double slope) { return std::max(0.0, (o.threshold - from) / slope); };
+    t.daysToThreshold = level >= o.threshold ? 0.0 : daysAt(level, changed->slope);
+    t.daysLow = daysAt(levelHigh, changed->slopeHigh);
+    if (changed->slopeLow > 0.0) t.daysHigh = daysAt(levelLow, changed->slopeLow);
     t.crossingDay = t.lastDay + *t.daysToThreshold;
     t.evidence = changed->name + " has risen " + number(100.0 * changed->slope, "%.2f") + " %/day (99 %: " +
                  number(100.0 * changed->slopeLow, "%.2f") + " to " + number(100.0 * changed->slopeHigh, "%.2f") +

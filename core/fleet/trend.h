@@ -62,6 +62,8 @@ struct ParameterSeries {
   double z = 0.0;                        // the change in standard errors
   double slope = 0.0, slopeLow = 0.0, slopeHigh = 0.0;  // drift: relative per day, 99 %
   double level = 0.0;                    // the fitted value at the last log, relative
+  double levelSe = 0.0;                  // its standard error (drift: with alpha's at that log)
+  double quantile = 2.5758;              // of the 99 % intervals (Student's t of the scatter)
   std::vector<double> fitted;            // the fitted levels at each day, relative
 };
 
