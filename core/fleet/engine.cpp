@@ -95,6 +95,9 @@ FleetRunResult runFleet(const FleetManifest& manifest, FleetStore& store, const 
     run.message = why;
     return run;
   }
+  // What the panel needs to show the store as this run saw it.
+  store.setMeta("model", options.analysis.model, nullptr);
+  store.setMeta("threshold", std::to_string(options.trend.threshold), nullptr);
   auto failEntry = [&](const FleetEntry& e, const std::string& message) {
     run.failures.push_back({e.robot, e.axis, e.time, e.path, message});
     ++run.failed;

@@ -373,20 +373,22 @@ AxisTrend analyseAxisTrend(const std::vector<TrendPoint>& input, std::optional<d
     t.daysToThreshold = level >= o.threshold ? 0.0 : daysAt(level, changed->slope);
     t.daysLow = daysAt(levelHigh, changed->slopeHigh);
     if (changed->slopeLow > 0.0) t.daysHigh = daysAt(levelLow, changed->slopeLow);
-    t.crossingDay = t.lastDay + *t.daysToThreshold;
+    // When passed, the day the fitted drift crossed it.
+    t.crossingDay = t.lastDay + (level >= o.threshold ? (o.threshold - level) / changed->slope : *t.daysToThreshold);
     t.evidence = changed->name + " has risen " + number(100.0 * changed->slope, "%.2f") + " %/day (99 %: " +
                  number(100.0 * changed->slopeLow, "%.2f") + " to " + number(100.0 * changed->slopeHigh, "%.2f") +
                  ") since " + dateOf(*changed->since) + ", now " + percent(level) + " over theta_0 (" +
                  number(changed->z, "%.1f") + " standard errors, scatter " + number(100.0 * changed->scatter, "%.2g") +
                  " % per log); the threshold " + percent(o.threshold, 0) + " is " +
-                 (*t.daysToThreshold <= 0.0 ? std::string("passed")
+                 (level >= o.threshold ? "passed (about " + dateOf(*t.crossingDay) + ")"
                                             : "reached in " + number(*t.daysToThreshold, "%.1f") + " days (" +
                                                   number(*t.daysLow, "%.1f") + " to " +
                                                   (t.daysHigh ? number(*t.daysHigh, "%.1f") : std::string("unbounded")) +
                                                   ", 99 %), about " + dateOf(*t.crossingDay)) +
                  "; " + temperatureNote + ".";
     t.serviceAtNextStop = *t.daysLow <= o.nextStopDays;
-    t.suggestion = t.serviceAtNextStop
+    t.suggestion = level >= o.threshold ? "service the gearbox at the next stop (the threshold is passed)"
+                   : t.serviceAtNextStop
                        ? "service the gearbox at the next stop (the threshold may be reached within " +
                              number(o.nextStopDays, "%.0f") + " days)"
                        : "plan a gearbox service before " + dateOf(t.lastDay + *t.daysLow);
