@@ -321,7 +321,8 @@ void FleetPanel::plotTrend() {
                          .arg(a.axis)
                          .arg(QString::fromStdString(t.status + (t.parameter.empty() ? "" : " in " + t.parameter)))
                          .arg(QString::fromStdString(t.evidence).toHtmlEscaped())
-                         .arg(tr("Suggestion: %1.").arg(QString::fromStdString(t.suggestion))));
+                         .arg(tr("Suggestion: %1.").arg(QString::fromStdString(t.suggestion)) +
+                              (t.caveat.empty() ? QString() : "<br><i>" + QString::fromStdString(t.caveat).toHtmlEscaped() + "</i>")));
   plot_->replot();
 }
 

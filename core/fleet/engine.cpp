@@ -299,6 +299,7 @@ json fleetAxisJson(const FleetAxisReport& a) {
           {"trend", trend},
           {"days_to_threshold", optionalJson(t.daysToThreshold)},
           {"evidence", t.evidence},
+          {"caveat", t.caveat.empty() ? json(nullptr) : json(t.caveat)},
           {"suggestion", t.suggestion},
           {"service_at_next_stop", t.serviceAtNextStop},
           {"logs", a.logs},

@@ -132,6 +132,7 @@ Report fleetReport(const FleetRunResult& run, const std::string& manifest, const
     s.title = a.robot + " axis " + std::to_string(a.axis) + ": " + a.trend.status + " in " + a.trend.parameter;
     s.paragraphs.push_back(a.trend.evidence);
     s.paragraphs.push_back("Suggestion: " + a.trend.suggestion + ".");
+    if (!a.trend.caveat.empty()) s.paragraphs.push_back("Caveat: " + a.trend.caveat);
     if (const auto* series = a.trend.find(a.trend.parameter)) s.plots.push_back(fleetTrendPlot(a, *series, a.trend.threshold));
     if (a.trend.parameter == "f_m") s.plots.push_back(fleetTemperaturePlot(a));
     s.values = fleetAxisJson(a);

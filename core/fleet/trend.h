@@ -80,6 +80,7 @@ struct AxisTrend {
   int logs = 0;
   std::string evidence;                  // sentences: what was found and how sure
   std::string suggestion;                // what to do at the next maintenance stop
+  std::string caveat;                    // what the sizes are of (set when something changed)
   bool serviceAtNextStop = false;
   FrictionTemperatureFit temperature;    // alpha as used (estimated or given)
   std::optional<double> referenceTemperatureC;
