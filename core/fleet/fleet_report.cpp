@@ -51,6 +51,16 @@ ReportPlot fleetTrendPlot(const FleetAxisReport& a, const ParameterSeries& s, do
     }
     p.series.push_back({"threshold " + percentText(threshold, 0), {0.0, end}, {100.0 * threshold, 100.0 * threshold}, true, 2});
   }
+  // Every point in view, with room below them for the legend (changes mostly rise).
+  double bottom = 0.0, top = 0.0;
+  for (const auto& x : p.series)
+    for (double y : x.y) {
+      bottom = std::min(bottom, y);
+      top = std::max(top, y);
+    }
+  const double span = std::max(top - bottom, 1.0);
+  p.yRange = std::make_pair(bottom - 0.9 * span, top + 0.05 * span);
+  p.legendBottomLeft = true;
   return p;
 }
 
