@@ -55,6 +55,9 @@ FleetPanel::FleetPanel(QWidget* parent) : QWidget(parent) {
   cancel_ = new QPushButton(tr("Cancel"), this);
   progress_ = new QProgressBar(this);
   progress_->setRange(0, 1000);
+  open_->setToolTip(tr("Open a fleet store (SQLite) that flexarm fleet writes; it may be writing now"));
+  cancel_->setToolTip(tr("Stop the run after the results in hand; everything stored so far stays"));
+  progress_->setToolTip(tr("Logs of the manifest analysed so far"));
   cancel_->setVisible(false);
   progress_->setVisible(false);
   storeLabel_ = new QLabel(tr("No store open"), this);
@@ -88,11 +91,15 @@ FleetPanel::FleetPanel(QWidget* parent) : QWidget(parent) {
   pick->addWidget(new QLabel(tr("Trend of"), lower));
   parameter_ = new QComboBox(lower);
   for (const char* p : kParameters) parameter_->addItem(p);
+  parameter_->setToolTip(tr("The parameter whose change from theta_0 over days is drawn (f_m at the reference "
+                            "log's temperature)"));
   pick->addWidget(parameter_);
   pick->addWidget(new QLabel(tr("(click a day to open its log with its diagnosis)"), lower), 1);
   lowerLayout->addLayout(pick);
   plot_ = new QCustomPlot(lower);
   plot_->setObjectName("fleetTrendPlot");
+  plot_->setToolTip(tr("Each day's estimate with +-2 std, the fitted level, the temperature (right axis), the "
+                       "threshold and the predicted crossing; click a day to open its log with its diagnosis"));
   plot_->setMinimumHeight(220);
   plot_->setInteractions(QCP::iRangeDrag | QCP::iRangeZoom);
   plot_->yAxis2->setVisible(true);
@@ -248,11 +255,19 @@ void FleetPanel::showAxis(int index, const QString& parameter) {
 
 QString FleetPanel::evidenceText() const { return evidence_->text(); }
 
+void FleetPanel::showEvent(QShowEvent* event) {
+  QWidget::showEvent(event);
+  plot_->replot(QCustomPlot::rpQueuedReplot);  // laid out at the size it is shown at
+}
+
 void FleetPanel::plotTrend() {
   plot_->clearGraphs();
   plot_->clearItems();
   if (current_ < 0) {
-    plot_->xAxis->setLabel(tr("days"));
+    plot_->xAxis->setLabel(tr("time [days]"));
+    plot_->yAxis2->setVisible(false);
+    // An empty legend would cap the plot's column at its own width of nothing.
+    plot_->addGraph()->setName(tr("no axis chosen"));
     plot_->yAxis->setLabel(tr("change from theta_0 [%]"));
     evidence_->setText(tr("Open a fleet store (written by flexarm fleet), or run a manifest."));
     plot_->replot();

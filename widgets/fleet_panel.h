@@ -54,6 +54,9 @@ class FleetPanel : public QWidget {
   void storeOpened();
   void runFinished(bool ok, const QString& message);
 
+ protected:
+  void showEvent(QShowEvent* event) override;
+
  private:
   void fillGrid();
   void plotTrend();

@@ -21,7 +21,7 @@ ReportPlot fleetTrendPlot(const FleetAxisReport& a, const ParameterSeries& s, do
   const double d0 = firstDay(a);
   ReportPlot p;
   p.title = a.robot + " axis " + std::to_string(a.axis) + ": " + s.name + " over days";
-  p.xLabel = "days since " + dateOf(d0);
+  p.xLabel = "time [days since " + dateOf(d0) + "]";
   p.yLabel = s.name + " - theta_0 [%]";
   ReportSeries est{"estimate", {}, {}}, hi{"+2 std", {}, {}, true, 0}, lo{"-2 std", {}, {}, true, 0},
       fit{s.kind == "none" ? "mean" : s.kind == "step" ? "fitted step" : "fitted drift", {}, {}, false, 1};
@@ -68,7 +68,7 @@ ReportPlot fleetTemperaturePlot(const FleetAxisReport& a) {
   const double d0 = firstDay(a);
   ReportPlot p;
   p.title = a.robot + " axis " + std::to_string(a.axis) + ": temperature of the daily logs";
-  p.xLabel = "days since " + dateOf(d0);
+  p.xLabel = "time [days since " + dateOf(d0) + "]";
   p.yLabel = "temperature [degC]";
   ReportSeries t{"temperature", {}, {}, false, 4};
   for (const auto& pt : a.points)
