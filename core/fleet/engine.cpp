@@ -5,6 +5,7 @@
 #include <cmath>
 #include <map>
 #include <stdexcept>
+#include <sys/stat.h>
 
 #include "core/fleet/work.h"
 #include "core/session/sha256.h"
@@ -103,8 +104,23 @@ FleetRunResult runFleet(const FleetManifest& manifest, FleetStore& store, const 
     ++run.failed;
   };
 
-  // What is new: every log whose (bytes, reference) pair the store lacks.
+  // What is new: every log whose (bytes, reference) pair the store lacks. A file whose size,
+  // modification time and inode are as when it was last hashed keeps its checksum.
   const auto stored = store.storedKeys();
+  std::vector<std::pair<std::string, std::pair<FleetStore::FileStamp, std::string>>> hashed;
+  auto hashOf = [&](const std::string& path, std::string* error) -> std::optional<std::string> {
+    struct stat st {};
+    if (::stat(path.c_str(), &st) == 0 && S_ISREG(st.st_mode)) {
+      const FleetStore::FileStamp stamp{static_cast<long long>(st.st_size),
+                                        static_cast<long long>(st.st_mtim.tv_sec) * 1000000000LL + st.st_mtim.tv_nsec,
+                                        static_cast<long long>(st.st_ino)};
+      if (auto known = store.knownSha256(path, stamp)) return known;
+      auto sha = sha256OfFile(path, error);
+      if (sha) hashed.push_back({path, {stamp, *sha}});
+      return sha;
+    }
+    return sha256OfFile(path, error);
+  };
   fleet::WorkChunk fits, logs;
   fits.options = logs.options = options.analysis;
   std::vector<const FleetEntry*> logEntry;             // LogJob id -> entry
@@ -114,7 +130,7 @@ FleetRunResult runFleet(const FleetManifest& manifest, FleetStore& store, const 
   int newLogs = 0;
   for (const auto& axis : manifest.axes) {
     const FleetEntry& ref = manifest.entries[axis.referenceEntry];
-    const auto refSha = sha256OfFile(ref.path, &why);
+    const auto refSha = hashOf(ref.path, &why);
     if (!refSha) {
       for (std::size_t i : axis.entries)
         failEntry(manifest.entries[i], "the axis' reference log " + ref.path + " cannot be read: " + why);
@@ -127,7 +143,7 @@ FleetRunResult runFleet(const FleetManifest& manifest, FleetStore& store, const 
     bool needFit = !haveReference;
     for (std::size_t i : axis.entries) {
       const FleetEntry& e = manifest.entries[i];
-      const auto sha = sha256OfFile(e.path, &why);
+      const auto sha = hashOf(e.path, &why);
       if (!sha) {
         failEntry(e, e.path + ": " + why);
         continue;
@@ -148,6 +164,7 @@ FleetRunResult runFleet(const FleetManifest& manifest, FleetStore& store, const 
       fitAxis.push_back(&axis);
     }
   }
+  store.putSha256(hashed, nullptr);  // only saves time on the next run
   const std::size_t total = fits.size() + logs.size();
   std::size_t done = 0;
   bool cancelled = false;

@@ -34,6 +34,9 @@ CREATE TABLE IF NOT EXISTS estimates(
   sha256 TEXT NOT NULL, reference_sha256 TEXT NOT NULL, parameter TEXT NOT NULL,
   value REAL NOT NULL, std REAL NOT NULL, reference REAL NOT NULL, position INTEGER NOT NULL,
   PRIMARY KEY(sha256, reference_sha256, parameter));
+CREATE TABLE IF NOT EXISTS files(
+  path TEXT PRIMARY KEY, size INTEGER NOT NULL, mtime_ns INTEGER NOT NULL, inode INTEGER NOT NULL,
+  sha256 TEXT NOT NULL);
 CREATE TABLE IF NOT EXISTS runs(
   id INTEGER PRIMARY KEY, started TEXT NOT NULL, finished TEXT, engine TEXT NOT NULL,
   manifest TEXT NOT NULL, analysed INTEGER, skipped INTEGER, failed INTEGER, seconds REAL);
@@ -336,6 +339,46 @@ std::vector<StoredLog> FleetStore::logs(const std::string& robot, int axis,
     e.reset();
   }
   return out;
+}
+
+std::optional<std::string> FleetStore::knownSha256(const std::string& path, const FileStamp& f) const {
+  Statement s(db_, "SELECT sha256 FROM files WHERE path = ? AND size = ? AND mtime_ns = ? AND inode = ?");
+  if (!s.ok()) return std::nullopt;  // a store opened read-only before the table existed
+  s.bind(1, path);
+  s.bind(2, static_cast<long>(f.size));
+  s.bind(3, static_cast<long>(f.mtimeNs));
+  s.bind(4, static_cast<long>(f.inode));
+  if (s.step() != SQLITE_ROW) return std::nullopt;
+  return s.text(0);
+}
+
+bool FleetStore::putSha256(const std::vector<std::pair<std::string, std::pair<FileStamp, std::string>>>& files,
+                           std::string* why) {
+  if (files.empty()) return true;
+  std::string err;
+  if (!exec("BEGIN IMMEDIATE", &err)) {
+    if (why) *why = "cannot write to the store: " + err;
+    return false;
+  }
+  Statement s(db_, "INSERT OR REPLACE INTO files(path, size, mtime_ns, inode, sha256) VALUES(?, ?, ?, ?, ?)");
+  bool good = s.ok();
+  for (const auto& [path, stamped] : files) {
+    if (!good) break;
+    s.bind(1, path);
+    s.bind(2, static_cast<long>(stamped.first.size));
+    s.bind(3, static_cast<long>(stamped.first.mtimeNs));
+    s.bind(4, static_cast<long>(stamped.first.inode));
+    s.bind(5, stamped.second);
+    good = s.step() == SQLITE_DONE;
+    s.reset();
+  }
+  if (!good || !exec("COMMIT", &err)) {
+    const std::string e = errorOf(db_);
+    exec("ROLLBACK", nullptr);
+    if (why) *why = "cannot record the files' checksums: " + e;
+    return false;
+  }
+  return true;
 }
 
 std::size_t FleetStore::logCount() const {

@@ -80,6 +80,15 @@ class FleetStore {
   bool finishRun(const StoredRun& run, std::string* why);
   std::vector<StoredRun> runs() const;
 
+  // The SHA-256 of a file as last hashed, when its size, modification time (ns) and inode are
+  // still those recorded: a rerun need not read every log of the manifest again.
+  struct FileStamp {
+    long long size = 0, mtimeNs = 0, inode = 0;
+  };
+  std::optional<std::string> knownSha256(const std::string& path, const FileStamp& stamp) const;
+  // Records hashed files in one transaction.
+  bool putSha256(const std::vector<std::pair<std::string, std::pair<FileStamp, std::string>>>& files, std::string* why);
+
   std::optional<std::string> meta(const std::string& key) const;
   bool setMeta(const std::string& key, const std::string& value, std::string* why);
 

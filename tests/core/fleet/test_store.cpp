@@ -115,3 +115,25 @@ TEST(FleetStore, RefusesOtherFilesAndOtherVersions) {
 
 }  // namespace
 }  // namespace flexarm
+
+namespace flexarm {
+namespace {
+
+TEST(FleetStore, KeepsAFilesChecksumOnlyWhileItsStampHolds) {
+  const auto path = scratch("e.sqlite").string();
+  std::string why;
+  auto store = FleetStore::open(path, true, &why);
+  ASSERT_TRUE(store) << why;
+  const FleetStore::FileStamp stamp{1754844, 1780000000123456789LL, 42};
+  EXPECT_FALSE(store->knownSha256("/logs/a.csv", stamp));
+  ASSERT_TRUE(store->putSha256({{"/logs/a.csv", {stamp, "abc"}}}, &why)) << why;
+  EXPECT_EQ(store->knownSha256("/logs/a.csv", stamp).value_or(""), "abc");
+  for (FleetStore::FileStamp other : {FleetStore::FileStamp{1754845, stamp.mtimeNs, 42},
+                                      FleetStore::FileStamp{stamp.size, stamp.mtimeNs + 1, 42},
+                                      FleetStore::FileStamp{stamp.size, stamp.mtimeNs, 43}})
+    EXPECT_FALSE(store->knownSha256("/logs/a.csv", other));
+  EXPECT_FALSE(store->knownSha256("/logs/b.csv", stamp));
+}
+
+}  // namespace
+}  // namespace flexarm
