@@ -148,6 +148,8 @@ int runFleet(const std::vector<std::string>& argv, std::ostream& out, std::ostre
     err << pre << why << "\n";
     return kExitBadInput;
   }
+  if (const auto model = store->meta("model"); model && *model != o.analysis.model)
+    return usage(*db + " holds " + *model + " analyses; give --model " + *model + " or another --db");
   const FleetRunResult run = flexarm::runFleet(*manifest, *store, o);
   if (run.termination != Termination::Converged) {
     err << pre << run.message << "\n";

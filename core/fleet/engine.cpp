@@ -91,6 +91,12 @@ FleetRunResult runFleet(const FleetManifest& manifest, FleetStore& store, const 
   const auto begin = std::chrono::steady_clock::now();
   FleetRunResult run;
   run.engine = options.engine;
+  // One store, one model: its analyses are not comparable with another model's.
+  if (const auto model = store.meta("model"); model && *model != options.analysis.model) {
+    run.message = store.path() + " holds " + *model + " analyses; the " + options.analysis.model +
+                  " model needs a store of its own";
+    return run;
+  }
   run.runId = store.beginRun(toString(options.engine), manifest.path, &why);
   if (run.runId == 0) {
     run.message = why;

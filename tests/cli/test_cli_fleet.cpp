@@ -280,6 +280,10 @@ TEST(CliFleet, ABadLogIsReportedAndTheRestGoesOn) {
   const auto again = json::parse(runFlexarm({"fleet", m.string(), "--db", db.string(), "--json"}).out);
   EXPECT_EQ(again.at("failed"), 1);
   EXPECT_EQ(again.at("skipped"), p.run.at("analysed").get<int>() + 1);
+  // Another model's analyses are not mixed into the store.
+  const auto other = runFlexarm({"fleet", m.string(), "--db", db.string(), "--model", "two-mass"});
+  EXPECT_EQ(other.code, 2);
+  EXPECT_NE(other.err.find("holds three-mass analyses"), std::string::npos) << other.err;
   // A manifest that cannot be read ends the run before anything is written.
   std::ofstream(dir / "broken.csv") << "# flexarm-fleet: 1\nrobot,axis,time,log\nR01,1,yesterday,a.csv\n";
   const auto broken = runFlexarm({"fleet", (dir / "broken.csv").string(), "--db", db.string()});
