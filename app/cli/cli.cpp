@@ -26,6 +26,8 @@ const std::vector<Verb>& verbs() {
        runRecursive},
       {"diagnose", "detect and isolate a fault in k_T, J_a or f_m from recursive estimates",
        runDiagnose},
+      {"fleet", "every robot's axes over days: new logs diagnosed, stored, trends, maintenance",
+       runFleet},
   };
   return kVerbs;
 }
