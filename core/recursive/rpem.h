@@ -55,7 +55,8 @@ std::optional<RecursiveGradient> recursiveGradientFromString(std::string_view s)
 //            last bankSize of them kept), each from the running estimate with P(0) as if the
 //            data before its start were not known; when one predicts the data since its start
 //            better than the running estimate by more than bankThreshold noise variances (a
-//            likelihood ratio of the change hypothesis), the change is accepted: the running
+//            likelihood ratio of the change hypothesis, its squared errors summed per design
+//            sample), once it has run bankMinAgeS, the change is accepted: the running
 //            estimate becomes that estimator's and the change time is reported.
 enum class RecursiveTracking { Fixed, Variable, Bank };
 const char* toString(RecursiveTracking t);  // "fixed", "variable", "bank"
