@@ -41,6 +41,7 @@ struct RunTrace {
   double from = 0.0;
   std::vector<double> time;
   std::vector<TestTrace> traces;  // ratio only
+  bool mismatch = false;          // the model check found the model no longer fits
 };
 
 // The reference of a run: its own, or fitted on a fault-free run of the same arm.
@@ -100,6 +101,7 @@ RunTrace runOnce(const MonteCarloRun& m, const DiagnosisOptions& options) {
     return out;
   }
   out.ok = true;
+  out.mismatch = r.modelCheck.mismatch;
   out.from = m.fault >= 0 ? m.faultTimeS : options.settleS;
   out.time = std::move(r.time);
   for (auto& t : r.tests) {
@@ -141,6 +143,7 @@ double designThreshold(DiagnosisTest test, const DiagnosisOptions& o) {
     case DiagnosisTest::Robust: return o.robustK;
     case DiagnosisTest::Cusum: return o.cusumAlpha2;
     case DiagnosisTest::Hypothesis: return o.hypothesisThreshold;
+    case DiagnosisTest::Joint: return o.jointScale;
   }
   return 1.0;
 }
@@ -183,6 +186,7 @@ DiagnosisOptions withThresholdScale(const DiagnosisOptions& options, DiagnosisTe
     case DiagnosisTest::Robust: o.robustK *= scale; break;
     case DiagnosisTest::Cusum: o.cusumAlpha2 *= scale; break;
     case DiagnosisTest::Hypothesis: o.hypothesisThreshold *= scale; break;
+    case DiagnosisTest::Joint: o.jointScale *= scale; break;
   }
   return o;
 }
@@ -362,6 +366,8 @@ CalibrationResult monteCarlo(const std::vector<MonteCarloRun>& plan, const Diagn
                     m.conditions.note.c_str(), m.noiseScale, static_cast<unsigned long long>(m.seed));
       return finish(Termination::Failed, std::string(what) + " could not be diagnosed: " + runs[i].message);
     }
+  for (const RunTrace& r : runs)
+    if (r.mismatch) ++(r.fault < 0 ? result.healthyMismatches : result.faultyMismatches);
 
   for (const auto& r : runs) {
     (r.fault < 0 ? result.healthyRuns : result.faultyRuns) += 1;
@@ -429,7 +435,8 @@ CalibrationResult monteCarlo(const std::vector<MonteCarloRun>& plan, const Diagn
   for (std::size_t k = 0; k < options.tests.size(); ++k) {
     TestCalibration tc;
     tc.test = options.tests[k];
-    const bool hypothesis = tc.test == DiagnosisTest::Hypothesis;
+    // The hypothesis and joint tests have one threshold for all their columns.
+    const bool hypothesis = tc.test == DiagnosisTest::Hypothesis || tc.test == DiagnosisTest::Joint;
     const std::size_t columns = runs.front().traces[k].columns.size();
     const double testBudget = calibration.targetFalseAlarmsPerHour /
                               static_cast<double>(options.decides(tc.test) ? std::max<std::size_t>(1, deciding) : 1);

@@ -82,6 +82,9 @@ struct CalibrationResult {
   double seconds = 0.0;
   int healthyRuns = 0, faultyRuns = 0;  // completed
   double healthyHours = 0.0;            // simulated fault-free time after settling
+  // Runs the model check (model_check.h) called a mismatch: none should be, the simulated arm
+  // is the model's own structure.
+  int healthyMismatches = 0, faultyMismatches = 0;
   double noiseScale = 1.0;
   std::string conditions;               // what was simulated, in words
   std::vector<std::string> faults;      // the monitored parameters' model names

@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <stdexcept>
 
+#include "core/diagnosis/diagnosis_temperature.h"
 #include "core/diagnosis/simulate_like.h"
 #include "core/ident/closed_loop_pem.h"
 #include "core/ident/pem.h"
@@ -246,6 +247,7 @@ DiagnosisReference referenceFromLog(const PhysicalModel& start, const IdData& he
     return ref;
   }
   DiagnosisReference ref = referenceFromSignals(start, *signals, options, referenceOptions, progress);
+  ref.temperatureC = logTemperature(healthy).celsius;
   if (ref.ok() || ref.termination == Termination::Cancelled || options.predictor != DiagnosisPredictor::Auto ||
       signals->predictor != DiagnosisPredictor::Loop)
     return ref;
@@ -255,6 +257,7 @@ DiagnosisReference referenceFromLog(const PhysicalModel& start, const IdData& he
   if (!direct) return ref;
   DiagnosisReference fallback = referenceFromSignals(start, *direct, options, referenceOptions, progress);
   if (!fallback.ok()) return ref;
+  fallback.temperatureC = ref.temperatureC;
   fallback.source += " (the loop predictor could not be fitted: " + ref.message + ")";
   fallback.message = fallback.source;
   return fallback;
