@@ -27,7 +27,7 @@ const char* const kDirectCoverage = "8 of 30";
 Eigen::VectorXd simulated(const FitOptions& o, const FitResult& r, const PreparedData& d, SampleRange range) {
   const auto b = static_cast<Eigen::Index>(range.begin), n = static_cast<Eigen::Index>(range.size());
   if (r.physical && !r.effects.empty()) {
-    const Eigen::VectorXd y = simulateNonlinear(*r.physical, r.effects, nonlinearSeries(r, d, range), nonlinearOptions(o));
+    const Eigen::VectorXd y = simulateNonlinear(*r.physical, r.effects, nonlinearSeries(r, d, range), nonlinearOptions(o, r));
     return y.size() ? y : Eigen::VectorXd::Constant(n, NAN);
   }
   const Eigen::VectorXd u = d.u.segment(b, n);
