@@ -28,6 +28,10 @@ bool DiscoveryOptions::isValid(std::string* why) const {
     return false;
   };
   if (candidates.empty()) return fail("at least one candidate effect is needed");
+  for (EffectKind k : candidates)
+    if (std::find(seedEffectKinds().begin(), seedEffectKinds().end(), k) == seedEffectKinds().end())
+      return fail("discovery looks for the effects of the seed's Section 3.2 assumptions; the arm-side effects "
+                  "are fitted with fit --effect");
   if (!(observerBandwidthHz >= 0.0) || !std::isfinite(observerBandwidthHz))
     return fail("the observer bandwidth must be >= 0 Hz");
   if (!(maxRateHz > 0.0)) return fail("the maximum rate must be positive");
@@ -405,6 +409,7 @@ void fitCandidate(EffectKind kind, const PhysicalModel& base, const PhysicalMode
       }
       break;
     }
+    default: break;  // not a candidate (DiscoveryOptions::isValid)
   }
   // Screening: a few iterations from every start; the ripple grid fits A alone (linear in A).
   LeastSquaresSolution bestSol;
@@ -512,6 +517,7 @@ std::string describeEffect(const CandidateFit& c) {
       return "an extra mass: " + plusMinus(p[1], 100.0) +
              " % of the outermost inertia on a spring resonating at " + number(p[0].value) +
              " +- " + number(p[0].std, 2) + " rad/s";
+    default: break;
   }
   return toString(c.kind);
 }

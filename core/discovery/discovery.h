@@ -30,7 +30,7 @@
 namespace flexarm {
 
 struct DiscoveryOptions {
-  std::vector<EffectKind> candidates = allEffectKinds();  // effects to test
+  std::vector<EffectKind> candidates = seedEffectKinds();  // effects to test
   double observerBandwidthHz = 1.0;  // load observer; 0 gives pure output error (simulation)
   double maxRateHz = 1100.0;  // faster data are decimated by block means of u (same impulse)
   int substeps = 0;           // Runge-Kutta steps per sample; 0 picks h <= 0.25 ms
