@@ -727,6 +727,14 @@ void FitPanel::onFinished() {
   lines << tr("Notches: %1. Peaks: %2. (rad/s: the minima and maxima of |G(i w)|, what a click on "
               "the Bode plot reads, as flexarm model and the reports give them)")
                .arg(joined(r.notches), joined(r.peaks));
+  if (r.deflection && r.deflection->fitPercent)
+    lines << tr("Deflection r phi_m - phi_a (arm encoder, %1 mrad RMS) predicted from the torque: %2 % (5.2), "
+                "%3 % NRMSE; encoder skew %4 ms.")
+                 .arg(1e3 * r.deflection->measuredRms, 0, 'g', 3)
+                 .arg(*r.deflection->fitPercent, 0, 'f', 1)
+                 .arg(r.deflection->fitPercentNrmse.value_or(NAN), 0, 'f', 1)
+                 .arg(1e3 * r.deflection->skewSeconds, 0, 'g', 3);
+  for (const auto& w : r.plausibility) lines << tr("Implausible: %1.").arg(QString::fromStdString(w));
   for (const auto& w : r.warnings) lines << tr("Note: %1.").arg(QString::fromStdString(w));
   // The estimate joins the shared list under a name no other entry has, naming its data:
   // "three-mass estimate 2 (chirp.csv 0.5-12 s)".

@@ -220,6 +220,15 @@ struct DeflectionCheck {
   Eigen::VectorXd measured, predicted, measuredValidation, predictedValidation;
 };
 
+// The deflection r phi_m - phi_a the linear part of a physical model predicts from the torque
+// u sampled every sampleTime: the zero-order hold (5.3) from zero state at the first sample,
+// the output PhysicalModel::armDeflectionRow (all zero for the rigid model).
+Eigen::VectorXd simulateDeflection(const PhysicalModel& model, const Eigen::VectorXd& u, double sampleTime);
+// The deflection the motor and arm-side encoders measure, r phi_m - phi_a over the whole of d
+// (the logged motor angle, or an output that is the angle, and arm_angle_rad); empty without
+// both.
+Eigen::VectorXd measuredDeflection(const PreparedData& d, double gearRatio);
+
 struct FitResult {
   Termination termination = Termination::Failed;
   std::string message;  // a sentence: how it ended, or why it failed

@@ -27,28 +27,8 @@ Eigen::VectorXd predictedDeflection(const FitOptions& o, const FitResult& r, con
     if (!predictOutput(plant, s, substeps, {}, PredictedOutput::MotorVelocity, yhat, nullptr, &arm)) return {};
     return Eigen::Map<const Eigen::VectorXd>(arm.data(), static_cast<Eigen::Index>(arm.size()));
   }
-  StateSpace ss = model->stateSpace();
-  ss.C = model->armDeflectionRow();
-  ss.D = Eigen::MatrixXd::Zero(1, 1);
-  const StateSpace z = discretizeZoh(ss, d.sampleTime);
-  Eigen::VectorXd x = Eigen::VectorXd::Zero(z.A.rows()), y(n);
-  const auto b = static_cast<Eigen::Index>(range.begin);
-  for (Eigen::Index k = 0; k < n; ++k) {
-    y[k] = (z.C * x)(0);
-    x = z.A * x + z.B.col(0) * d.u[b + k];
-  }
-  if (!y.allFinite()) return {};
-  return y;
-}
-
-// The measured deflection r phi_m - phi_a over the whole log; empty without both encoders.
-Eigen::VectorXd measuredDeflection(const PreparedData& d, double r) {
-  if (d.arm.size() != d.u.size()) return {};
-  Eigen::VectorXd motor;
-  if (d.angle.size() == d.u.size()) motor = d.angle;
-  else if (!d.differentiated && d.outputName == columns::kMotorAngle) motor = d.y.array() + d.outputMean;
-  else return {};
-  return r * motor - d.arm;
+  const Eigen::VectorXd y = simulateDeflection(*model, d.u.segment(static_cast<Eigen::Index>(range.begin), n), d.sampleTime);
+  return y.allFinite() ? y : Eigen::VectorXd();
 }
 
 Eigen::VectorXd aboutMean(const Eigen::VectorXd& x) { return x.array() - x.mean(); }
@@ -112,3 +92,31 @@ void deflectionCheck(const FitOptions& o, FitResult& r) {
 }
 
 }  // namespace flexarm::fit_detail
+
+namespace flexarm {
+
+Eigen::VectorXd simulateDeflection(const PhysicalModel& model, const Eigen::VectorXd& u, double sampleTime) {
+  auto m = std::unique_ptr<PhysicalModel>(static_cast<PhysicalModel*>(model.clone().release()));
+  m->setOptions(ModelOptions{});
+  StateSpace ss = m->stateSpace();
+  ss.C = m->armDeflectionRow();
+  ss.D = Eigen::MatrixXd::Zero(1, 1);
+  const StateSpace z = discretizeZoh(ss, sampleTime);
+  Eigen::VectorXd x = Eigen::VectorXd::Zero(z.A.rows()), y(u.size());
+  for (Eigen::Index k = 0; k < u.size(); ++k) {
+    y[k] = (z.C * x)(0);
+    x = z.A * x + z.B.col(0) * u[k];
+  }
+  return y;
+}
+
+Eigen::VectorXd measuredDeflection(const PreparedData& d, double r) {
+  if (d.arm.size() != d.u.size()) return {};
+  Eigen::VectorXd motor;
+  if (d.angle.size() == d.u.size()) motor = d.angle;
+  else if (!d.differentiated && d.outputName == columns::kMotorAngle) motor = d.y.array() + d.outputMean;
+  else return {};
+  return r * motor - d.arm;
+}
+
+}  // namespace flexarm
