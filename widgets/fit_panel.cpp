@@ -45,7 +45,10 @@ QString number(double v) { return QString::number(v, 'g', 5); }
 FitEffect startEffect(EffectKind kind, const std::vector<Effect>& own) {
   FitEffect f = FitEffect::defaults(kind);
   for (const auto& e : own)
-    if (e.kind == kind) f.effect = e;
+    if (e.kind == kind) {
+      f.effect = e;
+      f.scaleSmoothing = false;  // the model's own v_s, e.g. the one discovery found
+    }
   return f;
 }
 

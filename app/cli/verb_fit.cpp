@@ -239,12 +239,14 @@ std::vector<std::string> fitValuedOptionNames() {
   std::vector<std::string> v = logReadOptionNames();
   for (const char* n : {"model", "effect", "free", "fix", "start", "bound", "decimate", "range", "log", "validation-log",
                         "validation-range", "max-iterations", "starts", "seed", "closed-loop", "method",
-                        "cutoff", "friction", "outputs"})
+                        "cutoff", "friction", "outputs", "reference"})
     v.push_back(n);
   return v;
 }
 
-std::vector<std::string> fitFlagNames() { return {"json", "help", "noise-model", "keep-means", "no-idim-start"}; }
+std::vector<std::string> fitFlagNames() {
+  return {"json", "help", "noise-model", "keep-means", "no-idim-start", "same-instant"};
+}
 
 const char* fitOptionsHelp() {
   return "  --model SPEC          arx:NA,NB,NK | armax:NA,NB,NC,NK | oe:NB,NF,NK |\n"
@@ -332,7 +334,12 @@ const char* fitOptionsHelp() {
          "                        low-passed and decimated alike; idim-iv takes instruments from\n"
          "                        the position reference (closed loop). --friction asymmetric\n"
          "                        fits F_v+, F_v-, F_c+, F_c- instead. A prismatic axis (metadata\n"
-         "                        axis: prismatic, or an output in m) reports M, N s/m and N\n"
+         "                        axis: prismatic, or an output in m) reports M, N s/m and N.\n"
+         "                        The torque, held over each sample, is paired with the motion\n"
+         "                        half a sample later; --same-instant pairs them at the same\n"
+         "                        sample, as the EMPS reference does\n"
+         "  --reference CHANNEL   the channel holding the position reference (default: the\n"
+         "                        log's reference, angle_ref_rad), e.g. qg of a .mat file\n"
          "  --no-idim-start       a prediction-error fit of a flexible model starts from the\n"
          "                        model as given; by default inverse dynamics below its first\n"
          "                        notch scales its inertias, stiffnesses, dampings and f_m when\n"
@@ -461,6 +468,8 @@ int runFitPipeline(ArgParser& args, const std::string& verb, FitResult& result, 
     o.idim.friction = *f == "asymmetric" ? IdimFriction::Asymmetric : IdimFriction::Symmetric;
   }
   o.idimStart = !args.flag("no-idim-start");
+  o.idim.heldTorque = !args.flag("same-instant");
+  if (auto ref = args.value("reference")) o.reference = *ref;
   if (auto outputs = args.value("outputs")) {
     if (*outputs != "motor" && *outputs != "motor,arm") {
       err << pre << "--outputs expects motor or motor,arm, not '" << *outputs << "'\n";

@@ -79,7 +79,7 @@ void plausibilityChecks(const FitOptions& o, FitResult& r) {
   const IdData& log = *o.estimation.front().data;
   bool rGiven = false;
   for (const auto& v : o.startValues) rGiven = rGiven || v.name == "r";
-  if (log.meta("gear_ratio").empty() && !rGiven && m.structureName() != "two-mass-theta")
+  if (log.meta("gear_ratio").empty() && !rGiven && m.structureName() != "two-mass-theta" && !inverse)
     r.plausibility.push_back("the log states no gear ratio (metadata gear_ratio), so r = " + g(ratio) +
                              " is the model's default, not this axis's: the arm-side inertias and stiffnesses "
                              "are referred through a ratio nobody set (give --start r=VALUE, or the log's "
