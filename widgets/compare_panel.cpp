@@ -227,7 +227,8 @@ CompareOutcome compareModels(const WorkspaceSnapshot& snapshot, const std::vecto
     addCurve(*data, *sim, QObject::tr("%1: %2 % (5.2)").arg(list[i].name).arg(fit.seed52, 0, 'f', 1),
              QPen(color, 1.2));
     if (measured.size() && list[i].model && &data == &base) {
-      const Eigen::VectorXd predicted = simulateDeflection(*list[i].model, data->u, data->sampleTime);
+      const Eigen::VectorXd predicted =
+          simulateDeflection(*list[i].model, data->u, data->sampleTime, encoderSkewOf(list[i].effects));
       const SampleRange r2 = rangeOf(*data);
       const auto b = static_cast<Eigen::Index>(r2.begin), n = static_cast<Eigen::Index>(r2.size());
       const Eigen::VectorXd m = measured.segment(b, n).array() - measured.segment(b, n).mean();
@@ -248,7 +249,7 @@ CompareOutcome compareModels(const WorkspaceSnapshot& snapshot, const std::vecto
   if (!out.deflection.empty()) {
     addCurve(*base, measured, QObject::tr("measured"), QPen(QColor(20, 20, 20), 1.0), &out.deflection, true);
     lines << QObject::tr("The deflection r phi_m - phi_a the arm-side encoder measures (r = %1), predicted from "
-                         "the torque, each about its mean:")
+                         "the torque by each model's linear part (with its encoder_skew), each about its mean:")
                  .arg(ratio, 0, 'g', 6)
           << deflection;
   }

@@ -134,9 +134,12 @@ FitPanel::FitPanel(Workspace* workspace, QWidget* parent)
   noise_->setObjectName("noiseModelCombo");
   noise_->addItem(tr("Output error (K = 0)"), "output-error");
   noise_->addItem(tr("Innovations form (K estimated)"), "innovations");
+  noise_->addItem(tr("Output error of the motor and the arm encoder"), "motor-and-arm");
   noise_->setToolTip(tr("Output error: the model's simulation against the log (K = 0); "
                         "innovations form: a Kalman gain K is estimated too and the one-step "
-                        "prediction error (4.5) is minimised (4.6)"));
+                        "prediction error (4.5) is minimised (4.6); motor and arm encoder (a log "
+                        "with arm_angle_rad): the deflection r phi_m - phi_a is fitted as a second "
+                        "output, each weighted by its noise (flexarm fit --outputs motor,arm)"));
   closedLoop_->setObjectName("closedLoopCombo");
   closedLoop_->addItem(tr("Auto: indirect when the controller is known or identified"), "auto");
   closedLoop_->addItem(tr("Two-stage: fit to the input part the reference explains"), "two-stage");
@@ -522,6 +525,8 @@ std::optional<FitOptions> FitPanel::options(QString* name, std::vector<Experimen
     o.noiseModel = noise_->currentIndex() == 1 ? NoiseModel::Innovations : NoiseModel::OutputError;
     o.closedLoop = closedLoopChoiceFromString(closedLoop_->currentData().toString().toStdString())
                        .value_or(ClosedLoopChoice::Auto);
+    o.model.armOutput = noise_->currentIndex() == 2;
+    if (o.model.armOutput) o.closedLoop = ClosedLoopChoice::Auto;  // the nonlinear fit is direct
     o.randomStarts = starts_->value();
     std::string bad;
     if (!startsAndBoundsFromText(startsBounds_->text().toStdString(), o.startValues, o.bounds, &bad)) {

@@ -222,8 +222,12 @@ struct DeflectionCheck {
 
 // The deflection r phi_m - phi_a the linear part of a physical model predicts from the torque
 // u sampled every sampleTime: the zero-order hold (5.3) from zero state at the first sample,
-// the output PhysicalModel::armDeflectionRow (all zero for the rigid model).
-Eigen::VectorXd simulateDeflection(const PhysicalModel& model, const Eigen::VectorXd& u, double sampleTime);
+// the output PhysicalModel::armDeflectionRow (all zero for the rigid model), plus, as an arm
+// encoder reading encoderSkew seconds late sees it, encoderSkew times the arm's speed.
+Eigen::VectorXd simulateDeflection(const PhysicalModel& model, const Eigen::VectorXd& u, double sampleTime,
+                                   double encoderSkew = 0.0);
+// The encoder_skew T_o among effects (0 without it).
+double encoderSkewOf(const std::vector<Effect>& effects);
 // The deflection the motor and arm-side encoders measure, r phi_m - phi_a over the whole of d
 // (the logged motor angle, or an output that is the angle, and arm_angle_rad); empty without
 // both.

@@ -95,11 +95,21 @@ void deflectionCheck(const FitOptions& o, FitResult& r) {
 
 namespace flexarm {
 
-Eigen::VectorXd simulateDeflection(const PhysicalModel& model, const Eigen::VectorXd& u, double sampleTime) {
+double encoderSkewOf(const std::vector<Effect>& effects) {
+  for (const auto& e : effects)
+    if (e.kind == EffectKind::EncoderSkew) return e.value(0);
+  return 0.0;
+}
+
+Eigen::VectorXd simulateDeflection(const PhysicalModel& model, const Eigen::VectorXd& u, double sampleTime,
+                                   double encoderSkew) {
   auto m = std::unique_ptr<PhysicalModel>(static_cast<PhysicalModel*>(model.clone().release()));
   m->setOptions(ModelOptions{});
   StateSpace ss = m->stateSpace();
   ss.C = m->armDeflectionRow();
+  const ModelTopology t = m->topology();
+  if (t.armVelocityState >= 0) ss.C(0, t.armVelocityState) += encoderSkew;
+  else ss.C(0, t.motorVelocityState) += encoderSkew * m->value("r");
   ss.D = Eigen::MatrixXd::Zero(1, 1);
   const StateSpace z = discretizeZoh(ss, sampleTime);
   Eigen::VectorXd x = Eigen::VectorXd::Zero(z.A.rows()), y(u.size());

@@ -125,6 +125,7 @@ json fitRequestToJson(const FitRequest& r) {
       j["effects_scale_smoothing"] = scaled;
     }
     j["noise_model"] = toString(o.noiseModel);
+    if (o.model.armOutput) j["arm_output"] = true;
     j["closed_loop"] = toString(o.closedLoop);
     j["random_starts"] = o.randomStarts;
     j["seed"] = o.seed;
@@ -205,6 +206,10 @@ std::optional<FitRequest> fitRequestFromJson(const json& j, std::string* why) {
       if (!m) return fail(where + "noise_model must be \"" + toString(NoiseModel::OutputError) +
                           "\" or \"" + toString(NoiseModel::Innovations) + "\"");
       o.noiseModel = *m;
+    }
+    if (j.contains("arm_output")) {
+      if (!j["arm_output"].is_boolean()) return fail(where + "arm_output must be true or false");
+      o.model.armOutput = j["arm_output"].get<bool>();
     }
     // Sessions written before fits stored their closed-loop method ran direct fits.
     o.closedLoop = ClosedLoopChoice::Direct;

@@ -3,7 +3,9 @@
 // each physical model's prediction and its fit %, the Fit panel's summary gives the deflection
 // check and names absurd parameters, and the Arm view writes the measured arm angle and
 // deflection beside the model's. Screenshots of Compare and the Fit panel.
+#include <QComboBox>
 #include <QDockWidget>
+#include <QLineEdit>
 #include <QPushButton>
 #include <QSignalSpy>
 #include <QTemporaryDir>
@@ -100,6 +102,43 @@ class ArmSideTest : public QObject {
     arm->showTime(3.0);
     QVERIFY2(arm->statusText().contains("arm encoder phi_a"), qPrintable(arm->statusText()));
     QVERIFY2(arm->statusText().contains("r phi_m - phi_a measured"), qPrintable(arm->statusText()));
+  }
+
+  // A real robot (tests/data/kuka, KUKA KR300 axis 1): the Fit panel fits motor and arm
+  // encoder together with the encoders' skew, and Compare shows the deflection it predicts.
+  void kukaAxisOneWithTheArmEncoder() {
+    MainWindow w;
+    w.resize(1366, 768);
+    w.show();
+    QVERIFY(QTest::qWaitForWindowExposed(&w));
+    QSignalSpy opened(&w, &MainWindow::logOpened);
+    w.openFile(QString(FLEXARM_TEST_DATA_DIR) + "/kuka/axis1.csv");
+    QVERIFY(opened.wait(30000));
+    FitPanel* fit = w.fitPanel();
+    w.findChild<QDockWidget*>("fitDock")->show();
+    QVERIFY(fit->setModelChoice("two-mass"));
+    auto* starts = fit->findChild<QLineEdit*>("startsBoundsEdit");
+    QVERIFY(starts);
+    starts->setText("J_m=0.01, J_a=2000, k_a=3e6, d_a=5000, f_m=0.05");
+    fit->findChild<QComboBox*>("noiseModelCombo")->setCurrentIndex(2);  // motor and arm encoder
+    fit->setEffects({"encoder_skew"});
+    QSignalSpy done(fit, &FitPanel::estimated);
+    QTest::mouseClick(fit->findChild<QPushButton*>("estimateButton"), Qt::LeftButton);
+    QVERIFY(done.wait(120000));
+    QVERIFY2(done.takeFirst().at(0).toBool(), qPrintable(fit->summaryText()));
+    QVERIFY2(fit->summaryText().contains("Deflection r phi_m - phi_a"), qPrintable(fit->summaryText()));
+    test::saveShot(fit->grab().toImage(), "kuka_fit");
+    auto* dock = w.findChild<QDockWidget*>("compareDock");
+    dock->show();
+    dock->raise();
+    w.comparePanel()->setRangeKind(RangeKind::Estimation);
+    QTRY_VERIFY_WITH_TIMEOUT(!w.isBusy(), 60000);
+    const QString text = w.comparePanel()->fitText();
+    const auto at = text.indexOf(": deflection ");
+    QVERIFY2(at > 0, qPrintable(text));
+    QVERIFY2(text.mid(at + 13).section(' ', 0, 0).toDouble() > 85.0, qPrintable(text));
+    test::saveShot(w.comparePanel()->grab().toImage(), "kuka_compare");
+    test::saveShot(w.grab().toImage(), "kuka_window");
   }
 
   void cleanupTestCase() { delete window_; }

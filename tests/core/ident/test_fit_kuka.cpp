@@ -2,7 +2,8 @@
 // model fitted to the motor and the arm encoder together, with the encoders' sampling skew as
 // an effect and gravity on the axes that carry it, predicts the deflection r phi_m - phi_a from
 // the torque alone far better than a static torque-to-deflection map (64 % (5.2) on axis 1,
-// 46 % on axes 2 and 3), and finds the same skew of about 3.3 ms on every axis.
+// 46 % on axes 2 and 3), and finds the same skew of about 3.3 ms on every axis. (The skew is
+// most of what these encoders read: the measured arm speed times 3.1 ms explains 94-99 % of it.)
 #include <gtest/gtest.h>
 
 #include <string>
