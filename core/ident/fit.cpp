@@ -67,6 +67,10 @@ bool FitModelSpec::isValid(std::string* why) const {
                       start->structureName());
         for (std::size_t k = 0; k < effectParameters(f.effect.kind).size(); ++k) anyFree = anyFree || f.free[k];
       }
+      for (const auto& f : effects)
+        if (f.effect.kind == EffectKind::EncoderSkew && !armOutput)
+          return fail("encoder_skew shifts what the arm encoder reads: it goes with the arm as an output "
+                      "(--outputs motor,arm)");
       if (armOutput && start->options().output != ModelOutput::MotorVelocity)
         return fail("the arm as a second output goes with the motor velocity as the first");
       if (!effects.empty() && start->options().armAcceleration)

@@ -58,6 +58,10 @@ TEST(CliArmSide, BothOutputsTogether) {
   EXPECT_NEAR(j["parameters"]["J_a"].get<double>(), 12.0, 0.03 * 12.0);
   const auto bad = runFlexarm({"fit", armLog(), "--model", "two-mass", "--outputs", "arm"});
   EXPECT_EQ(bad.code, 2) << bad.err;
+  // A skew between encoders means nothing without the arm encoder as an output.
+  const auto skew = runFlexarm({"fit", armLog(), "--model", "two-mass", "--effect", "encoder_skew"});
+  EXPECT_EQ(skew.code, 2) << skew.err;
+  EXPECT_NE(skew.err.find("--outputs motor,arm"), std::string::npos) << skew.err;
 }
 
 TEST(CliArmSide, IdimReproducesTheEmpsReference) {
