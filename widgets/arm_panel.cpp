@@ -24,6 +24,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "core/ident/fit.h"
 #include "widgets/arm/arm_scene.h"
 #include "widgets/arm/frame_exporter.h"
 #include "widgets/arm/vtk_view.h"
@@ -84,9 +85,8 @@ int niceNearest(double x, int lo, int hi) {
 }
 
 double gearRatioOf(const IdData& d) {
-  const std::string r = d.meta("gear_ratio");
-  const double v = r.empty() ? 1.0 / 118.0 : std::atof(r.c_str());
-  return v > 0 && std::isfinite(v) ? v : 1.0 / 118.0;
+  // The log's gear ratio as the fit reads it ("1/256.86" too); else the models' default.
+  return logGearRatio(d).value_or(1.0 / 118.0);
 }
 
 }  // namespace
@@ -302,6 +302,7 @@ void ArmPanel::clearExternalModel() {
 void ArmPanel::onLogChanged() {
   const IdData* d = workspace_->raw();
   gearRatio_ = d ? gearRatioOf(*d) : 1.0 / 118.0;
+  armMeanFor_ = nullptr;  // another log: its own encoder offset
   measured_->setEnabled(d && d->channel(columns::kMotorAngle));
   // Auto magnification: the log's largest motion about axis one drawn at about 35 degrees.
   if (const Channel* angle = d ? d->channel(columns::kMotorAngle) : nullptr) {
@@ -478,9 +479,35 @@ void ArmPanel::showTime(double t) {
       status += tr("   phi_g - phi_a %1 mrad").arg(mrad(pose.armDeflection));
     if (angles_ && angles_->springs >= 3)
       status += tr("   phi_g - phi_p %1 mrad").arg(mrad(pose.parallelDeflection));
+    status += measuredArmText(t, pose);
   }
   overlay_.status = status;
   view_->requestRender();
+}
+
+QString ArmPanel::measuredArmText(double t, const BodyPose& pose) {
+  const IdData* d = workspace_->raw();
+  const Channel* arm = d ? d->channel(columns::kArmAngle) : nullptr;
+  const Channel* motor = d ? d->channel(columns::kMotorAngle) : nullptr;
+  if (!arm || !motor || arm->values.empty() || arm->values.size() != motor->values.size()) return {};
+  // The encoders' zeros are unrelated: the measured deflection is shown about its mean.
+  if (armMeanFor_ != d || armMeanRatio_ != gearRatio_) {
+    double sum = 0.0;
+    for (std::size_t i = 0; i < arm->values.size(); ++i) sum += gearRatio_ * motor->values[i] - arm->values[i];
+    armMean_ = sum / static_cast<double>(arm->values.size());
+    armMeanFor_ = d;
+    armMeanRatio_ = gearRatio_;
+  }
+  const double pos = std::round((t - d->startTime) / d->sampleTime);
+  const auto i = static_cast<std::size_t>(std::clamp(pos, 0.0, static_cast<double>(arm->values.size() - 1)));
+  const double measured = gearRatio_ * motor->values[i] - arm->values[i] - armMean_;
+  QString text = tr("\narm encoder phi_a %1 mrad (shown: %2 mrad)   r phi_m - phi_a measured %3 mrad")
+                     .arg(fixed(1e3 * arm->values[i], 3))
+                     .arg(fixed(1e3 * pose.arm, 3))
+                     .arg(mrad(measured));
+  if (angles_ && angles_->springs >= 1)
+    text += tr(", model %1 mrad").arg(mrad(pose.gearDeflection + (angles_->springs >= 2 ? pose.armDeflection : 0.0)));
+  return text;
 }
 
 void ArmPanel::showFault(ArmPart part, const QString& reason, const QString& resultKey) {

@@ -121,6 +121,9 @@ class ArmPanel : public QWidget {
   void onSimulated();
   void updateCaption();
   BodyPose poseAt(double t) const;
+  // On a log with an arm-side encoder: the measured arm angle and deflection at t beside the
+  // shown pose's (a line of the status text); empty without the encoder.
+  QString measuredArmText(double t, const BodyPose& pose);
   void redraw();
   void saveStill();
   void askExportFrames();
@@ -165,6 +168,9 @@ class ArmPanel : public QWidget {
   QString computingName_;
   double gearRatio_ = 1.0 / 118.0;
   double shownTime_ = 0.0;
+  // The measured deflection's mean over the log (the encoders' zero offset), for that log and r.
+  const IdData* armMeanFor_ = nullptr;
+  double armMeanRatio_ = 0.0, armMean_ = 0.0;
   bool filling_ = false;
   bool exporting_ = false;
 };

@@ -26,7 +26,8 @@ const QColor kColors[] = {QColor(31, 119, 180), QColor(214, 39, 40), QColor(44, 
 ComparePanel::ComparePanel(Workspace* workspace, QWidget* parent)
     : QWidget(parent), workspace_(workspace), models_(new QListWidget(this)),
       range_(new QComboBox(this)), plot_(new QCustomPlot(this)), fit_(new QLabel(this)),
-      cursor_(new PlayheadCursor(plot_, this)), worker_(new BackgroundRefresh(this)) {
+      cursor_(new PlayheadCursor(plot_, this)), deflection_(new QCustomPlot(this)),
+      worker_(new BackgroundRefresh(this)) {
   setObjectName("comparePanel");
   models_->setObjectName("compareModelList");
   models_->setMaximumWidth(220);
@@ -34,25 +35,44 @@ ComparePanel::ComparePanel(Workspace* workspace, QWidget* parent)
   range_->setToolTip(tr("Range the models are simulated on and the fit (5.2) computed over"));
   range_->addItem(tr("Validation range"), static_cast<int>(RangeKind::Validation));
   range_->addItem(tr("Estimation range"), static_cast<int>(RangeKind::Estimation));
-  plot_->setObjectName("comparePlot");
-  plot_->setMinimumSize(320, 220);
-  plot_->xAxis->setLabel(tr("time [s]"));
-  plot_->yAxis->setLabel(tr("output"));
-  plot_->setInteractions(QCP::iRangeDrag | QCP::iRangeZoom);
-  plot_->legend->setVisible(true);
-  plot_->legend->setFont(QFont(font().family(), 8));
-  placeLegendAbove(plot_);
-  PlotTools::install(plot_)->limitAxisToData(plot_->xAxis);  // no time before the range
+  // A time plot with its legend above, no time before the range.
+  auto timePlot = [this](QCustomPlot* plot, const char* name, int height, const QString& label) {
+    plot->setObjectName(name);
+    plot->setMinimumSize(320, height);
+    plot->xAxis->setLabel(tr("time [s]"));
+    plot->yAxis->setLabel(label);
+    plot->setInteractions(QCP::iRangeDrag | QCP::iRangeZoom);
+    plot->legend->setVisible(true);
+    plot->legend->setFont(QFont(font().family(), 8));
+    placeLegendAbove(plot);
+    PlotTools::install(plot)->limitAxisToData(plot->xAxis);
+  };
+  timePlot(plot_, "comparePlot", 220, tr("output"));
   fit_->setObjectName("compareFitLabel");
   fit_->setWordWrap(true);
+  // The deflection between motor and arm, shown when the log has an arm-side encoder.
+  timePlot(deflection_, "compareDeflectionPlot", 160, tr("r phi_m - phi_a [mrad]"));
+  deflection_->setVisible(false);
+  connect(plot_->xAxis, QOverload<const QCPRange&>::of(&QCPAxis::rangeChanged), deflection_,
+          [this](const QCPRange& r) {
+            if (deflection_->isVisible() && deflection_->xAxis->range() != r) {
+              deflection_->xAxis->setRange(r);
+              deflection_->replot();
+            }
+          });
 
   auto* top = new QHBoxLayout;
   top->addWidget(new QLabel(tr("Compare on"), this));
   top->addWidget(range_);
   top->addStretch(1);
   auto* split = new QSplitter(Qt::Horizontal, this);
+  auto* plots = new QSplitter(Qt::Vertical, this);
+  plots->addWidget(plot_);
+  plots->addWidget(deflection_);
+  plots->setStretchFactor(0, 3);
+  plots->setStretchFactor(1, 2);
   split->addWidget(models_);
-  split->addWidget(plot_);
+  split->addWidget(plots);
   split->setStretchFactor(1, 4);
   auto* layout = new QVBoxLayout(this);
   layout->addLayout(top);
@@ -104,6 +124,9 @@ struct CompareOutcome {
   std::vector<double> fits, fitsNrmse;
   bool velocity = false;  // the curves are the motor velocity
   std::vector<Curve> curves;
+  // On a log with an arm-side encoder: the measured deflection r phi_m - phi_a and each
+  // physical model's, about their means over the range (empty without the encoder).
+  std::vector<Curve> deflection;
   QString text;
 };
 
@@ -134,10 +157,17 @@ CompareOutcome compareModels(const WorkspaceSnapshot& snapshot, const std::vecto
     const SampleRange r = kind == RangeKind::Validation ? d.validation : d.estimation;
     return r.empty() ? d.estimation : r;
   };
-  auto addCurve = [&](const PreparedData& d, const Eigen::VectorXd& v, const QString& name,
-                      const QPen& pen) {
+  // A deflection curve is drawn about its mean over the range, in mrad.
+  auto addCurve = [&](const PreparedData& d, const Eigen::VectorXd& v, const QString& name, const QPen& pen,
+                      std::vector<Curve>* to = nullptr, bool deflection = false) {
     const SampleRange r = rangeOf(d);
     std::vector<double> values(v.data() + r.begin, v.data() + r.end);
+    if (deflection && !values.empty()) {
+      double mean = 0.0;
+      for (double x : values) mean += x;
+      mean /= static_cast<double>(values.size());
+      for (double& x : values) x = 1e3 * (x - mean);
+    }
     Curve c;
     c.name = name;
     c.pen = pen;
@@ -149,7 +179,7 @@ CompareOutcome compareModels(const WorkspaceSnapshot& snapshot, const std::vecto
       c.hi = *hi;
     }
     c.envelope = std::make_shared<const EnvelopePyramid>(values);
-    out.curves.push_back(std::move(c));
+    (to ? *to : out.curves).push_back(std::move(c));
   };
   out.velocity = velocity;
   const auto& base = at(1);
@@ -158,8 +188,15 @@ CompareOutcome compareModels(const WorkspaceSnapshot& snapshot, const std::vecto
     return out;
   }
   const bool noValidation = kind == RangeKind::Validation && base->validation.empty();
-  QStringList lines;
+  QStringList lines, deflection;
   int colour = 0;
+  // The deflection the encoders measure, through the log's gear ratio (else the first
+  // physical model's r), when the log has an arm-side encoder.
+  double ratio = std::nan("");
+  if (const auto stated = logGearRatio(*snapshot.data)) ratio = *stated;
+  for (std::size_t i = 0; i < list.size() && std::isnan(ratio); ++i)
+    if (checked[i] && list[i].model) ratio = list[i].model->value("r");
+  const Eigen::VectorXd measured = std::isnan(ratio) ? Eigen::VectorXd() : measuredDeflection(*base, ratio);
   for (std::size_t i = 0; i < list.size() && !stop.load(); ++i) {
     const QColor color = kColors[colour++ % 6];
     if (!checked[i]) continue;
@@ -189,11 +226,33 @@ CompareOutcome compareModels(const WorkspaceSnapshot& snapshot, const std::vecto
     out.fitsNrmse.push_back(fit.nrmse);
     addCurve(*data, *sim, QObject::tr("%1: %2 % (5.2)").arg(list[i].name).arg(fit.seed52, 0, 'f', 1),
              QPen(color, 1.2));
+    if (measured.size() && list[i].model && &data == &base) {
+      const Eigen::VectorXd predicted =
+          simulateDeflection(*list[i].model, data->u, data->sampleTime, encoderSkewOf(list[i].effects));
+      const SampleRange r2 = rangeOf(*data);
+      const auto b = static_cast<Eigen::Index>(r2.begin), n = static_cast<Eigen::Index>(r2.size());
+      const Eigen::VectorXd m = measured.segment(b, n).array() - measured.segment(b, n).mean();
+      const Eigen::VectorXd p = predicted.segment(b, n).array() - predicted.segment(b, n).mean();
+      const FitPercents df = fitPercents(m, p);
+      addCurve(*data, predicted, QObject::tr("%1: %2 % (5.2)").arg(list[i].name).arg(df.seed52, 0, 'f', 1),
+               QPen(color, 1.2), &out.deflection, true);
+      deflection << QObject::tr("%1: deflection %2 % (5.2), %3 % NRMSE")
+                        .arg(list[i].name)
+                        .arg(df.seed52, 0, 'f', 1)
+                        .arg(df.nrmse, 0, 'f', 1);
+    }
     lines << QObject::tr("%1: fit %2 % (5.2), %3 % NRMSE%4").arg(list[i].name).arg(fit.seed52, 0, 'f', 1)
                  .arg(fit.nrmse, 0, 'f', 1)
                  .arg(factor > 1 ? QObject::tr(" (at %1 Hz)").arg(1.0 / data->sampleTime, 0, 'g', 4) : QString());
   }
   addCurve(*base, base->y, QObject::tr("measured"), QPen(QColor(20, 20, 20), 1.0));  // on top
+  if (!out.deflection.empty()) {
+    addCurve(*base, measured, QObject::tr("measured"), QPen(QColor(20, 20, 20), 1.0), &out.deflection, true);
+    lines << QObject::tr("The deflection r phi_m - phi_a the arm-side encoder measures (r = %1), predicted from "
+                         "the torque by each model's linear part (with its encoder_skew), each about its mean:")
+                 .arg(ratio, 0, 'g', 6)
+          << deflection;
+  }
   lines.prepend(QObject::tr("Fit of the simulated output on the %1 data (%2), as the seed's (5.2) "
                             "1 - sum e^2/sum (y - mean y)^2 and as MATLAB compare's NRMSE 1 - |e|/|y - mean y|:")
                     .arg(noValidation ? QObject::tr("estimation (no validation range set)")
@@ -218,15 +277,14 @@ void ComparePanel::refresh() {
   });
 }
 
-void ComparePanel::showOutcome(const CompareOutcome& out) {
-  plot_->clearGraphs();
-  fits_ = out.fits;
-  fitsNrmse_ = out.fitsNrmse;
-  plot_->yAxis->setLabel(outputAxisLabel(*workspace_, out.velocity));
-  fit_->setText(out.text);
+namespace {
+
+// Draws curves in plot over their common time span and value range, through their envelopes.
+void drawCurves(QCustomPlot* plot, const std::vector<Curve>& curves) {
+  plot->clearGraphs();
   double t0 = HUGE_VAL, t1 = -HUGE_VAL, lo = HUGE_VAL, hi = -HUGE_VAL;
-  for (const Curve& c : out.curves) {
-    auto* g = plot_->addGraph();
+  for (const Curve& c : curves) {
+    auto* g = plot->addGraph();
     g->setName(c.name);
     g->setPen(c.pen);
     if (c.envelope->size() == 0) continue;
@@ -235,17 +293,31 @@ void ComparePanel::showOutcome(const CompareOutcome& out) {
     lo = std::min(lo, c.lo);
     hi = std::max(hi, c.hi);
   }
-  if (t1 > t0) plot_->xAxis->setRange(t0, t1);
+  if (t1 > t0) plot->xAxis->setRange(t0, t1);
   if (hi >= lo) {
     const double pad = std::max(1e-12, 0.05 * (hi - lo));
-    plot_->yAxis->setRange(lo - pad, hi + pad);
+    plot->yAxis->setRange(lo - pad, hi + pad);
   }
   // After the range is set, so each curve takes only the points of its visible range.
-  for (std::size_t i = 0; i < out.curves.size(); ++i) {
-    const Curve& c = out.curves[i];
-    new EnvelopeGraph(plot_->graph(static_cast<int>(i)), c.envelope, c.startTime, c.sampleTime);
+  for (std::size_t i = 0; i < curves.size(); ++i) {
+    const Curve& c = curves[i];
+    new EnvelopeGraph(plot->graph(static_cast<int>(i)), c.envelope, c.startTime, c.sampleTime);
   }
-  plot_->replot();
+  plot->replot();
+}
+
+}  // namespace
+
+void ComparePanel::showOutcome(const CompareOutcome& out) {
+  plot_->clearGraphs();
+  fits_ = out.fits;
+  fitsNrmse_ = out.fitsNrmse;
+  plot_->yAxis->setLabel(outputAxisLabel(*workspace_, out.velocity));
+  fit_->setText(out.text);
+  drawCurves(plot_, out.curves);
+  deflection_->setVisible(!out.deflection.empty());
+  deflectionCurves_ = static_cast<int>(out.deflection.size());
+  if (!out.deflection.empty()) drawCurves(deflection_, out.deflection);
 }
 
 }  // namespace flexarm

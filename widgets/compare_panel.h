@@ -1,7 +1,8 @@
 #pragma once
 // Compare panel: the measured output against the output simulated by several models of the
 // shared list on the validation range (or the estimation range), each with its fit % (5.2),
-// as the seed's Figure 5.11. Simulation starts at the log's first sample, so no start-up
+// as the seed's Figure 5.11; on a log with an arm-side encoder, below it the measured deflection
+// r phi_m - phi_a against each physical model's. Simulation starts at the log's first sample, so no start-up
 // transient enters the fit. Simulating runs off the GUI thread; the curves are drawn through
 // their min/max envelope for the visible time range.
 #include <QWidget>
@@ -34,6 +35,11 @@ class ComparePanel : public QWidget {
   std::vector<double> fitsNrmse() const { return fitsNrmse_; }
   QString fitText() const;
   QCustomPlot* plot() const { return plot_; }
+  // The measured deflection r phi_m - phi_a and each physical model's, below the output; shown
+  // only on a log with an arm-side encoder (arm_angle_rad). Its curves: one per model, then
+  // the measured one.
+  QCustomPlot* deflectionPlot() const { return deflection_; }
+  int deflectionCurves() const { return deflectionCurves_; }
   // Shows the window's playhead in the plot; a click there moves it.
   void setPlayhead(Playhead* playhead);
   PlayheadCursor* playheadCursor() const { return cursor_; }
@@ -53,6 +59,8 @@ class ComparePanel : public QWidget {
   QCustomPlot* plot_;
   QLabel* fit_;
   PlayheadCursor* cursor_;
+  QCustomPlot* deflection_;
+  int deflectionCurves_ = 0;
   std::vector<double> fits_, fitsNrmse_;
   BackgroundRefresh* worker_;
 };

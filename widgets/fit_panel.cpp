@@ -45,7 +45,10 @@ QString number(double v) { return QString::number(v, 'g', 5); }
 FitEffect startEffect(EffectKind kind, const std::vector<Effect>& own) {
   FitEffect f = FitEffect::defaults(kind);
   for (const auto& e : own)
-    if (e.kind == kind) f.effect = e;
+    if (e.kind == kind) {
+      f.effect = e;
+      f.scaleSmoothing = false;  // the model's own v_s, e.g. the one discovery found
+    }
   return f;
 }
 
@@ -132,9 +135,12 @@ FitPanel::FitPanel(Workspace* workspace, QWidget* parent)
   noise_->setObjectName("noiseModelCombo");
   noise_->addItem(tr("Output error (K = 0)"), "output-error");
   noise_->addItem(tr("Innovations form (K estimated)"), "innovations");
+  noise_->addItem(tr("Output error of the motor and the arm encoder"), "motor-and-arm");
   noise_->setToolTip(tr("Output error: the model's simulation against the log (K = 0); "
                         "innovations form: a Kalman gain K is estimated too and the one-step "
-                        "prediction error (4.5) is minimised (4.6)"));
+                        "prediction error (4.5) is minimised (4.6); motor and arm encoder (a log "
+                        "with arm_angle_rad): the deflection r phi_m - phi_a is fitted as a second "
+                        "output, each weighted by its noise (flexarm fit --outputs motor,arm)"));
   closedLoop_->setObjectName("closedLoopCombo");
   closedLoop_->addItem(tr("Auto: indirect when the controller is known or identified"), "auto");
   closedLoop_->addItem(tr("Two-stage: fit to the input part the reference explains"), "two-stage");
@@ -534,6 +540,8 @@ std::optional<FitOptions> FitPanel::options(QString* name, std::vector<Experimen
     o.noiseModel = noise_->currentIndex() == 1 ? NoiseModel::Innovations : NoiseModel::OutputError;
     o.closedLoop = closedLoopChoiceFromString(closedLoop_->currentData().toString().toStdString())
                        .value_or(ClosedLoopChoice::Auto);
+    o.model.armOutput = noise_->currentIndex() == 2;
+    if (o.model.armOutput) o.closedLoop = ClosedLoopChoice::Auto;  // the nonlinear fit is direct
     o.randomStarts = starts_->value();
     std::string bad;
     if (!startsAndBoundsFromText(startsBounds_->text().toStdString(), o.startValues, o.bounds, &bad)) {
@@ -726,6 +734,14 @@ void FitPanel::onFinished() {
   lines << tr("Notches: %1. Peaks: %2. (rad/s: the minima and maxima of |G(i w)|, what a click on "
               "the Bode plot reads, as flexarm model and the reports give them)")
                .arg(joined(r.notches), joined(r.peaks));
+  if (r.deflection && r.deflection->fitPercent)
+    lines << tr("Deflection r phi_m - phi_a (arm encoder, %1 mrad RMS) predicted from the torque: %2 % (5.2), "
+                "%3 % NRMSE; encoder skew %4 ms.")
+                 .arg(1e3 * r.deflection->measuredRms, 0, 'g', 3)
+                 .arg(*r.deflection->fitPercent, 0, 'f', 1)
+                 .arg(r.deflection->fitPercentNrmse.value_or(NAN), 0, 'f', 1)
+                 .arg(1e3 * r.deflection->skewSeconds, 0, 'g', 3);
+  for (const auto& w : r.plausibility) lines << tr("Implausible: %1.").arg(QString::fromStdString(w));
   for (const auto& w : r.warnings) lines << tr("Note: %1.").arg(QString::fromStdString(w));
   // The estimate joins the shared list under a name no other entry has, naming its data:
   // "three-mass estimate 2 (chirp.csv 0.5-12 s)".

@@ -106,6 +106,7 @@ bool applyStartOptions(ArgParser& args, PhysicalModel& model, FitOptions& o, con
       if (const auto [e, k] = effectValue(effects, name); e >= 0) {
         FitEffect& f = effects[static_cast<std::size_t>(e)];
         if (v) f.effect.values[static_cast<std::size_t>(k)] = v->value;
+        if (v && k == 1) f.scaleSmoothing = false;
         if (option == "fix") f.free[static_cast<std::size_t>(k)] = false;
         std::string why;
         if (!f.effect.isValid(&why)) {
@@ -238,12 +239,15 @@ bool parseModelSpec(const std::string& text, FitModelSpec& spec, std::string* wh
 std::vector<std::string> fitValuedOptionNames() {
   std::vector<std::string> v = logReadOptionNames();
   for (const char* n : {"model", "effect", "free", "fix", "start", "bound", "decimate", "range", "log", "validation-log",
-                        "validation-range", "max-iterations", "starts", "seed", "closed-loop"})
+                        "validation-range", "max-iterations", "starts", "seed", "closed-loop", "method",
+                        "cutoff", "friction", "outputs", "reference"})
     v.push_back(n);
   return v;
 }
 
-std::vector<std::string> fitFlagNames() { return {"json", "help", "noise-model", "keep-means"}; }
+std::vector<std::string> fitFlagNames() {
+  return {"json", "help", "noise-model", "keep-means", "no-idim-start", "same-instant"};
+}
 
 const char* fitOptionsHelp() {
   return "  --model SPEC          arx:NA,NB,NK | armax:NA,NB,NC,NK | oe:NB,NF,NK |\n"
@@ -264,6 +268,16 @@ const char* fitOptionsHelp() {
          "                        finite differences; standard deviations from the Gauss-Newton\n"
          "                        Jacobian (4.37). Closed-loop logs take the direct fit. The\n"
          "                        frequency response, notches and peaks are the linear part's\n"
+         "                        Arm side: arm_friction:f_a,F_a (viscous and Coulomb on the\n"
+         "                        arm), asymmetric_coulomb:F_c+,F_c- (Coulomb friction forwards\n"
+         "                        and backwards), gravity:mgl,phi_0 (mgl sin(phi_a + phi_0) on\n"
+         "                        the arm), encoder_skew:T_o (the arm encoder reads T_o s late;\n"
+         "                        with --outputs motor,arm). The smooth signs' speed v_s is 1 %\n"
+         "                        of the data's RMS motor speed unless given\n"
+         "  --outputs motor,arm   physical models on a log with an arm-side encoder: fit the arm\n"
+         "                        too, the deflection r phi_m - phi_a with the motor output\n"
+         "                        (nonlinear estimator), each weighted by its noise level (a\n"
+         "                        first fit estimates both, then the fit is refined)\n"
          "  --free P1,P2          physical models: estimate only these parameters (model or\n"
          "                        effect parameters, e.g. J_m,k_g,beta)\n"
          "  --fix P[=V]           physical models: hold P, a model or effect parameter (at V,\n"
@@ -312,6 +326,26 @@ const char* fitOptionsHelp() {
          "                        two-stage fit at the lowest and the highest. Otherwise\n"
          "                        two-stage on a log with a reference, direct without one.\n"
          "                        It says which and why.\n"
+         "  --method M            physical models: pem (prediction error, default), idim or\n"
+         "                        idim-iv: the rigid part by inverse dynamics in closed form\n"
+         "                        (Gautier and Janot's IDIM): tau = J q'' + F_v q' + F_c sign(q')\n"
+         "                        + offset by least squares on the position low-passed by a\n"
+         "                        Butterworth filter run both ways (--cutoff HZ, default a\n"
+         "                        twentieth of the sample rate) and differentiated, every column\n"
+         "                        low-passed and decimated alike; idim-iv takes instruments from\n"
+         "                        the position reference (closed loop). --friction asymmetric\n"
+         "                        fits F_v+, F_v-, F_c+, F_c- instead. A prismatic axis (metadata\n"
+         "                        axis: prismatic, or an output in m) reports M, N s/m and N.\n"
+         "                        The torque, held over each sample, is paired with the motion\n"
+         "                        half a sample later; --same-instant pairs them at the same\n"
+         "                        sample, as the EMPS reference does\n"
+         "  --reference CHANNEL   the channel holding the position reference (default: the\n"
+         "                        log's reference, angle_ref_rad), e.g. qg of a .mat file\n"
+         "  --no-idim-start       a prediction-error fit of a flexible model starts from the\n"
+         "                        model as given; by default inverse dynamics below its first\n"
+         "                        notch scales its inertias, stiffnesses, dampings and f_m when\n"
+         "                        its inertia is off by more than a factor of two (the fit says\n"
+         "                        so; not when start values of them are given)\n"
          "  --decimate N          decimate by N with the anti-alias FIR before fitting (a\n"
          "                        physical model then holds each torque sample's mean over its\n"
          "                        period; its zero-order hold is an approximation there, and a\n"
@@ -344,6 +378,10 @@ const char* fitOptionsHelp() {
          "         fit_percent_validation, and fit_percent in each experiment)\n"
          "  NRMSE  MATLAB compare's 1 - ||e|| / ||y - mean y|| (JSON: fit_percent_nrmse,\n"
          "         fit_percent_validation_nrmse); 96.4 % (5.2) is 81.0 % NRMSE.\n"
+         "On a log with an arm-side encoder (arm_angle_rad) a physical fit says how well it\n"
+         "predicts the deflection r phi_m - phi_a from the torque alone (JSON deflection:\n"
+         "fit_percent, fit_percent_validation, their _nrmse twins, rms_estimation,\n"
+         "rms_validation in rad, and the encoders' skew skew_s by least squares).\n"
          "Notches and peaks (JSON notches_rad_s, peaks_rad_s): the frequencies of the local\n"
          "minima and maxima of |G(i w)| of the estimate, what a click on the Bode plot reads\n"
          "(the same rule as `flexarm model`).\n";
@@ -411,6 +449,39 @@ int runFitPipeline(ArgParser& args, const std::string& verb, FitResult& result, 
       return kExitUsage;
     }
   }
+  if (auto m = args.value("method")) {
+    auto method = fitMethodFromString(*m);
+    if (!method) {
+      err << pre << "--method expects pem, idim or idim-iv, not '" << *m << "'\n";
+      return kExitUsage;
+    }
+    o.method = *method;
+  }
+  if (!args.number("cutoff", o.idim.cutoffHz)) {
+    err << pre << args.error() << "\n";
+    return kExitUsage;
+  }
+  if (auto f = args.value("friction")) {
+    if (*f != "symmetric" && *f != "asymmetric") {
+      err << pre << "--friction expects symmetric or asymmetric, not '" << *f << "'\n";
+      return kExitUsage;
+    }
+    o.idim.friction = *f == "asymmetric" ? IdimFriction::Asymmetric : IdimFriction::Symmetric;
+  }
+  o.idimStart = !args.flag("no-idim-start");
+  o.idim.heldTorque = !args.flag("same-instant");
+  if (auto ref = args.value("reference")) o.reference = *ref;
+  if (auto outputs = args.value("outputs")) {
+    if (*outputs != "motor" && *outputs != "motor,arm") {
+      err << pre << "--outputs expects motor or motor,arm, not '" << *outputs << "'\n";
+      return kExitUsage;
+    }
+    if (!physical) {
+      err << pre << "--outputs applies to physical models only\n";
+      return kExitUsage;
+    }
+    o.model.armOutput = *outputs == "motor,arm";
+  }
   if (!physical && !args.values("effect").empty()) {
     err << pre << "--effect applies to physical models only\n";
     return kExitUsage;
@@ -423,6 +494,7 @@ int runFitPipeline(ArgParser& args, const std::string& verb, FitResult& result, 
     }
     FitEffect f = FitEffect::defaults(e->kind);
     f.effect = *e;
+    f.scaleSmoothing = spec.find(',') == std::string::npos;  // v_s given: kept
     o.model.effects.push_back(f);
   }
   if (physical) {
@@ -541,8 +613,46 @@ int runFit(const std::vector<std::string>& argv, std::ostream& out, std::ostream
                   {"ti", fit.controller->ti},
                   {"torque_fit_percent", optJson(fit.controllerFitPercent)},
                   {"source", fit.controllerSource}};
+  // Inverse dynamics (the method's result, or the start it gave): its parameter rows, its
+  // filters and the torque it explains.
+  nlohmann::json idimJ = nullptr;
+  if (fit.idim) {
+    const IdimResult& e = *fit.idim;
+    nlohmann::json rows = nlohmann::json::object();
+    for (const auto& p : e.parameters)
+      rows[p.name] = {{"value", p.value}, {"std", p.std}, {"lower", p.lower}, {"upper", p.upper}, {"unit", p.unit}};
+    idimJ = {{"parameters", rows},
+             {"cutoff_hz", e.cutoffHz},
+             {"decimation", e.decimation},
+             {"samples", e.samples},
+             {"relative_error_percent", e.relativeError},
+             {"torque_fit_percent", e.torqueFitPercent},
+             {"condition_number", e.conditionNumber},
+             {"message", e.message}};
+  }
+  // The deflection check: the fit's own keys, of the deflection r phi_m - phi_a.
+  nlohmann::json deflectionJ = nullptr;
+  if (fit.deflection) {
+    const DeflectionCheck& c = *fit.deflection;
+    auto finite = [](double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); };
+    deflectionJ = {{"fit_percent", optJson(c.fitPercent)},
+                   {"fit_percent_validation", optJson(c.fitPercentValidation)},
+                   {"fit_percent_nrmse", optJson(c.fitPercentNrmse)},
+                   {"fit_percent_validation_nrmse", optJson(c.fitPercentValidationNrmse)},
+                   {"rms_estimation", finite(c.rmsEstimation)},
+                   {"rms_validation", finite(c.rmsValidation)},
+                   {"measured_rms", finite(c.measuredRms)},
+                   {"gear_ratio", c.gearRatio},
+                   {"skew_s", c.skewSeconds},
+                   {"skew_std_s", c.skewStd},
+                   {"fit_percent_without_skew", optJson(c.fitPercentWithoutSkew)}};
+  }
   if (args.flag("json")) {
     nlohmann::json j = {{"model", fit.modelName()},
+                        {"idim", idimJ},
+                        {"idim_start", fit.idimNote},
+                        {"deflection", deflectionJ},
+                        {"plausibility", fit.plausibility},
                         {"parameters", params},
                         {"std", stds},
                         {"effects", effects},
@@ -584,6 +694,10 @@ int runFit(const std::vector<std::string>& argv, std::ostream& out, std::ostream
       << " Hz (" << fit.data.note() << ")\n";
   if (fit.method) out << "closed-loop method: " << fit.methodDescription << " (" << fit.methodReason << ")\n";
   if (fit.controller) out << "controller: " << fit.controllerSource << "\n";
+  if (!fit.idimNote.empty()) out << "start: " << fit.idimNote << "\n";
+  if (fit.idim && fit.idimNote.empty())
+    out << "inverse dynamics: " << fit.idim->message << ", the torque explained " << fit.idim->torqueFitPercent
+        << " % (5.2), condition number " << fit.idim->conditionNumber << "\n";
   for (const auto& p : fit.parameters)
     out << "  " << p.name << " = " << p.value << " +- " << p.std << (p.free ? "" : " (fixed)")
         << (p.effect.empty() ? "" : " " + p.unit + " (" + p.effect + ")") << "\n";
@@ -621,7 +735,21 @@ int runFit(const std::vector<std::string>& argv, std::ostream& out, std::ostream
   };
   listFits("estimation", fit.estimation, files.estimation, false);
   listFits("validation", fit.validation, files.validation, true);
+  if (fit.deflection) {
+    const DeflectionCheck& c = *fit.deflection;
+    out << "deflection r phi_m - phi_a (arm encoder, r = " << c.gearRatio << ", measured " << c.measuredRms * 1e3
+        << " mrad RMS): predicted from the torque ";
+    if (c.fitPercent) both(c.fitPercent, c.fitPercentNrmse);
+    out << ", error " << c.rmsEstimation * 1e3 << " mrad RMS";
+    if (c.fitPercentValidation) {
+      out << "; validation ";
+      both(c.fitPercentValidation, c.fitPercentValidationNrmse);
+    }
+    out << "\n  encoder skew " << c.skewSeconds * 1e3 << " +- " << c.skewStd * 1e3 << " ms (arm reading late); without it "
+        << c.fitPercentWithoutSkew.value_or(NAN) << " % (5.2)\n";
+  }
   for (const auto& w : fit.warnings) out << "warning: " << w << "\n";
+  for (const auto& w : fit.plausibility) out << "implausible: " << w << "\n";
   auto list = [&](const char* what, const std::vector<double>& w) {
     out << what;
     for (double x : w) out << " " << x;

@@ -61,6 +61,13 @@ const char* kSimulateHelpTail =
     "  --substeps N          Runge-Kutta steps per controller period (default 10)\n"
     "  --motor-velocity      also log the true motor_velocity_rad_s\n"
     "  --log-arm-accel       also log the true arm_accel_rad_s2\n"
+    "  --arm-angle           also log arm_angle_rad, an arm-side encoder (2^22 counts per\n"
+    "                        revolution) reading the truth's arm angle phi_a, so that fits\n"
+    "                        report the deflection r phi_m - phi_a they predict\n"
+    "  --velocity-feedforward F  a controller other than Figure 5.1's: F times the\n"
+    "                        reference's velocity fed forward into the velocity loop\n"
+    "  --velocity-filter HZ  ... and a first-order low-pass of HZ on its velocity estimate\n"
+    "                        (both written to the log's metadata)\n"
     "  --out FILE            the CSV log to write (required); the truth goes to FILE with\n"
     "                        .csv replaced by .truth.json\n"
     "  --json                print a JSON summary\n";
@@ -144,11 +151,11 @@ int runSimulate(const std::vector<std::string>& argv, std::ostream& out, std::os
   for (const char* v : {"effect", "step", "excitation", "amplitude", "chirp", "multisine-lines",
                         "multisine-period", "prbs-clock", "reference-velocity", "duration", "seed",
                         "rate", "controller-rate", "kp", "kv", "ti", "torque-noise", "load-noise",
-                        "encoder-counts", "substeps", "out"})
+                        "encoder-counts", "substeps", "velocity-feedforward", "velocity-filter", "out"})
     valued.push_back(v);
   for (const char* v : kSimulateFleetOptions) valued.push_back(v);
   auto flags = modelFlagOptions();
-  for (const char* f : {"json", "help", "motor-velocity", "log-arm-accel"}) flags.push_back(f);
+  for (const char* f : {"json", "help", "motor-velocity", "log-arm-accel", "arm-angle"}) flags.push_back(f);
   ArgParser args(flags, valued);
   auto usage = [&err](const std::string& why) {
     err << "flexarm simulate: " << why << "\n(flexarm simulate --help explains the options)\n";
@@ -183,7 +190,9 @@ int runSimulate(const std::vector<std::string>& argv, std::ostream& out, std::os
       !args.number("torque-noise", o.disturbance.torqueNoiseStd) ||
       !args.number("load-noise", o.disturbance.loadTorqueStd) || !args.integer("seed", seed) ||
       !args.integer("encoder-counts", counts, 0, 1 << 30) ||
-      !args.integer("substeps", o.substeps, 1, 10000))
+      !args.integer("substeps", o.substeps, 1, 10000) ||
+      !args.number("velocity-feedforward", o.velocityFeedForward) ||
+      !args.number("velocity-filter", o.velocityFilterHz))
     return usage(args.error());
   o.excitation.prbsClockS = prbsClock;
   o.disturbance.encoderCountsPerRev = counts;
@@ -203,6 +212,7 @@ int runSimulate(const std::vector<std::string>& argv, std::ostream& out, std::os
   }
   o.logMotorVelocity = args.flag("motor-velocity");
   o.logArmAcceleration = args.flag("log-arm-accel");
+  o.logArmAngle = args.flag("arm-angle");
   std::string why;
   if (!o.isValid(&why)) return usage(why);
   if (o.excitation.kind == ExcitationKind::Multisine &&

@@ -201,6 +201,7 @@ int addEffectCoordinates(NonlinearProblem& pr, int index, const EffectBounds& bo
       pr.coords.push_back(effectCoordinate(index, 1, CoordinateMap::Fraction, e.kind));
       return 0;
     }
+    default: break;  // not a discovery candidate (DiscoveryOptions::isValid)
   }
   return 0;
 }
@@ -277,6 +278,9 @@ void fitCandidate(const Context& ctx, EffectKind kind, const ModelFit& current, 
         }
         break;
       }
+      default:  // not a discovery candidate (DiscoveryOptions::isValid): one start, the default
+        starts.push_back(e0);
+        break;
     }
     // Screening: a few iterations from every start; the ripple grid fits A alone (linear in A).
     LeastSquaresSolution bestSol;

@@ -37,6 +37,7 @@ std::string signatureText(EffectKind k) {
       return "the residual lines at n times the motor angle (the response to A sin(n phi_m))";
     case EffectKind::ExtraMass:
       return "the residual against the resonance shift of an added mass at omega";
+    default: break;  // not a discovery candidate (DiscoveryOptions::isValid)
   }
   return toString(k);
 }

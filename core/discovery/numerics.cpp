@@ -16,6 +16,10 @@ bool DiscoveryOptions::isValid(std::string* why) const {
     return false;
   };
   if (candidates.empty()) return fail("at least one candidate effect is needed");
+  for (EffectKind k : candidates)
+    if (std::find(seedEffectKinds().begin(), seedEffectKinds().end(), k) == seedEffectKinds().end())
+      return fail(std::string("discovery looks for the effects of the seed's Section 3.2 assumptions; ") +
+                  toString(k) + " is fitted with fit --effect");
   for (std::size_t i = 0; i < startEffects.size(); ++i) {
     std::string reason;
     if (!startEffects[i].isValid(&reason)) return fail("start effect: " + reason);

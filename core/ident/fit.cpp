@@ -67,6 +67,12 @@ bool FitModelSpec::isValid(std::string* why) const {
                       start->structureName());
         for (std::size_t k = 0; k < effectParameters(f.effect.kind).size(); ++k) anyFree = anyFree || f.free[k];
       }
+      for (const auto& f : effects)
+        if (f.effect.kind == EffectKind::EncoderSkew && !armOutput)
+          return fail("encoder_skew shifts what the arm encoder reads: it goes with the arm as an output "
+                      "(--outputs motor,arm)");
+      if (armOutput && start->options().output != ModelOutput::MotorVelocity)
+        return fail("the arm as a second output goes with the motor velocity as the first");
       if (!effects.empty() && start->options().armAcceleration)
         return fail("a fit with effects takes one output (the motor velocity or angle), not the arm acceleration");
       if (!anyFree) return fail("a physical fit needs at least one free parameter");
@@ -90,6 +96,7 @@ std::string FitModelSpec::name() const {
     case FitModelKind::Physical: {
       std::string n = start ? start->structureName() : "physical";
       for (const auto& f : effects) n += std::string(" + ") + toString(f.effect.kind);
+      if (armOutput) n += " (motor and arm)";
       return n;
     }
     case FitModelKind::BlackBox: return PolynomialModel::zero(structure, orders, 1.0).name();
@@ -128,6 +135,18 @@ bool FitOptions::isValidExceptData(std::string* why) const {
   if (!(level > 0.0 && level < 1.0)) return fail("the level must lie strictly between 0 and 1");
   if (responsePoints < 2) return fail("the frequency response needs at least two points");
   if (!(notchDepthDb >= 0.0)) return fail("the notch depth cannot be negative");
+  if (method != FitMethod::PredictionError) {
+    if (model.kind != FitModelKind::Physical)
+      return fail(std::string("the ") + toString(method) + " method estimates a physical model's rigid part; "
+                  "give a physical model");
+    if (!model.effects.empty())
+      return fail(std::string("the ") + toString(method) + " method has its own friction model; it takes no effects");
+    if (decimation > 1)
+      return fail(std::string("the ") + toString(method) + " method filters and decimates the data itself; "
+                  "it excludes decimation");
+    if (estimation.size() > 1) return fail(std::string("the ") + toString(method) + " method takes one estimation experiment");
+    if (!idim.isValid(why)) return false;
+  }
   if (model.kind == FitModelKind::Physical) {
     if (noiseModel == NoiseModel::Innovations && closedLoop != ClosedLoopChoice::Auto &&
         closedLoop != ClosedLoopChoice::Direct)
@@ -143,7 +162,9 @@ bool FitOptions::isValidExceptData(std::string* why) const {
     if (controller && !controller->isValid(why)) return false;
     if (!controllerIdent.isValid(why)) return false;
     try {
-      const auto start = fitStartModel(*this);
+      FitOptions dataless = *this;  // the log's own gear ratio is the data's business (fitModel)
+      dataless.estimation.clear();
+      const auto start = fitStartModel(dataless);
       bool anyFree = false;
       for (const auto& p : start->parameters()) anyFree = anyFree || p.free;
       if (!anyFree) return fail("a physical fit needs at least one free parameter");
@@ -379,19 +400,29 @@ FitResult fitModel(const FitOptions& options, const ProgressCallback& progress) 
     return std::move(r);
   };
 
-  // 1. Data.
+  // 1. Data. A log's gear ratio, the one source of a physical model's r, must be a ratio.
+  if (options.model.kind == FitModelKind::Physical)
+    for (const auto& e : options.estimation) {
+      std::string bad;
+      if (!logGearRatio(*e.data, &bad) && !bad.empty()) {
+        r.badData = true;
+        return finish(Termination::Failed, bad);
+      }
+    }
   FitDataOptions d;
   d.input = options.input;
   d.output = options.output;
   d.reference = options.reference;
-  d.velocityOutput = options.model.wantsVelocity();
+  const bool inverse = options.method != FitMethod::PredictionError;
+  // Inverse dynamics differentiates the position itself, behind its own filter.
+  d.velocityOutput = options.model.wantsVelocity() && !inverse;
   d.decimation = options.decimation;
   // A physical model holds its input over each sample (5.3): decimated, the torque it holds
   // is the logged torque's mean over the sample period (fit_data.h).
   if (options.model.kind == FitModelKind::Physical)
     d.decimatedInput = FitDataOptions::DecimatedInput::HeldMean;
   // The effects act on the real torque, velocity and angle: their means stay.
-  d.removeMeans = options.removeMeans && !options.model.nonlinear();
+  d.removeMeans = options.removeMeans && !options.model.nonlinear() && !inverse;
   r.badData = !prepareEstimation(options, d, r) || !prepareValidation(options, d, r);
   if (r.badData) return finish(r.termination, r.message);
   const bool nonparametric = options.model.kind == FitModelKind::Spa || options.model.kind == FitModelKind::Etfe;
@@ -405,12 +436,24 @@ FitResult fitModel(const FitOptions& options, const ProgressCallback& progress) 
                   "the input is constant over the estimation range, so the data say nothing about the system");
 
   // 2-4. Method, starts, estimator.
+  if (inverse) {
+    try {
+      if (!fit_detail::fitIdim(options, r)) return finish(r.termination, r.message);
+      r.response = fitResponse(r, fitFrequencyGrid(r.data, options.responsePoints), options.level);
+      fit_detail::plausibilityChecks(options, r);
+    } catch (const std::exception& e) {
+      return finish(Termination::Failed, std::string("inverse dynamics failed: ") + e.what());
+    }
+    return finish(r.summary.termination, r.summary.message);
+  }
+  FitOptions started = options;  // with the start values inverse dynamics gives
   try {
     switch (options.model.kind) {
       case FitModelKind::Physical:
+        fit_detail::idimStart(started, r);
         if (options.model.nonlinear()) {
-          fit_detail::fitNonlinear(options, r, progress);
-        } else if (!fit_detail::fitPhysical(options, r, progress)) {
+          fit_detail::fitNonlinear(started, r, progress);
+        } else if (!fit_detail::fitPhysical(started, r, progress)) {
           return finish(r.termination, r.message);
         }
         break;
@@ -440,6 +483,7 @@ FitResult fitModel(const FitOptions& options, const ProgressCallback& progress) 
   // 5. Evaluation.
   try {
     fit_detail::evaluate(options, r);
+    fit_detail::plausibilityChecks(options, r);
   } catch (const std::exception& e) {
     return finish(Termination::Failed, std::string("the estimate could not be evaluated: ") + e.what());
   }

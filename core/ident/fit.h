@@ -30,6 +30,7 @@
 #include "core/ident/closed_loop_pem.h"
 #include "core/ident/controller_ident.h"
 #include "core/ident/fit_data.h"
+#include "core/ident/idim.h"
 #include "core/ident/nonlinear_pem.h"
 #include "core/ident/nonparametric.h"
 #include "core/ident/pem.h"
@@ -55,6 +56,11 @@ struct FitModelSpec {
   // velocity); not with the innovations form or the arm acceleration output. The response,
   // notches and peaks are the linear part's.
   std::vector<FitEffect> effects;
+  // Physical: the arm as a second output (`--outputs motor,arm`), from a log with an arm-side
+  // encoder: the deflection r phi_m - phi_a fitted together with the motor output by the
+  // nonlinear estimator, each output's errors weighted by its noise level (estimated by a
+  // first fit, then the fit refined).
+  bool armOutput = false;
   // Black-box: the structure (4.8) and its orders.
   PolyStructure structure = PolyStructure::Oe;
   PolyOrders orders;
@@ -63,7 +69,7 @@ struct FitModelSpec {
   bool isValid(std::string* why) const;
   // "three-mass", "three-mass + coulomb_friction", "oe[2 2 1]", "spa", "etfe".
   std::string name() const;
-  bool nonlinear() const { return kind == FitModelKind::Physical && !effects.empty(); }
+  bool nonlinear() const { return kind == FitModelKind::Physical && (!effects.empty() || armOutput); }
   // The output the model gives is the motor velocity (Section 5.2), so a logged motor angle
   // is differentiated first.
   bool wantsVelocity() const;
@@ -73,6 +79,13 @@ struct FitModelSpec {
 enum class ClosedLoopChoice { Auto, Direct, TwoStage, Indirect };
 const char* toString(ClosedLoopChoice c);  // "auto", "direct", "two-stage", "indirect"
 std::optional<ClosedLoopChoice> closedLoopChoiceFromString(std::string_view s);
+
+// How a physical model is estimated: by prediction error (the seed's (5.7), the default), or
+// its rigid part by inverse dynamics in closed form (core/ident/idim.h): least squares
+// (IDIM-LS) or, for closed-loop logs, instrumental variables from the reference (IDIM-IV).
+enum class FitMethod { PredictionError, Idim, IdimIv };
+const char* toString(FitMethod m);  // "pem", "idim", "idim-iv"
+std::optional<FitMethod> fitMethodFromString(std::string_view s);
 
 // A value of one physical parameter, by the name parameters() gives it (e.g. "J_m", "k_g").
 struct ParameterValue {
@@ -122,6 +135,16 @@ struct FitOptions {
   int decimation = 1;
   bool removeMeans = true;
   // Physical models.
+  FitMethod method = FitMethod::PredictionError;
+  // The inverse-dynamics estimate's filters and friction model (method Idim, IdimIv, and the
+  // start values below).
+  IdimOptions idim;
+  // A prediction-error fit of a flexible model whose start has no inertia given (no start
+  // value of an inertia) first estimates the rigid part by IDIM-LS below the start model's
+  // first notch; when the start model's total inertia is off by more than a factor of two,
+  // its inertias, stiffnesses, dampings and f_m are scaled to match (resonances and damping
+  // ratios kept), and the fit says so (the seed's 9.2 asks for good initial values).
+  bool idimStart = true;
   NoiseModel noiseModel = NoiseModel::OutputError;
   ClosedLoopChoice closedLoop = ClosedLoopChoice::Auto;
   // The controller the log was recorded with, for the indirect fit; unset: the log's
@@ -173,6 +196,43 @@ struct FitValidation {
   Eigen::VectorXd simulated;  // the whole log, from its first sample
 };
 
+// How well a physical estimate predicts the deflection r phi_m - phi_a between motor and arm
+// (arm side, rad) from the torque alone, against what the log's motor encoder and arm-side
+// encoder (arm_angle_rad) measure: the estimate's deflection (PhysicalModel::armDeflectionRow,
+// or the nonlinear plant's) simulated from the torque as the output is, r the estimate's gear
+// ratio. Each signal is taken about its own mean over the range (the two encoders' zeros are
+// unrelated), so a fit % says how much of the deflection's variation the model explains.
+struct DeflectionCheck {
+  std::optional<double> fitPercent, fitPercentNrmse;                      // estimation range
+  std::optional<double> fitPercentValidation, fitPercentValidationNrmse;  // first validation
+  double rmsEstimation = 0.0, rmsValidation = 0.0;  // of the prediction error (rad; NaN: none)
+  double measuredRms = 0.0;  // of the measured deflection about its mean, estimation range (rad)
+  double gearRatio = 0.0;
+  // A sampling skew between the two encoders: the time T_o (s) by which the arm encoder's
+  // reading lags (positive) the motor's, by least squares of the prediction error on the
+  // measured arm velocity (d_measured = d_model + T_o phi_a'), with its std; and the fit %
+  // (5.2) once that skew is taken out. A skew read as stiffness would make the spring look
+  // softer (or harder) than it is.
+  double skewSeconds = 0.0, skewStd = 0.0;
+  std::optional<double> fitPercentWithoutSkew;
+  // Over the whole first estimation log and the first validation log, about the estimation
+  // range's means (the Compare panel overlays them); times are the data's.
+  Eigen::VectorXd measured, predicted, measuredValidation, predictedValidation;
+};
+
+// The deflection r phi_m - phi_a the linear part of a physical model predicts from the torque
+// u sampled every sampleTime: the zero-order hold (5.3) from zero state at the first sample,
+// the output PhysicalModel::armDeflectionRow (all zero for the rigid model), plus, as an arm
+// encoder reading encoderSkew seconds late sees it, encoderSkew times the arm's speed.
+Eigen::VectorXd simulateDeflection(const PhysicalModel& model, const Eigen::VectorXd& u, double sampleTime,
+                                   double encoderSkew = 0.0);
+// The encoder_skew T_o among effects (0 without it).
+double encoderSkewOf(const std::vector<Effect>& effects);
+// The deflection the motor and arm-side encoders measure, r phi_m - phi_a over the whole of d
+// (the logged motor angle, or an output that is the angle, and arm_angle_rad); empty without
+// both.
+Eigen::VectorXd measuredDeflection(const PreparedData& d, double gearRatio);
+
 struct FitResult {
   Termination termination = Termination::Failed;
   std::string message;  // a sentence: how it ended, or why it failed
@@ -202,9 +262,18 @@ struct FitResult {
   std::string controllerSource;  // a sentence: metadata or identified, and its fit % of the torque
   std::optional<double> controllerFitPercent;
 
+  // The inverse-dynamics estimate: the result of method Idim/IdimIv, or the one a
+  // prediction-error fit started from (idimStart), with the sentence saying what it did.
+  std::optional<IdimResult> idim;
+  std::string idimNote;
+
   EstimateSummary summary;
   std::shared_ptr<const PhysicalModel> physical;  // physical estimate (the start's output)
   std::vector<Effect> effects;                    // the effects' estimated values
+  // Nonlinear fits: the motor speed of the smooth signs, from the data (1 % of the RMS motor
+  // speed), and with the arm as an output the weight its errors had.
+  double smoothingSpeed = 0.0;
+  double deflectionWeight = 0.0;
   Eigen::VectorXd K;                              // innovations gain (empty: output error)
   Eigen::MatrixXd covariance;                     // of physical->parameters()[freeIndices]
   // With effects: the covariance of every free parameter, the model's (freeIndices order)
@@ -237,6 +306,13 @@ struct FitResult {
   std::vector<double> notches, peaks;  // rad/s (5.4)
   // Sentences for the user: biased method, unstable model, intervals to read with care.
   std::vector<std::string> warnings;
+  // Sentences beside the numbers of a physical fit whose parameters are physically absurd: an
+  // interval wider than its value, an inertia or stiffness orders of magnitude outside the
+  // range of robot axes, a resonance the data cannot see, a gear ratio the log never stated.
+  // Empty: nothing absurd found.
+  std::vector<std::string> plausibility;
+  // A physical fit on a log with an arm-side encoder: the deflection it predicts.
+  std::optional<DeflectionCheck> deflection;
 
   bool ok() const { return termination == Termination::Converged || termination == Termination::MaxIterations; }
   // "three-mass (K = 0)", "three-mass (innovations form)", "oe[2 2 1]", "spa".
@@ -245,12 +321,20 @@ struct FitResult {
 
 // The bounds a physical fit of options searches in, one per parameter of the start model in
 // its order: the model's own, with non-negative dampings (d_*; the model allows the seed's
-// negative ones, Tables 5.4 and 5.7) and positive inertias and stiffnesses, then
+// negative ones, Tables 5.4 and 5.7, and a damping whose start value is negative keeps them)
+// and positive inertias and stiffnesses, then
 // options.bounds. Throws std::invalid_argument when the options are not a physical fit.
 std::vector<ParameterBound> fitBounds(const FitOptions& options);
 
+// The gear ratio a log states (metadata gear_ratio, arm turns per motor turn: "0.0039" or
+// "1/256.86"); nullopt when it states none, or (with a sentence in why) when the value is not
+// a ratio in (0, 1].
+std::optional<double> logGearRatio(const IdData& data, std::string* why = nullptr);
+
 // The start model of a physical fit: options.model.start with options.startValues (r's
-// rescaling included), the fit's bounds and its values moved into them. Sentences about
+// rescaling included), r from the first estimation log's gear_ratio when it states one and no
+// start value names r (the log is the one source of r), the fit's bounds and its values moved
+// into them. Sentences about
 // values moved are appended to notes (may be null). Throws std::invalid_argument as fitBounds,
 // or for a start value that is unknown or outside its bounds.
 std::shared_ptr<PhysicalModel> fitStartModel(const FitOptions& options, std::vector<std::string>* notes = nullptr);

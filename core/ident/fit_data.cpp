@@ -99,6 +99,9 @@ PreparedData prepareFitData(const IdData& data, const FitDataOptions& options) {
   const bool outputIsAngle = outCh->name == columns::kMotorAngle;
   if (angle && !outputIsAngle && angle != in && angle != ref)
     d.setChannel(Channel{angle->name, angle->unit, ChannelRole::None, angle->values});
+  const Channel* arm = data.channel(columns::kArmAngle);
+  if (arm && arm != in && arm != outCh && arm != ref)
+    d.setChannel(Channel{arm->name, arm->unit, ChannelRole::None, arm->values});
   if (!d.isValid(&why)) return fail("the log's channels are not usable: " + why);
   if (d.samples() < 2) return fail("the log holds fewer than two samples");
   out.inputName = in->name;
@@ -144,6 +147,7 @@ PreparedData prepareFitData(const IdData& data, const FitDataOptions& options) {
   out.y = vectorOf(d.output());
   out.r = vectorOf(d.withRole(ChannelRole::Reference));
   out.angle = vectorOf(d.channel(columns::kMotorAngle));
+  if (arm && arm != in && arm != outCh && arm != ref) out.arm = vectorOf(d.channel(columns::kArmAngle));
 
   // 4. Ranges in seconds become sample ranges of the data as they now are.
   const std::string span = seconds(d.timeAt(0)) + "-" + seconds(d.timeAt(d.samples() - 1)) + " s";

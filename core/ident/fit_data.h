@@ -63,6 +63,9 @@ struct PreparedData {
   // The measured motor angle after step 3, its mean kept (empty when the log has none): what
   // a controller sees, for the indirect closed-loop fit.
   Eigen::VectorXd angle;
+  // The arm-side encoder's angle (arm_angle_rad) after step 3, its mean kept; empty when the
+  // log has none. With the motor angle it gives the measured deflection r phi_m - phi_a.
+  Eigen::VectorXd arm;
   SampleRange estimation;  // never empty when ok()
   SampleRange validation;  // empty without a validation range
   double sampleTime = 1.0;

@@ -26,7 +26,7 @@ const char* const kDirectCoverage = "8 of 30";
 // nonlinear simulation blows up.
 Eigen::VectorXd simulated(const FitOptions& o, const FitResult& r, const PreparedData& d, SampleRange range) {
   const auto b = static_cast<Eigen::Index>(range.begin), n = static_cast<Eigen::Index>(range.size());
-  if (r.physical && !r.effects.empty()) {
+  if (r.physical && o.model.nonlinear()) {
     const Eigen::VectorXd y = simulateNonlinear(*r.physical, r.effects, nonlinearSeries(r, d, range), nonlinearOptions(o, r));
     return y.size() ? y : Eigen::VectorXd::Constant(n, NAN);
   }
@@ -38,7 +38,7 @@ Eigen::VectorXd simulated(const FitOptions& o, const FitResult& r, const Prepare
 // errors of its innovations form when K is estimated; with effects, of the nonlinear
 // simulation), one-step errors (4.5) of a black-box one.
 Eigen::VectorXd residualsOf(const FitOptions& o, const FitResult& r, const PreparedData& d) {
-  if (r.physical && !r.effects.empty())
+  if (r.physical && o.model.nonlinear())
     return d.y - simulated(o, r, d, SampleRange{0, static_cast<std::size_t>(d.u.size())});
   return r.physical ? predictionErrors(*r.physical, r.K, d.u, d.y, d.sampleTime)
                     : predictionErrors(*r.polynomial, d.u, d.y);
@@ -192,7 +192,10 @@ void evaluate(const FitOptions& o, FitResult& r) {
                                      "independently parameterized noise model (BJ) are free of bias (4.43); "
                                      "on simulated logs at the sample logs' noise only ") +
                          kDirectCoverage + " of the direct fit's 99 % intervals held the truth");
-  if (r.physical) intervalCaveats(o, r);
+  if (r.physical) {
+    intervalCaveats(o, r);
+    deflectionCheck(o, r);
+  }
   if (r.polynomial && d.closedLoop && r.polynomial->structure != PolyStructure::Bj)
     r.warnings.push_back("the log was recorded in closed loop: only models with a flexible, independently "
                          "parameterized noise model (BJ) are free of bias (4.43)");

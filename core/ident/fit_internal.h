@@ -24,6 +24,10 @@ void boundWarnings(const PhysicalModel& start, FitResult& result);
 // Steps 2-4 for physical models with effects: the nonlinear grey-box estimator over every
 // estimation experiment (nonlinear_pem.h). Fills the estimate, its effects and parameter rows.
 void fitNonlinear(const FitOptions& options, FitResult& result, const ProgressCallback& progress);
+// The estimate of the nonlinear estimator into result: summary, parameter rows, covariance,
+// effects and warnings (start: the model the search started from).
+void keepNonlinear(NonlinearPemResult&& estimate, const FitOptions& options, const PhysicalModel& start,
+                   FitResult& result);
 
 // One experiment of prepared data over range as the nonlinear estimator sees it
 // (nonlinearSeries of nonlinear_pem.h, the output the model gives: velocity or angle), and the
@@ -31,6 +35,23 @@ void fitNonlinear(const FitOptions& options, FitResult& result, const ProgressCa
 // the predicted angle differentiated as the logged one was).
 NonlinearSeries nonlinearSeries(const FitResult& result, const PreparedData& data, SampleRange range);
 NonlinearPemOptions nonlinearOptions(const FitOptions& options, const FitResult& result);
+
+// Steps 2-4 of method idim / idim-iv: the inverse-dynamics estimate of the rigid part on the
+// first estimation experiment (positions and torques with their means). False with
+// termination and message set when the data cannot carry it.
+bool fitIdim(const FitOptions& options, FitResult& result);
+
+// Start values from inverse dynamics for a prediction-error fit (FitOptions::idimStart):
+// appended to options.startValues when the start model's inertia is off by more than a factor
+// of two; result.idim and result.idimNote say what was done.
+void idimStart(FitOptions& options, FitResult& result);
+
+// Step 5 on a log with an arm-side encoder: the deflection the physical estimate predicts
+// against the measured one (FitResult::deflection).
+void deflectionCheck(const FitOptions& options, FitResult& result);
+
+// Step 5 for physical fits: FitResult::plausibility.
+void plausibilityChecks(const FitOptions& options, FitResult& result);
 
 // Step 5: fit % on every experiment, residual tests, response, notches and peaks, warnings.
 void evaluate(const FitOptions& options, FitResult& result);

@@ -44,7 +44,7 @@ int defaultSubsteps(double Ts) { return std::max(2, static_cast<int>(std::ceil(T
 
 bool predictOutput(const NonlinearPlant& plant, const NonlinearSeries& s, int substeps,
                    const LoadObserver& observer, PredictedOutput output, std::vector<double>& yhat,
-                   std::vector<double>* deflection) {
+                   std::vector<double>* deflection, std::vector<double>* armDeflection) {
   const std::size_t N = s.u.size();
   if (N == 0) return false;
   const bool hasAngle = s.phi.size() == N;
@@ -52,6 +52,7 @@ bool predictOutput(const NonlinearPlant& plant, const NonlinearSeries& s, int su
   std::vector<double> phiHat(N);
   yhat.resize(N);
   if (deflection) deflection->resize(N);
+  if (armDeflection) armDeflection->resize(N);
   // Start in rigid-body motion at the given speed (a data set cut from a longer log need not
   // start at rest): phi_m' = v0, every arm-side speed r v0, the springs relaxed.
   NonlinearPlant::State x{};
@@ -103,6 +104,7 @@ bool predictOutput(const NonlinearPlant& plant, const NonlinearSeries& s, int su
       return false;
     if (output == PredictedOutput::MotorVelocity) yhat[k] = v;
     if (deflection) (*deflection)[k] = plant.gearDeflection(x);
+    if (armDeflection) (*armDeflection)[k] = plant.armDeflection(x) + plant.encoderSkew() * plant.armVelocity(x);
     if (wo > 0.0 && k > 0) {
       const double e = hasAngle ? ((s.phi[k] - s.phi[k - 1]) - (phiHat[k] - phiHat[k - 1])) / Ts
                                 : s.y[k] - v;
@@ -155,12 +157,30 @@ std::pair<std::unique_ptr<PhysicalModel>, std::vector<Effect>> NonlinearProblem:
   return {std::move(m), std::move(e)};
 }
 
+std::vector<double> NonlinearSeries::targets() const {
+  std::vector<double> t = y;
+  if (deflection.empty()) return t;
+  double mean = 0.0;
+  for (double v : deflection) mean += v;
+  mean /= static_cast<double>(deflection.size());
+  for (double v : deflection) t.push_back(deflectionWeight * (v - mean));
+  return t;
+}
+
 bool NonlinearProblem::simulate(const Eigen::VectorXd& phi, const NonlinearSeries& s, std::vector<double>& yhat,
                                 std::vector<double>* deflection) const {
   try {
     auto built = build(phi);
-    const NonlinearPlant plant(*built.first, built.second);
-    return predictOutput(plant, s, substeps, observer, output, yhat, deflection);
+    NonlinearPlant plant(*built.first, built.second);
+    if (smoothingSpeed > 0.0) plant.setSmoothingSpeed(smoothingSpeed);
+    if (s.deflection.empty()) return predictOutput(plant, s, substeps, observer, output, yhat, deflection);
+    std::vector<double> arm;
+    if (!predictOutput(plant, s, substeps, observer, output, yhat, deflection, &arm)) return false;
+    double mean = 0.0;
+    for (double v : arm) mean += v;
+    mean /= static_cast<double>(arm.size());
+    for (double v : arm) yhat.push_back(s.deflectionWeight * (v - mean));
+    return true;
   } catch (const std::invalid_argument&) {
     return false;
   }
@@ -172,19 +192,30 @@ bool NonlinearProblem::evaluate(const Eigen::VectorXd& phi, Eigen::VectorXd& eps
   Eigen::Index N = 0;
   for (std::size_t s = 0; s < series.size(); ++s) {
     if (!simulate(phi, *series[s], yhat[s])) return false;
-    N += static_cast<Eigen::Index>(series[s]->fitSamples.empty() ? yhat[s].size() : series[s]->fitSamples.size());
+    // With a deflection the prediction stacks the output and the deflection, each one value a
+    // sample: fitSamples then pick the same samples of both.
+    const std::size_t outputs = series[s]->deflection.empty() ? 1 : 2;
+    N += static_cast<Eigen::Index>(series[s]->fitSamples.empty() ? yhat[s].size()
+                                                                  : outputs * series[s]->fitSamples.size());
   }
-  // The errors that enter the loss: every sample, or the series' fitSamples.
+  // The errors that enter the loss: every sample, or the series' fitSamples (of each output).
   auto stack = [this](std::size_t s, const std::vector<double>& y, auto&& put) {
     const auto& pick = series[s]->fitSamples;
-    if (pick.empty())
+    if (pick.empty()) {
       for (std::size_t k = 0; k < y.size(); ++k) put(k);
-    else
-      for (std::size_t k : pick) put(k);
+      return;
+    }
+    const std::size_t n = series[s]->y.size();
+    for (std::size_t offset = 0; offset < y.size(); offset += n)
+      for (std::size_t k : pick) put(offset + k);
   };
   eps.resize(N);
-  for (std::size_t s = 0, at = 0; s < series.size(); ++s)
-    stack(s, yhat[s], [&](std::size_t k) { eps[static_cast<Eigen::Index>(at++)] = series[s]->y[k] - yhat[s][k]; });
+  for (std::size_t s = 0, at = 0; s < series.size(); ++s) {
+    const std::vector<double> target = series[s]->deflection.empty() ? std::vector<double>{} : series[s]->targets();
+    const std::vector<double>& y = target.empty() ? series[s]->y : target;
+    if (y.size() != yhat[s].size()) return false;
+    stack(s, yhat[s], [&](std::size_t k) { eps[static_cast<Eigen::Index>(at++)] = y[k] - yhat[s][k]; });
+  }
   if (!psi) return true;
   const std::size_t p = coords.size();
   psi->resize(N, static_cast<Eigen::Index>(p));
@@ -291,6 +322,7 @@ bool NonlinearPemOptions::isValid(std::string* why) const {
   if (threads < 1 || threads > 64) return fail("threads must be in 1..64");
   if (!(observerBandwidthHz >= 0.0) || !std::isfinite(observerBandwidthHz))
     return fail("the observer bandwidth must be >= 0 Hz");
+  if (!(smoothingSpeed >= 0.0) || !std::isfinite(smoothingSpeed)) return fail("the smoothing speed must be >= 0");
   if (why) why->clear();
   return true;
 }
@@ -307,11 +339,17 @@ NonlinearCoordinate effectCoordinate(int effect, int index, const Effect& e) {
   const bool positive = (e.kind == EffectKind::CoulombFriction && index == 1) ||
                         (e.kind == EffectKind::TorqueRipple && index == 1);
   const double v = e.values[static_cast<std::size_t>(index)];
+  // A phase or a skew takes either sign.
+  const bool signed_ = (e.kind == EffectKind::Gravity && index == 1) || e.kind == EffectKind::EncoderSkew;
   if (positive) {
     c.map = CoordinateMap::Log;
+  } else if (signed_) {
+    c.map = CoordinateMap::Scaled;
+    c.scale = std::max(std::abs(v), e.kind == EffectKind::Gravity ? 1.0 : 1e-3);
   } else {
     c.map = CoordinateMap::NonNegative;
     c.scale = std::max(std::abs(v), std::abs(effectParameters(e.kind)[static_cast<std::size_t>(index)].defaultValue));
+    if (!(c.scale > 0.0)) c.scale = 1.0;  // a value that starts (and defaults) at zero
   }
   c.rough = e.kind == EffectKind::Backlash || e.kind == EffectKind::InputDelay;
   return c;
@@ -327,6 +365,7 @@ NonlinearPemResult nonlinearPem(const PhysicalModel& start, const std::vector<Fi
   if (experiments.empty()) throw std::invalid_argument("nonlinearPem: no experiment");
   for (const auto& s : experiments)
     if (s.u.size() != s.y.size() || s.u.size() < 2 || !(s.Ts > 0.0) ||
+        (!s.deflection.empty() && s.deflection.size() != s.u.size()) ||
         std::abs(s.Ts - experiments.front().Ts) > 1e-9 * s.Ts)
       throw std::invalid_argument("nonlinearPem: every experiment needs u and y of equal length (>= 2) and "
                                   "the same positive sample time");
@@ -354,6 +393,7 @@ NonlinearPemResult nonlinearPem(const PhysicalModel& start, const std::vector<Fi
   pr.output = o.output;
   pr.observer = loadObserver(*base, o.observerBandwidthHz);
   pr.threads = o.threads;
+  pr.smoothingSpeed = o.smoothingSpeed;
   LeastSquaresSolution sol =
       pr.solve(pr.coordinatesOf(values), o.maxIterations, o.relativeTolerance, progress);
   NonlinearPemResult R;
@@ -417,7 +457,8 @@ Eigen::VectorXd simulateNonlinear(const PhysicalModel& model, const std::vector<
                                   const NonlinearSeries& series, const NonlinearPemOptions& o) {
   std::unique_ptr<PhysicalModel> m(static_cast<PhysicalModel*>(model.clone().release()));
   m->setOptions(ModelOptions{});
-  const NonlinearPlant plant(*m, effects);
+  NonlinearPlant plant(*m, effects);
+  if (o.smoothingSpeed > 0.0) plant.setSmoothingSpeed(o.smoothingSpeed);
   std::vector<double> yhat;
   const int substeps = o.substeps > 0 ? o.substeps : defaultSubsteps(series.Ts);
   if (!predictOutput(plant, series, substeps, loadObserver(*m, o.observerBandwidthHz), o.output, yhat)) return {};

@@ -54,6 +54,16 @@ struct NonlinearSeries {
   // The samples whose errors enter the loss, ascending (empty: every sample): a log split
   // into fitted and held-out samples is still simulated whole.
   std::vector<std::size_t> fitSamples;
+  // The arm as a second output: the measured deflection r phi_m - phi_a (motor and arm-side
+  // encoders; empty: the motor output alone) and the weight of its errors against the first
+  // output's (the ratio of their noise levels). Both are compared about their own means over
+  // the experiment (the two encoders' zeros are unrelated); the arm's prediction is the plant's
+  // deflection as the arm encoder reads it (encoder_skew).
+  std::vector<double> deflection;
+  double deflectionWeight = 1.0;
+  // The output, then (with a deflection) the weighted deflection about its mean: what the
+  // predictor's stacked output is compared with.
+  std::vector<double> targets() const;
 };
 
 // A slow observer of an unmeasured arm-side load: a PI torque on the motor (in units of u)
@@ -82,10 +92,12 @@ LoadObserver loadObserver(const PhysicalModel& model, double bandwidthHz);
 NonlinearSeries nonlinearSeries(const PreparedData& data, SampleRange range, bool angleOutput);
 
 // The predicted output of a plant for one experiment; false when the simulation blows up.
-// deflection, when given, receives the gear deflection at every sample.
+// deflection, when given, receives the gear deflection at every sample; armDeflection the
+// deflection r phi_m - phi_a as the arm encoder reads it (NonlinearPlant::armDeflection plus
+// encoder_skew's T_o times the arm's speed).
 bool predictOutput(const NonlinearPlant& plant, const NonlinearSeries& s, int substeps,
                    const LoadObserver& observer, PredictedOutput output, std::vector<double>& yhat,
-                   std::vector<double>* deflection = nullptr);
+                   std::vector<double>* deflection = nullptr, std::vector<double>* armDeflection = nullptr);
 
 // Runge-Kutta steps per sample for a step of at most 0.25 ms (and at least 2).
 int defaultSubsteps(double sampleTime);
@@ -121,11 +133,13 @@ struct NonlinearProblem {
   PredictedOutput output = PredictedOutput::DifferentiatedAngle;
   int threads = 1;  // gradient columns computed in parallel
   const std::atomic<bool>* cancel = nullptr;
+  double smoothingSpeed = 0.0;  // NonlinearPlant::setSmoothingSpeed; 0: the default
 
   // Model and effects for a coordinate vector; throws std::invalid_argument when the values
   // leave the model's bounds.
   std::pair<std::unique_ptr<PhysicalModel>, std::vector<Effect>> build(const Eigen::VectorXd& phi) const;
-  // The predicted output of one experiment; false when the values are refused or it blows up.
+  // The predicted output of one experiment (with a deflection, the weighted deflection about
+  // its mean appended); false when the values are refused or it blows up.
   bool simulate(const Eigen::VectorXd& phi, const NonlinearSeries& s, std::vector<double>& yhat,
                 std::vector<double>* deflection = nullptr) const;
   // Stacked prediction errors of every experiment and, when asked, psi = -d eps / d phi.
@@ -144,6 +158,9 @@ std::vector<NonlinearCoordinate> baseCoordinates(const PhysicalModel& m);
 struct FitEffect {
   Effect effect;
   std::array<bool, 2> free{true, false};
+  // coulomb_friction: the fit sets v_s from the data's speed (1 % of the RMS motor speed,
+  // whatever its units) instead of keeping the value given; false when v_s was given.
+  bool scaleSmoothing = true;
   // The effect at its defaults with its first value free and the others fixed (v_s of the
   // Coulomb friction, n of the ripple: a smoothing speed and an integer the data hardly
   // inform).
@@ -161,6 +178,9 @@ struct NonlinearPemOptions {
   PredictedOutput output = PredictedOutput::MotorVelocity;
   // Load observer (loadObserver) for closed-loop data: kClosedLoopObserverHz; 0: output error.
   double observerBandwidthHz = 0.0;
+  // The motor speed of the smooth signs of asymmetric_coulomb and arm_friction
+  // (NonlinearPlant::setSmoothingSpeed); 0: the default 0.1 rad/s.
+  double smoothingSpeed = 0.0;
   bool isValid(std::string* why) const;
 };
 

@@ -14,6 +14,8 @@ constexpr KindName kKindNames[] = {
     {EffectKind::CoulombFriction, "coulomb_friction"}, {EffectKind::Backlash, "backlash"},
     {EffectKind::NonlinearSpring, "nonlinear_spring"}, {EffectKind::InputDelay, "input_delay"},
     {EffectKind::TorqueRipple, "torque_ripple"},       {EffectKind::ExtraMass, "extra_mass"},
+    {EffectKind::ArmFriction, "arm_friction"},         {EffectKind::AsymmetricCoulomb, "asymmetric_coulomb"},
+    {EffectKind::Gravity, "gravity"},                  {EffectKind::EncoderSkew, "encoder_skew"},
 };
 
 bool parseNumber(std::string_view s, double& out) {
@@ -37,8 +39,15 @@ std::optional<EffectKind> effectKindFromString(std::string_view s) {
 const std::vector<EffectKind>& allEffectKinds() {
   static const std::vector<EffectKind> kAll = {
       EffectKind::CoulombFriction, EffectKind::Backlash,     EffectKind::NonlinearSpring,
-      EffectKind::InputDelay,      EffectKind::TorqueRipple, EffectKind::ExtraMass};
+      EffectKind::InputDelay,      EffectKind::TorqueRipple, EffectKind::ExtraMass,
+      EffectKind::ArmFriction,     EffectKind::AsymmetricCoulomb, EffectKind::Gravity,
+      EffectKind::EncoderSkew};
   return kAll;
+}
+
+const std::vector<EffectKind>& seedEffectKinds() {
+  static const std::vector<EffectKind> kSeed(allEffectKinds().begin(), allEffectKinds().begin() + 6);
+  return kSeed;
 }
 
 const std::vector<EffectParameterInfo>& effectParameters(EffectKind k) {
@@ -57,7 +66,22 @@ const std::vector<EffectParameterInfo>& effectParameters(EffectKind k) {
   static const std::vector<EffectParameterInfo> kMass = {
       {"omega", "rad/s", 250.0, "resonance frequency of the added mass on its spring"},
       {"fraction", "1", 0.3, "part of the outermost mass moved to the added mass"}};
+  static const std::vector<EffectParameterInfo> kArm = {
+      {"f_a", "N m s/rad", 50.0, "viscous friction on the arm side of the gear"},
+      {"F_a", "N m", 0.0, "Coulomb friction on the arm side: F_a tanh(phi_a'/(r v_s))"}};
+  static const std::vector<EffectParameterInfo> kAsymmetric = {
+      {"F_c+", "N m", 0.05, "Coulomb friction on the motor while it turns forwards"},
+      {"F_c-", "N m", 0.05, "Coulomb friction on the motor while it turns backwards"}};
+  static const std::vector<EffectParameterInfo> kGravity = {
+      {"mgl", "N m", 100.0, "gravity torque amplitude m g l on the arm: mgl sin(phi_a + phi_0)"},
+      {"phi_0", "rad", 0.0, "phase of the gravity torque: the arm angle (from the log's zero) plus phi_0 is the angle from the vertical"}};
+  static const std::vector<EffectParameterInfo> kSkew = {
+      {"T_o", "s", 0.0, "time by which the arm encoder's reading lags the motor encoder's"}};
   switch (k) {
+    case EffectKind::ArmFriction: return kArm;
+    case EffectKind::AsymmetricCoulomb: return kAsymmetric;
+    case EffectKind::Gravity: return kGravity;
+    case EffectKind::EncoderSkew: return kSkew;
     case EffectKind::CoulombFriction: return kCoulomb;
     case EffectKind::Backlash: return kBacklash;
     case EffectKind::NonlinearSpring: return kSpring;
@@ -107,6 +131,18 @@ bool Effect::isValid(std::string* why) const {
     case EffectKind::ExtraMass:
       if (values[0] <= 0.0) return fail(name + ": omega must be > 0");
       if (!(values[1] > 0.0 && values[1] < 1.0)) return fail(name + ": fraction must be in (0, 1)");
+      break;
+    case EffectKind::ArmFriction:
+      if (values[0] < 0.0 || values[1] < 0.0) return fail(name + ": f_a and F_a must be >= 0");
+      break;
+    case EffectKind::AsymmetricCoulomb:
+      if (values[0] < 0.0 || values[1] < 0.0) return fail(name + ": F_c+ and F_c- must be >= 0");
+      break;
+    case EffectKind::Gravity:
+      if (values[0] < 0.0) return fail(name + ": mgl must be >= 0 (phi_0 turns the direction)");
+      break;
+    case EffectKind::EncoderSkew:
+      if (values[0] < -1.0 || values[0] > 1.0) return fail(name + ": T_o must be in [-1, 1] s");
       break;
   }
   if (why) why->clear();

@@ -18,10 +18,20 @@ enum class EffectKind {
   InputDelay,       // "input_delay": the torque acts T_d seconds late
   TorqueRipple,     // "torque_ripple": A sin(n phi_m) on the motor, n periods per revolution
   ExtraMass,        // "extra_mass": one more mass (rigid -> two-mass -> ... -> four-mass)
+  // Effects of large robots, on the arm side of the gear and between the encoders:
+  ArmFriction,        // "arm_friction": -f_a phi_a' - F_a tanh(phi_a'/(r v_s)) on the arm
+  AsymmetricCoulomb,  // "asymmetric_coulomb": Coulomb friction F_c+ moving forwards, F_c-
+                      // backwards, on the motor (EMPS's (12))
+  Gravity,            // "gravity": -m g l sin(phi_a + phi_0) on the arm (an axis that is not
+                      // vertical)
+  EncoderSkew,        // "encoder_skew": the arm encoder reads T_o seconds after the motor's
 };
 const char* toString(EffectKind k);
 std::optional<EffectKind> effectKindFromString(std::string_view s);
 const std::vector<EffectKind>& allEffectKinds();
+// The six effects of the seed's Section 3.2 assumptions (coulomb_friction ... extra_mass),
+// the ones discovery looks for.
+const std::vector<EffectKind>& seedEffectKinds();
 
 struct EffectParameterInfo {
   std::string name;  // e.g. "F_c"

@@ -34,6 +34,11 @@ NonlinearPlant::NonlinearPlant(const PhysicalModel& model, const std::vector<Eff
   arm_ = topo.armVelocityState < 0 ? mv_ : topo.armVelocityState;
   armScale_ = topo.armVelocityState < 0 ? model_->value("r") : 1.0;
   gear_ = topo.gearDeflectionState;
+  ratio_ = model_->value("r");
+  {
+    const Eigen::RowVectorXd row = model_->armDeflectionRow();
+    for (int i = 0; i < n_; ++i) armDeflection_[static_cast<std::size_t>(i)] = row[i];
+  }
 
   const StateSpace ss = model_->stateSpace();
   Eigen::MatrixXd A0 = ss.A;
@@ -52,6 +57,7 @@ NonlinearPlant::NonlinearPlant(const PhysicalModel& model, const std::vector<Eff
     bl_[static_cast<std::size_t>(arm_)] = 1.0 / model_->value(topo.armInertia);
   }
 
+  coulombSpeed_ = effectParameters(EffectKind::CoulombFriction)[1].defaultValue;
   for (const Effect& e : effects_) {
     switch (e.kind) {
       case EffectKind::CoulombFriction:
@@ -72,6 +78,21 @@ NonlinearPlant::NonlinearPlant(const PhysicalModel& model, const std::vector<Eff
         ripplePeriods_ = e.value(1);
         break;
       case EffectKind::ExtraMass: break;
+      case EffectKind::ArmFriction:
+        armViscous_ = e.value(0);
+        armCoulomb_ = e.value(1);
+        armTorques_ = true;
+        break;
+      case EffectKind::AsymmetricCoulomb:
+        coulombPlus_ = e.value(0);
+        coulombMinus_ = e.value(1);
+        break;
+      case EffectKind::Gravity:
+        gravity_ = e.value(0);
+        gravityPhase_ = e.value(1);
+        armTorques_ = true;
+        break;
+      case EffectKind::EncoderSkew: skew_ = e.value(0); break;
     }
   }
   if (gear_ >= 0 && !topo.gearStiffness.empty()) {
@@ -100,11 +121,14 @@ NonlinearPlant::NonlinearPlant(const PhysicalModel& model, const std::vector<Eff
 NonlinearPlant::NonlinearPlant(const NonlinearPlant& o)
     : model_(static_cast<PhysicalModel*>(o.model_->clone().release())),
       effects_(o.effects_),
-      n_(o.n_), mv_(o.mv_), arm_(o.arm_), gear_(o.gear_), armScale_(o.armScale_), A0_(o.A0_),
+      n_(o.n_), mv_(o.mv_), arm_(o.arm_), gear_(o.gear_), armScale_(o.armScale_), ratio_(o.ratio_),
+      armDeflection_(o.armDeflection_), A0_(o.A0_),
       bu_(o.bu_), bm_(o.bm_), bl_(o.bl_), sg_(o.sg_), gearRate_(o.gearRate_),
       gearNonlinear_(o.gearNonlinear_), k_(o.k_), d_(o.d_), coulomb_(o.coulomb_),
       coulombSpeed_(o.coulombSpeed_), backlash_(o.backlash_), beta_(o.beta_), delay_(o.delay_),
-      rippleAmp_(o.rippleAmp_), ripplePeriods_(o.ripplePeriods_) {}
+      rippleAmp_(o.rippleAmp_), ripplePeriods_(o.ripplePeriods_), coulombPlus_(o.coulombPlus_),
+      coulombMinus_(o.coulombMinus_), armViscous_(o.armViscous_), armCoulomb_(o.armCoulomb_),
+      gravity_(o.gravity_), gravityPhase_(o.gravityPhase_), skew_(o.skew_), armTorques_(o.armTorques_) {}
 
 namespace {
 // Gear spring and damper torque with a dead zone of half-width b and stiffening beta: no
@@ -128,6 +152,23 @@ void NonlinearPlant::derivative(const double* x, double u, double load, double* 
   }
   double motorTorque = 0.0;
   if (coulomb_ != 0.0) motorTorque -= coulomb_ * std::tanh(x[mv_] / coulombSpeed_);
+  if (coulombPlus_ != 0.0 || coulombMinus_ != 0.0) {
+    const double t = std::tanh(x[mv_] / coulombSpeed_);
+    motorTorque -= (t > 0.0 ? coulombPlus_ : coulombMinus_) * t;
+  }
+  if (armTorques_) {
+    // Arm-side friction (its smoothing speed is the motor's through the gear) and gravity,
+    // acting where the load does.
+    const double va = arm_ == mv_ ? armScale_ * x[mv_] : x[arm_];
+    double arm = -armViscous_ * va;
+    if (armCoulomb_ != 0.0) arm -= armCoulomb_ * std::tanh(va / (ratio_ * coulombSpeed_));
+    if (gravity_ != 0.0) {
+      double deflection = 0.0;
+      for (int i = 0; i < n; ++i) deflection += armDeflection_[static_cast<std::size_t>(i)] * x[i];
+      arm -= gravity_ * std::sin(ratio_ * x[n] - deflection + gravityPhase_);
+    }
+    for (int i = 0; i < n; ++i) dx[i] += bl_[static_cast<std::size_t>(i)] * arm;
+  }
   if (rippleAmp_ != 0.0) motorTorque += rippleAmp_ * std::sin(ripplePeriods_ * x[n]);
   if (motorTorque != 0.0)
     for (int i = 0; i < n; ++i) dx[i] += bm_[static_cast<std::size_t>(i)] * motorTorque;
@@ -148,6 +189,26 @@ double NonlinearPlant::armAcceleration(const State& x, double u, double load) co
 
 double NonlinearPlant::gearDeflection(const State& x) const {
   return gear_ < 0 ? 0.0 : x[static_cast<std::size_t>(gear_)];
+}
+
+double NonlinearPlant::armDeflection(const State& x) const {
+  double s = 0.0;
+  for (int i = 0; i < n_; ++i) s += armDeflection_[static_cast<std::size_t>(i)] * x[static_cast<std::size_t>(i)];
+  return s;
+}
+
+double NonlinearPlant::armAngle(const State& x) const { return ratio_ * motorAngle(x) - armDeflection(x); }
+
+void NonlinearPlant::setSmoothingSpeed(double speed) {
+  if (!(speed > 0.0) || !std::isfinite(speed))
+    throw std::invalid_argument("NonlinearPlant: the smoothing speed must be positive");
+  for (const Effect& e : effects_)
+    if (e.kind == EffectKind::CoulombFriction) return;  // its own v_s rules
+  coulombSpeed_ = speed;
+}
+
+double NonlinearPlant::armVelocity(const State& x) const {
+  return arm_ == mv_ ? armScale_ * x[static_cast<std::size_t>(mv_)] : x[static_cast<std::size_t>(arm_)];
 }
 
 double NonlinearPlant::gearTorque(const State& x) const {

@@ -52,18 +52,34 @@ class NonlinearPlant {
   // damper (N m); both 0 for the rigid model.
   double gearDeflection(const State& x) const;
   double gearTorque(const State& x) const;
+  // The whole deflection r phi_m - phi_a (arm side, rad), the arm angle phi_a and its speed.
+  double armDeflection(const State& x) const;
+  double armAngle(const State& x) const;
+  double armVelocity(const State& x) const;
+  // The motor speed (rad/s) of the smooth sign tanh(phi_m'/v_s) of asymmetric_coulomb and,
+  // through the gear, arm_friction: coulomb_friction's v_s when it is on, else this (default
+  // 0.1, coulomb_friction's default). Throws std::invalid_argument unless positive.
+  void setSmoothingSpeed(double speed);
+  // The time by which the arm encoder's reading lags the motor's (encoder_skew; 0 without).
+  double encoderSkew() const { return skew_; }
 
  private:
   std::unique_ptr<PhysicalModel> model_;
   std::vector<Effect> effects_;
   int n_ = 0, mv_ = 0, arm_ = 0, gear_ = -1;
   double armScale_ = 1.0;  // phi_a'' = armScale * x'_arm (r for the rigid model)
+  double ratio_ = 1.0;     // r
+  State armDeflection_{};  // the row of armDeflection over the core states
   std::array<double, kMaxStates * kMaxStates> A0_{};  // row-major, n x n
   State bu_{}, bm_{}, bl_{}, sg_{}, gearRate_{};
   bool gearNonlinear_ = false;
   double k_ = 0.0, d_ = 0.0;
   double coulomb_ = 0.0, coulombSpeed_ = 1.0, backlash_ = 0.0, beta_ = 0.0, delay_ = 0.0;
   double rippleAmp_ = 0.0, ripplePeriods_ = 0.0;
+  double coulombPlus_ = 0.0, coulombMinus_ = 0.0;           // asymmetric_coulomb
+  double armViscous_ = 0.0, armCoulomb_ = 0.0;              // arm_friction
+  double gravity_ = 0.0, gravityPhase_ = 0.0, skew_ = 0.0;  // gravity, encoder_skew
+  bool armTorques_ = false;
 };
 
 template <class TorqueAt>

@@ -282,6 +282,15 @@ std::vector<std::string> PhysicalModel::stateNames() const {
   return names;
 }
 
+Eigen::RowVectorXd PhysicalModel::armDeflectionRow() const {
+  Eigen::RowVectorXd row = Eigen::RowVectorXd::Zero(topology_.coreStates);
+  for (std::size_t i = 0; i < coreStateNames_.size(); ++i) {
+    const std::string& n = coreStateNames_[i];
+    if (n == "r*phi_m - phi_a" || n == "r*phi_m - phi_g" || n == "phi_g - phi_a") row[static_cast<Eigen::Index>(i)] = 1.0;
+  }
+  return row;
+}
+
 std::vector<std::string> PhysicalModel::outputNames() const {
   std::vector<std::string> names = {options_.output == ModelOutput::MotorAngle ? "phi_m"
                                                                                : "phi_m'"};

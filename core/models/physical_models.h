@@ -63,6 +63,11 @@ class PhysicalModel : public ParametricModel {
   // Names of the states and outputs in order, e.g. "r*phi_m - phi_a", "phi_m'".
   std::vector<std::string> stateNames() const;
   std::vector<std::string> outputNames() const;
+  // The row over the core states that gives the whole deflection between motor and arm,
+  // r phi_m - phi_a (arm side, rad): the gear spring's deflection plus, for the three- and
+  // four-mass models, the arm spring's (phi_g - phi_a); zero for the rigid model. What an
+  // arm-side encoder sees against the motor encoder through the gear.
+  Eigen::RowVectorXd armDeflectionRow() const;
 
   // Implementation hooks: matrices A (n x n) and B (n x 1) of the core states, row-major, for
   // double and for dual numbers (value + derivative along one parameter).

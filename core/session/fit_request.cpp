@@ -113,14 +113,19 @@ json fitRequestToJson(const FitRequest& r) {
   if (r.physical()) {
     j["kind"] = toString(FitModelKind::Physical);
     std::vector<Effect> effects;
-    json free = json::array();
+    json free = json::array(), scaled = json::array();
     for (const auto& f : o.model.effects) {
       effects.push_back(f.effect);
       free.push_back({f.free[0], f.free[1]});
+      scaled.push_back(f.scaleSmoothing);
     }
     j["start"] = modelToJson(r.name, *o.model.start, effects);
-    if (!effects.empty()) j["effects_free"] = free;
+    if (!effects.empty()) {
+      j["effects_free"] = free;
+      j["effects_scale_smoothing"] = scaled;
+    }
     j["noise_model"] = toString(o.noiseModel);
+    if (o.model.armOutput) j["arm_output"] = true;
     j["closed_loop"] = toString(o.closedLoop);
     j["random_starts"] = o.randomStarts;
     j["seed"] = o.seed;
@@ -178,9 +183,15 @@ std::optional<FitRequest> fitRequestFromJson(const json& j, std::string* why) {
     const json* free = j.contains("effects_free") ? &j["effects_free"] : nullptr;
     if (free && (!free->is_array() || free->size() != spec->effects.size()))
       return fail(where + "effects_free must list one pair of flags per effect of the start model");
+    // Whether each effect's smoothing speed follows the data (absent, as sessions stored before
+    // it did: the value stored).
+    const json* scaled = j.contains("effects_scale_smoothing") ? &j["effects_scale_smoothing"] : nullptr;
+    if (scaled && (!scaled->is_array() || scaled->size() != spec->effects.size()))
+      return fail(where + "effects_scale_smoothing must list one flag per effect of the start model");
     for (std::size_t i = 0; i < spec->effects.size(); ++i) {
       FitEffect f = FitEffect::defaults(spec->effects[i].kind);
       f.effect = spec->effects[i];
+      f.scaleSmoothing = scaled && (*scaled)[i].is_boolean() && (*scaled)[i].get<bool>();
       if (free) {
         const json& flags = (*free)[i];
         if (!flags.is_array() || flags.size() != 2 || !flags[0].is_boolean() || !flags[1].is_boolean())
@@ -195,6 +206,10 @@ std::optional<FitRequest> fitRequestFromJson(const json& j, std::string* why) {
       if (!m) return fail(where + "noise_model must be \"" + toString(NoiseModel::OutputError) +
                           "\" or \"" + toString(NoiseModel::Innovations) + "\"");
       o.noiseModel = *m;
+    }
+    if (j.contains("arm_output")) {
+      if (!j["arm_output"].is_boolean()) return fail(where + "arm_output must be true or false");
+      o.model.armOutput = j["arm_output"].get<bool>();
     }
     // Sessions written before fits stored their closed-loop method ran direct fits.
     o.closedLoop = ClosedLoopChoice::Direct;

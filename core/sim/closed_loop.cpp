@@ -36,7 +36,7 @@ bool DisturbanceOptions::isValid(std::string* why) const {
   if (!finitePositive(loadBandwidthHz)) return failWith(why, "load bandwidth must be > 0");
   if (!std::isfinite(loadStepNm) || !(loadStepTimeS >= 0.0))
     return failWith(why, "load step must be finite and start at t >= 0");
-  if (encoderCountsPerRev < 0) return failWith(why, "encoder counts must be >= 0");
+  if (encoderCountsPerRev < 0 || armEncoderCountsPerRev < 0) return failWith(why, "encoder counts must be >= 0");
   if (why) why->clear();
   return true;
 }
@@ -64,6 +64,10 @@ bool SimulationOptions::isValid(std::string* why) const {
                              std::to_string(static_cast<long long>(kMaxTicks)) +
                              "; shorten the duration or lower the controller rate");
   if (!std::isfinite(referenceVelocity)) return failWith(why, "reference velocity must be finite");
+  if (!(velocityFeedForward >= 0.0 && velocityFeedForward <= 2.0))
+    return failWith(why, "the velocity feed-forward must be a fraction in [0, 2]");
+  if (!(velocityFilterHz >= 0.0) || !std::isfinite(velocityFilterHz))
+    return failWith(why, "the velocity filter's corner must be a finite frequency >= 0");
   if (!referenceSignal.empty() && !(referenceSampleTime > 0.0 && std::isfinite(referenceSampleTime)))
     return failWith(why, "a given reference signal needs a sample time > 0");
   for (double v : referenceSignal)
@@ -142,7 +146,8 @@ SimulationResult simulateClosedLoop(const PhysicalModel& model, const std::vecto
   IdData& d = result.data;
   d.sampleTime = 1.0 / o.logRateHz;
   std::vector<double> logAngle(samples), logTorque(samples), logRef(samples), logVel, logAcc,
-      logGearD, logGearT;
+      logGearD, logGearT, logArm;
+  if (o.logArmAngle) logArm.resize(samples);
   if (o.logMotorVelocity) logVel.resize(samples);
   if (o.logArmAcceleration) logAcc.resize(samples);
   if (o.logGear) {
@@ -155,6 +160,12 @@ SimulationResult simulateClosedLoop(const PhysicalModel& model, const std::vecto
   auto measure = [quantum](double angle) {
     return quantum > 0.0 ? quantum * std::nearbyint(angle / quantum) : angle;
   };
+  const double armQuantum = o.disturbance.armEncoderCountsPerRev > 0
+                                ? 2.0 * M_PI / static_cast<double>(o.disturbance.armEncoderCountsPerRev)
+                                : 0.0;
+  // The velocity filter's pole at the controller rate (0: no filter).
+  const double velocityPole = o.velocityFilterHz > 0.0 ? std::exp(-2.0 * M_PI * o.velocityFilterHz * Tc) : 0.0;
+  double filteredVelocity = 0.0, previousReference = 0.0;
   const double loadPole = std::exp(-2.0 * M_PI * o.disturbance.loadBandwidthHz * Tc);
   // Scale of the first-order noise so that its stationary standard deviation is loadTorqueStd.
   const double loadGain = o.disturbance.loadTorqueStd * std::sqrt(1.0 - loadPole * loadPole);
@@ -170,9 +181,13 @@ SimulationResult simulateClosedLoop(const PhysicalModel& model, const std::vecto
     const NonlinearPlant& plant = *active;
     const double reference = given ? givenReference(t) : o.referenceVelocity * t + excitation[k];
     const double angle = measure(plant.motorAngle(x));
-    const double velocity = k == 0 ? 0.0 : (angle - previousAngle) / Tc;
+    const double rawVelocity = k == 0 ? 0.0 : (angle - previousAngle) / Tc;
     previousAngle = angle;
-    const double ev = o.controller.kp * (reference - angle) - velocity;
+    filteredVelocity = velocityPole * filteredVelocity + (1.0 - velocityPole) * rawVelocity;
+    const double velocity = o.velocityFilterHz > 0.0 ? filteredVelocity : rawVelocity;
+    const double feedForward = k == 0 ? 0.0 : o.velocityFeedForward * (reference - previousReference) / Tc;
+    previousReference = reference;
+    const double ev = o.controller.kp * (reference - angle) + feedForward - velocity;
     integral += ev * Tc;
     const double u =
         o.controller.kv * (ev + (o.controller.ti > 0.0 ? integral / o.controller.ti : 0.0));
@@ -187,6 +202,10 @@ SimulationResult simulateClosedLoop(const PhysicalModel& model, const std::vecto
       logRef[i] = reference;
       if (o.logMotorVelocity) logVel[i] = plant.motorVelocity(x);
       if (o.logArmAcceleration) logAcc[i] = plant.armAcceleration(x, torqueAt(t + 1e-6 * h), load);
+      if (o.logArmAngle) {
+        const double arm = plant.armAngle(x);
+        logArm[i] = armQuantum > 0.0 ? armQuantum * std::nearbyint(arm / armQuantum) : arm;
+      }
       if (o.logGear) {
         logGearD[i] = plant.gearDeflection(x);
         logGearT[i] = plant.gearTorque(x);
@@ -222,6 +241,7 @@ SimulationResult simulateClosedLoop(const PhysicalModel& model, const std::vecto
   add(columns::kAngleRef, ChannelRole::Reference, logRef);
   if (o.logMotorVelocity) add(columns::kMotorVelocity, ChannelRole::None, logVel);
   if (o.logArmAcceleration) add(columns::kArmAccel, ChannelRole::None, logAcc);
+  if (o.logArmAngle) add(columns::kArmAngle, ChannelRole::None, logArm);
   if (o.logGear) {
     add("gear_deflection_rad", ChannelRole::None, logGearD);
     add("gear_torque_nm", ChannelRole::None, logGearT);
@@ -250,6 +270,13 @@ SimulationResult simulateClosedLoop(const PhysicalModel& model, const std::vecto
     std::snprintf(buf, sizeof buf, "%.12g", value);
     d.setMeta(key, buf);
   }
+  const std::pair<const char*, double> extra[] = {{"controller_velocity_feedforward", o.velocityFeedForward},
+                                                  {"controller_velocity_filter_hz", o.velocityFilterHz}};
+  for (const auto& [key, value] : extra)
+    if (value != 0.0) {
+      std::snprintf(buf, sizeof buf, "%.12g", value);
+      d.setMeta(key, buf);
+    }
   result.termination = Termination::Converged;
   result.message = "simulated " + std::to_string(samples) + " samples";
   result.controllerTicks = ticks;
@@ -318,6 +345,14 @@ std::optional<ControllerOptions> controllerFromMetadata(const IdData& data, std:
     if (why) *why = "the controller in the log's metadata: " + bad;
     return std::nullopt;
   }
+  for (const char* key : {"controller_velocity_feedforward", "controller_velocity_filter_hz"})
+    if (!data.meta(key).empty() && std::strtod(data.meta(key).c_str(), nullptr) != 0.0) {
+      if (why)
+        *why = std::string("the log's controller has ") +
+               (std::string(key) == "controller_velocity_feedforward" ? "velocity feed-forward" : "a velocity filter") +
+               " (metadata " + key + "), which the cascade of Figure 5.1 the indirect fit closes does not have";
+      return std::nullopt;
+    }
   return c;
 }
 

@@ -37,6 +37,9 @@ struct DisturbanceOptions {
   double loadStepNm = 0.0;          // N m on the arm from loadStepTimeS on
   double loadStepTimeS = 0.0;
   long encoderCountsPerRev = 65536; // motor encoder resolution; 0: ideal (no quantization)
+  // Arm-side encoder resolution (SimulationOptions::logArmAngle); 0: ideal. 2^22 counts per
+  // revolution, 1.5 urad, as the secondary encoders of large robots.
+  long armEncoderCountsPerRev = 1L << 22;
   bool isValid(std::string* why) const;
 };
 
@@ -64,6 +67,15 @@ struct SimulationOptions {
   bool logMotorVelocity = false;    // adds motor_velocity_rad_s (true velocity)
   bool logArmAcceleration = false;  // adds arm_accel_rad_s2 (true acceleration)
   bool logGear = false;             // adds gear_deflection_rad and gear_torque_nm
+  bool logArmAngle = false;         // adds arm_angle_rad, an arm-side encoder (the truth's
+                                    // r phi_m - deflection, quantized)
+  // Controllers other than Figure 5.1's, as many drives run them: the reference's velocity
+  // (backward difference, times this fraction) fed forward into the velocity loop, and a
+  // first-order low-pass of this corner (Hz) on the velocity estimate; 0: none. A log made
+  // with them says so in its metadata (controller_velocity_feedforward,
+  // controller_velocity_filter_hz), which the indirect closed-loop fit does not model.
+  double velocityFeedForward = 0.0;
+  double velocityFilterHz = 0.0;
   // A given position reference phi_ref (rad, motor side), sampled every referenceSampleTime s
   // from t = 0 and interpolated linearly at the controller rate (held after its last sample),
   // in place of the excitation and the reference velocity: to run the loop of a log again

@@ -48,6 +48,7 @@ FitOptions optionsFor(std::vector<std::shared_ptr<const IdData>> estimation, std
     spring.effect.values[0] = 1e6;  // half the truth
     FitEffect coulomb = FitEffect::defaults(EffectKind::CoulombFriction);
     coulomb.effect.values[0] = 0.02;  // v_s fixed at the truth's 0.1 rad/s
+    coulomb.scaleSmoothing = false;
     o.model.effects = {spring, coulomb};
   }
   for (auto& e : estimation) o.estimation.push_back({e, std::nullopt});

@@ -30,7 +30,7 @@ TEST(Effects, NamesRoundTrip) {
   }
   EXPECT_STREQ(toString(EffectKind::NonlinearSpring), "nonlinear_spring");
   std::string why;
-  EXPECT_FALSE(parseEffect("gravity", &why));
+  EXPECT_FALSE(parseEffect("stiction", &why));
   EXPECT_NE(why.find("unknown effect"), std::string::npos);
   EXPECT_FALSE(parseEffect("backlash:-1", &why));
   EXPECT_FALSE(parseEffect("backlash:1,2", &why));
@@ -57,6 +57,62 @@ TEST(Effects, PlantWithoutEffectsIsTheLinearModel) {
     x = d.A * x + d.B.col(0) * u[k];
   }
   EXPECT_LT(maxErr, 1e-6 * maxAbs);
+}
+
+// The arm-side effects act where the physics puts them: gravity and arm friction on the arm
+// (through the gear on a rigid axis), asymmetric Coulomb friction on the motor with its own
+// size each way, and the arm angle is r phi_m minus the whole deflection.
+TEST(Effects, ArmSideEffectsActOnTheArm) {
+  auto rigid = makeModel("rigid");
+  const double r = rigid->value("r"), J = rigid->value("J_m") + r * r * rigid->value("J_a");
+  Effect gravity = Effect::withDefaults(EffectKind::Gravity);
+  gravity.values = {200.0, M_PI / 2};  // -200 sin(phi_a + pi/2): -200 N m at phi_a = 0
+  const NonlinearPlant heavy(*rigid, {gravity});
+  NonlinearPlant::State x{}, dx{};
+  heavy.derivative(x.data(), 0.0, 0.0, dx.data());
+  EXPECT_NEAR(dx[0], -r * 200.0 / J, 1e-9 * r * 200.0 / J);
+  // The motor torque that holds the arm (k_T = 1): 200 N m at the arm is r 200 at the motor.
+  heavy.derivative(x.data(), r * 200.0, 0.0, dx.data());
+  EXPECT_NEAR(dx[0], 0.0, 1e-9);
+
+  Effect asym = Effect::withDefaults(EffectKind::AsymmetricCoulomb);
+  asym.values = {0.2, 0.5};
+  const NonlinearPlant sticky(*rigid, {asym});
+  const NonlinearPlant free(*rigid, {});
+  NonlinearPlant::State dFree{};
+  for (double v : {1.0, -1.0}) {
+    x[0] = v;
+    sticky.derivative(x.data(), 0.0, 0.0, dx.data());
+    free.derivative(x.data(), 0.0, 0.0, dFree.data());
+    const double expected = -(v > 0 ? 0.2 : 0.5) * std::tanh(v / 0.1) / J;  // smoothing 0.1 rad/s
+    EXPECT_NEAR(dx[0] - dFree[0], expected, 1e-9 * std::abs(expected)) << v;
+  }
+
+  auto twoMass = makeModel("two-mass");
+  Effect arm = Effect::withDefaults(EffectKind::ArmFriction);
+  arm.values = {40.0, 0.0};
+  const NonlinearPlant rubbing(*twoMass, {arm});
+  const NonlinearPlant plain(*twoMass, {});
+  NonlinearPlant::State y{};
+  y[0] = 1e-4;  // r phi_m - phi_a
+  y[1] = 0.5;   // phi_m'
+  y[2] = 0.004;  // phi_a'
+  y[3] = 3.0;   // phi_m
+  rubbing.derivative(y.data(), 0.0, 0.0, dx.data());
+  plain.derivative(y.data(), 0.0, 0.0, dFree.data());
+  EXPECT_NEAR(dx[2] - dFree[2], -40.0 * 0.004 / twoMass->value("J_a"), 1e-12);
+  EXPECT_DOUBLE_EQ(dx[1], dFree[1]);  // the motor feels it only through the spring
+  EXPECT_DOUBLE_EQ(rubbing.armDeflection(y), 1e-4);
+  EXPECT_DOUBLE_EQ(rubbing.armAngle(y), twoMass->value("r") * 3.0 - 1e-4);
+  EXPECT_DOUBLE_EQ(rubbing.armVelocity(y), 0.004);
+
+  // Three-mass: the deflection to the arm is the gear's plus the arm spring's.
+  const NonlinearPlant three(*makeModel("three-mass"), {});
+  NonlinearPlant::State z{};
+  z[0] = 1e-4;
+  z[1] = 2e-4;
+  EXPECT_DOUBLE_EQ(three.armDeflection(z), 3e-4);
+  EXPECT_DOUBLE_EQ(three.gearDeflection(z), 1e-4);
 }
 
 TEST(Effects, GearEffectsNeedAGearSpring) {
