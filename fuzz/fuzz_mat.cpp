@@ -8,6 +8,7 @@
 #include <string_view>
 
 #include "core/io/log_io.h"
+#include "core/io/log_source.h"
 #include "core/io/mat_check.h"
 
 namespace {
@@ -33,5 +34,16 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   o.format = flexarm::LogFormat::Mat;
   const flexarm::LogReadResult r = flexarm::readLog(path, o);
   if (!r.ok && r.error.problem.empty()) __builtin_trap();
+  // The import dialog's listing walks every struct field and cell; the first numeric entry
+  // it lists is read by its expression (a row of a matrix).
+  const flexarm::SourceListing listing = flexarm::listLogSource(path, o);
+  if (!listing.ok && listing.error.problem.empty()) __builtin_trap();
+  for (const auto& e : listing.entries)
+    if (e.numeric) {
+      const std::string expression = e.rows > 1 && e.cols > 1 ? e.expression + "(end,:)" : e.expression;
+      const flexarm::SeriesRead s = flexarm::readSourceSeries(path, listing, expression, o);
+      if (!s.ok && s.error.problem.empty()) __builtin_trap();
+      break;
+    }
   return 0;
 }

@@ -32,17 +32,19 @@ std::size_t firstDataLine(std::string_view text) {
 
 SourceListing listLogSource(const std::string& path, const LogReadOptions& options) {
   SourceListing listing;
+  InputFile file;
   FileBytes bytes;
   std::string problem;
-  if (!readInputFile(path, options.maxFileBytes, bytes, &problem)) {
+  char head[128] = {};
+  const auto fail = [&] {
     listing.error = ReadError{path, 0, 0, {}, problem};
     return listing;
-  }
-  const std::string_view text = bytes.view();
-  if (isMatFile(path, text.substr(0, 128))) {
-    bytes = FileBytes{};
+  };
+  if (!file.open(path, options.maxFileBytes, &problem)) return fail();
+  if (isMatFile(path, std::string_view(head, file.readFully(0, head, sizeof head))))
     return io::listMatSource(path, options);
-  }
+  if (!file.readAll(bytes, &problem)) return fail();
+  const std::string_view text = bytes.view();
   // A text file: its columns read as a headerless table. A header line becomes a comment
   // (same length, so every line keeps its number in messages) and gives the names.
   const std::size_t first = firstDataLine(text);

@@ -434,7 +434,7 @@ SourceEntry entryOf(const MatVariable& v, const std::string& label, const std::s
   SourceEntry e;
   e.label = label;
   e.expression = expression;
-  e.shape = matShapeText(v.dims);
+  e.shape = v.dims.empty() ? std::string() : matShapeText(v.dims);
   e.kind = matClassName(v.arrayClass);
   e.unreadable = v.unreadable;
   e.numeric = v.unreadable.empty() && isNumericMatClass(v.arrayClass) && !v.complex && v.elements > 0;
