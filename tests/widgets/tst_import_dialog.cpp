@@ -5,6 +5,9 @@
 // the reason, and a saved session reads the file the same way again. Screenshots of the dialog
 // and of the window with each axis open are saved for a person to look at.
 #include <QComboBox>
+#include <QDoubleSpinBox>
+#include <QFile>
+#include <QTextStream>
 #include <QLabel>
 #include <QLineEdit>
 #include <QMessageBox>
@@ -44,12 +47,12 @@ class ImportDialogTest : public QObject {
   MainWindow* window_ = nullptr;
   QTemporaryDir dir_;
 
-  // The dialog the importer shows for kKuka after File -> Open.
-  ImportDialog* openDialog() {
+  // The dialog the importer shows for path after File -> Open.
+  ImportDialog* openDialog(const QString& path = kKuka) {
     auto* importer = window_->findChild<LogImporter*>();
     if (!importer) return nullptr;
     QSignalSpy shown(importer, &LogImporter::dialogShown);
-    window_->requestOpenFile(kKuka);
+    window_->requestOpenFile(path);
     if (!shown.count() && !shown.wait(10000)) return nullptr;
     return importer->dialog();
   }
@@ -97,6 +100,7 @@ class ImportDialogTest : public QObject {
     QVERIFY(dir_.isValid());
     window_ = new MainWindow;
     window_->sessionController()->setOfferRecovery(false);
+    window_->sessionController()->setReplaceDecision([](const QString&) { return ReplaceDecision::Discard; });
     window_->resize(1366, 768);
     window_->show();
     QVERIFY(QTest::qWaitForWindowExposed(window_));
@@ -193,7 +197,67 @@ class ImportDialogTest : public QObject {
     }
   }
 
+  // A CSV file with other column names and a headerless table go through the same dialog:
+  // header names (or column numbers) offered, previews, names and units set there.
+  void otherColumnNamesAndTablesThroughTheDialog() {
+    const QString csv = dir_.filePath("bench.csv");
+    {
+      QFile f(csv);
+      QVERIFY(f.open(QIODevice::WriteOnly | QIODevice::Text));
+      QTextStream out(&f);
+      out << "t_s,torque_motor_Nm,pos_motor_deg_linkside,pos_link_deg\n";
+      for (int i = 0; i < 50; ++i) out << 0.002 * i << "," << 0.5 * i << "," << 0.1 * i << "," << 0.1 * i - 0.002 << "\n";
+    }
+    ImportDialog* d = openDialog(csv);
+    QVERIFY(d);
+    QCOMPARE(d->tree()->topLevelItemCount(), 4);
+    QCOMPARE(d->tree()->topLevelItem(2)->text(0), QString("pos_motor_deg_linkside"));
+    const std::pair<const char*, ImportDialog::Role> roles[] = {{"t_s", ImportDialog::Role::Time},
+                                                                {"torque_motor_Nm", ImportDialog::Role::Input},
+                                                                {"pos_motor_deg_linkside", ImportDialog::Role::Output},
+                                                                {"pos_link_deg", ImportDialog::Role::Arm}};
+    for (const auto& [name, role] : roles) {
+      QVERIFY(pick(d, name));
+      d->useSelectionAs(role);
+    }
+    QCOMPARE(d->previewPoints(), 50);
+    chooseData(d->findChild<QComboBox*>("importOutputUnit"), "deg");
+    chooseData(d->findChild<QComboBox*>("importOutputSide"), "arm");
+    chooseData(d->findChild<QComboBox*>("importArmUnit"), "deg");
+    d->findChild<QLineEdit*>("importGearRatio")->setText("1/100");
+    QVERIFY(clickOpen(d));
+    const IdData* data = window_->workspace()->raw();
+    QVERIFY(std::abs(data->sampleTime - 0.002) < 1e-12);
+    QCOMPARE(data->output()->name, std::string(columns::kMotorAngle));
+    QVERIFY(std::abs(data->output()->values[10] - 1.0 * 100 * kPi / 180) < 1e-12);
+    QVERIFY(std::abs(data->channel(columns::kArmAngle)->values[10] - (1.0 - 0.002) * kPi / 180) < 1e-15);
+    QVERIFY(!test::findBox("readWarningsBox"));  // everything was said
+
+    // The DaISy table: columns by number, the sample time given, the output read as stored.
+    d = openDialog(QString(FLEXARM_SAMPLE_DIR) + "/daisy_robot_arm.dat");
+    QVERIFY(d);
+    QCOMPARE(d->tree()->topLevelItem(0)->text(0), QString("column 1"));
+    QVERIFY(pick(d, "column 1"));
+    d->useSelectionAs(ImportDialog::Role::Input);
+    QVERIFY(pick(d, "column 2"));
+    d->useSelectionAs(ImportDialog::Role::Output);
+    QVERIFY2(d->previewTitle().startsWith("column 2: 1024 samples"), qPrintable(d->previewTitle()));
+    d->findChild<QDoubleSpinBox*>("importSampleTime")->setValue(0.1);
+    QVERIFY(clickOpen(d));
+    QCOMPARE(window_->workspace()->raw()->samples(), std::size_t{1024});
+    QVERIFY(std::abs(window_->workspace()->raw()->sampleTime - 0.1) < 1e-12);
+    QMessageBox* box = nullptr;
+    QTRY_VERIFY((box = test::findBox("readWarningsBox")) != nullptr);
+    QVERIFY2(box->text().contains("the output column 2 is read as stored"), qPrintable(box->text()));
+    box->close();
+  }
+
   void aSessionReadsTheFileTheSameWay() {
+    ImportDialog* d = openDialog();
+    QVERIFY(d);
+    QVERIFY(chooseAxis(d, 3));
+    QVERIFY(clickOpen(d));
+    if (QMessageBox* box = test::findBox("readWarningsBox")) box->close();
     const LogReadOptions read = window_->workspace()->logReadOptions();
     QCOMPARE(read.mapping.output, std::string("rec.act_pos_mot_deg(3,:)"));
     const QString path = dir_.filePath("kuka.json");
