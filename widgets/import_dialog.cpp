@@ -25,7 +25,7 @@ namespace {
 
 enum ItemData { kExpression = Qt::UserRole, kRows, kCols, kNumeric };
 
-const char* const kRoleNames[] = {"time", "input", "output", "arm"};
+const char* const kRoleNames[] = {"time", "input", "output", "arm", "reference"};
 
 // "(not said)" first, then the units; data: the unit's text.
 void fillUnits(QComboBox* box, std::initializer_list<SignalUnit> units) {
@@ -120,12 +120,13 @@ ImportDialog::ImportDialog(const QString& path, SourceListing listing, const Log
 
   auto* form = new QGridLayout;
   const QString roleText[] = {tr("Time (s)"), tr("Input (torque)"), tr("Output (motor encoder)"),
-                              tr("Arm angle (arm encoder)")};
-  const std::string* given[] = {&start.mapping.time, &start.mapping.input, &start.mapping.output, &start.mapping.arm};
-  for (int r = 0; r < 4; ++r) {
+                              tr("Arm angle (arm encoder)"), tr("Reference (as the output)")};
+  const std::string* given[] = {&start.mapping.time, &start.mapping.input, &start.mapping.output, &start.mapping.arm,
+                                &start.mapping.reference};
+  for (int r = 0; r < 5; ++r) {
     roles_[r] = new QLineEdit(QString::fromStdString(*given[r]));
     roles_[r]->setObjectName(QString("importRole_") + kRoleNames[r]);
-    roles_[r]->setPlaceholderText(r == 0 ? tr("none: give the sample time") : r == 3 ? tr("none") : tr("the file's default"));
+    roles_[r]->setPlaceholderText(r == 0 ? tr("none: give the sample time") : r >= 3 ? tr("none") : tr("the file's default"));
     auto* use = new QPushButton(tr("Use selection"));
     use->setObjectName(QString("importUse_") + kRoleNames[r]);
     connect(use, &QPushButton::clicked, this, [this, r] { useSelectionAs(static_cast<Role>(r)); });
@@ -359,8 +360,8 @@ LogReadOptions ImportDialog::options() const {
   LogReadOptions o;
   o.format = listing_.format;
   LogMapping& m = o.mapping;
-  std::string* roles[] = {&m.time, &m.input, &m.output, &m.arm};
-  for (int r = 0; r < 4; ++r) *roles[r] = roles_[r]->text().trimmed().toStdString();
+  std::string* roles[] = {&m.time, &m.input, &m.output, &m.arm, &m.reference};
+  for (int r = 0; r < 5; ++r) *roles[r] = roles_[r]->text().trimmed().toStdString();
   m.outputUnit = signalUnitFromString(outputUnit_->currentData().toString().toStdString());
   m.armUnit = signalUnitFromString(armUnit_->currentData().toString().toStdString());
   m.outputSide = encoderSideFromString(outputSide_->currentData().toString().toStdString());

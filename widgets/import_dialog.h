@@ -2,7 +2,8 @@
 // The import dialog: what a .mat file, a CSV file with other column names or a headerless
 // table holds (a tree of variables, struct fields and cells with their shapes and classes, or
 // the columns), a preview plot of the chosen variable, row or column, and the choices that
-// make it a FlexArm log: which signal is the time, the input, the output and the arm angle,
+// make it a FlexArm log: which signal is the time, the input, the output, the arm angle and a
+// closed loop's reference,
 // the output's unit and side, the arm encoder's unit, the gear ratio and the input scale
 // (core/io/log_mapping.h, the same description the command line and sessions use). Previews
 // of a .mat file are read off the GUI thread.
@@ -27,7 +28,7 @@ namespace flexarm {
 class ImportDialog : public QDialog {
   Q_OBJECT
  public:
-  enum class Role { Time, Input, Output, Arm };
+  enum class Role { Time, Input, Output, Arm, Reference };
 
   // listing: what path holds (listLogSource); start: the choices shown first (a session's
   // or the last import's mapping).
@@ -73,7 +74,7 @@ class ImportDialog : public QDialog {
   QLineEdit* selected_;   // the expression of the selection, editable
   QCustomPlot* plot_;
   QLabel* previewLabel_;
-  QLineEdit* roles_[4];
+  QLineEdit* roles_[5];
   QComboBox* outputUnit_;
   QComboBox* outputSide_;
   QComboBox* armUnit_;

@@ -11,8 +11,8 @@ namespace flexarm::cli {
 std::vector<std::string> logReadOptionNames() {
   return {"format",     "input-column", "output-column", "time-column", "sample-time",
           "input-name", "output-name",  "input-var",     "output-var",  "time-var",
-          "arm-var",    "output-unit",  "arm-unit",      "output-side", "gear-ratio",
-          "input-scale"};
+          "arm-var",    "ref-var",      "output-unit",   "arm-unit",    "output-side",
+          "gear-ratio", "input-scale"};
 }
 
 const char* logReadOptionsHelp() {
@@ -34,6 +34,8 @@ const char* logReadOptionsHelp() {
          "  --output-var EXPR     the output, named the same ways\n"
          "  --time-var EXPR       the time in s, named the same ways (rec.time_cont, t_s)\n"
          "  --arm-var EXPR        the arm-side encoder, read as arm_angle_rad\n"
+         "  --ref-var EXPR        a closed loop's position reference, in the output's unit\n"
+         "                        and side: angle_ref_rad (position_ref_m)\n"
          "  --output-unit U       the output's unit: rad, deg, rev (rad/s, deg/s, rpm for\n"
          "                        a velocity) or, for a prismatic axis, m, mm (m/s, mm/s);\n"
          "                        converted, and named motor_angle_rad (motor_velocity_rad_s,\n"
@@ -72,6 +74,7 @@ std::optional<LogReadOptions> logReadOptions(ArgParser& args, std::ostream& err)
   if (auto v = args.value("output-var")) m.output = *v;
   if (auto v = args.value("time-var")) m.time = *v;
   if (auto v = args.value("arm-var")) m.arm = *v;
+  if (auto v = args.value("ref-var")) m.reference = *v;
   for (const auto& [option, unit] : {std::pair<const char*, std::optional<SignalUnit>*>{"output-unit", &m.outputUnit},
                                      {"arm-unit", &m.armUnit}})
     if (auto v = args.value(option)) {

@@ -157,7 +157,7 @@ struct Head {
   std::size_t dataStart = 0;  // byte offset of the first line after the header
   std::size_t timeIndex = 0;
   // Header indices of the columns the mapping names (-1: not named).
-  long inputIndex = -1, outputIndex = -1, armIndex = -1;
+  long inputIndex = -1, outputIndex = -1, armIndex = -1, referenceIndex = -1;
 };
 
 enum class HeadStatus { Ok, Failed, NeedMore };
@@ -258,7 +258,8 @@ HeadStatus parseHead(std::string_view text, bool whole, const std::string& path,
   for (const Need& n : {Need{m.time, columns::kTime, "--time-var", &timeIndex},
                         Need{m.input, columns::kTorqueRef, "--input-var", &h.inputIndex},
                         Need{m.output, columns::kMotorAngle, "--output-var", &h.outputIndex},
-                        Need{m.arm, nullptr, "--arm-var", &h.armIndex}}) {
+                        Need{m.arm, nullptr, "--arm-var", &h.armIndex},
+                        Need{m.reference, nullptr, "--ref-var", &h.referenceIndex}}) {
     if (!n.flexArmName && n.given.empty()) continue;
     const std::string name = n.given.empty() ? std::string(n.flexArmName) : n.given;
     *n.index = indexOf(name);
@@ -488,9 +489,11 @@ LogReadResult finishLog(Head& h, std::vector<Chunk>& chunks, bool haveText, std:
     if (!m.input.empty() || m.inputScale != 1.0 || m.convertsOutput()) found.input = channelOf(h.inputIndex);
     if (!m.output.empty() || m.convertsOutput()) found.output = channelOf(h.outputIndex);
     if (!m.arm.empty() || m.armUnit) found.arm = channelOf(h.armIndex);
+    if (!m.reference.empty()) found.reference = channelOf(h.referenceIndex);
     for (const auto& [index, source] : {std::pair<long, std::string*>{h.inputIndex, &found.inputSource},
                                         {h.outputIndex, &found.outputSource},
-                                        {h.armIndex, &found.armSource}})
+                                        {h.armIndex, &found.armSource},
+                                        {h.referenceIndex, &found.referenceSource}})
       if (index >= 0) *source = h.header[static_cast<std::size_t>(index)];
     std::string why;
     if (!applyMapping(data, found, m, !m.output.empty(), ok.warnings, &why))

@@ -124,7 +124,7 @@ bool LogMapping::isValid(std::string* why) const {
 }
 
 bool LogMapping::operator==(const LogMapping& o) const {
-  return time == o.time && input == o.input && output == o.output && arm == o.arm &&
+  return time == o.time && input == o.input && output == o.output && arm == o.arm && reference == o.reference &&
          outputUnit == o.outputUnit && armUnit == o.armUnit && outputSide == o.outputSide &&
          gearRatio == o.gearRatio && inputScale == o.inputScale;
 }
@@ -156,6 +156,15 @@ std::vector<std::string> describeMapping(const LogMapping& m) {
     } else {
       s += "= " + m.output;
     }
+    out.push_back(s);
+  }
+  if (!m.reference.empty()) {
+    std::string s = "reference ";
+    const SignalUnit u = m.outputUnit.value_or(SignalUnit::Rad);
+    if (m.convertsOutput() && !isVelocity(u))
+      s += std::string(isLinear(u) ? columns::kPositionRef : columns::kAngleRef) + " = " + m.reference + " as the output";
+    else
+      s += "= " + m.reference;
     out.push_back(s);
   }
   if (!m.arm.empty())
@@ -195,6 +204,8 @@ bool applyMapping(IdData& data, const MappedChannels& found, const LogMapping& m
   Channel* in = channel(found.input);
   Channel* out = channel(found.output);
   Channel* arm = channel(found.arm);
+  Channel* ref = channel(found.reference);
+  double outputFactor = 1.0;  // what the output was multiplied by (the reference shares it)
   if (in) {
     scale(*in, m.inputScale);
     if ((m.convertsOutput() || m.inputScale != 1.0) &&
@@ -214,6 +225,7 @@ bool applyMapping(IdData& data, const MappedChannels& found, const LogMapping& m
         warnings.push_back("the output " + found.outputSource +
                            " is taken as the motor shaft's: its side was not given (--output-side motor|arm)");
       scale(*out, k);
+      outputFactor = k;
       const char* name = outputColumn(u);
       if (!rename(*out, name, isLinear(u) ? (isVelocity(u) ? "m/s" : "m") : (isVelocity(u) ? "rad/s" : "rad"),
                   found.outputSource))
@@ -231,6 +243,24 @@ bool applyMapping(IdData& data, const MappedChannels& found, const LogMapping& m
     const SignalUnit u = m.armUnit.value_or(SignalUnit::Rad);
     scale(*arm, toSiFactor(u));
     if (!rename(*arm, columns::kArmAngle, "rad", found.armSource)) return false;
+  }
+  if (ref) {
+    // A position reference in the output's unit and on its side; a velocity output says
+    // nothing of a position's unit, so the reference is then read as stored.
+    const SignalUnit u = m.outputUnit.value_or(SignalUnit::Rad);
+    if (m.convertsOutput() && !isVelocity(u)) {
+      scale(*ref, outputFactor);
+      if (!rename(*ref, isLinear(u) ? columns::kPositionRef : columns::kAngleRef, isLinear(u) ? "m" : "rad",
+                  found.referenceSource))
+        return false;
+    } else if (foreign) {
+      warnings.push_back("the reference " + found.referenceSource +
+                         " is read as stored: it takes the output's unit and side, and those were not given "
+                         "as a position's");
+    }
+    for (Channel& c : data.channels)
+      if (c.role == ChannelRole::Reference) c.role = ChannelRole::None;
+    ref->role = ChannelRole::Reference;
   }
   // Roles after the names: the mapped input and output are the only ones.
   if (in) data.setRole(in->name, ChannelRole::Input);

@@ -1,12 +1,13 @@
 #pragma once
 // Which signal of a foreign log is what, in which unit and on which side of the gear: the one
 // description that the command line (--time-var, --input-var, --output-var, --arm-var,
-// --output-unit, --arm-unit, --output-side, --gear-ratio, --input-scale), the window's import
+// --ref-var, --output-unit, --arm-unit, --output-side, --gear-ratio, --input-scale), the window's import
 // dialog and the session share. Reading applies it once: the input becomes torque_ref_nm
 // (N m at the motor; force_ref_n for a prismatic axis), the output the motor shaft's angle in
 // rad (motor_angle_rad; motor_velocity_rad_s for a velocity, motor_position_m and
 // motor_velocity_m_s for a prismatic axis), the arm encoder arm_angle_rad (the arm side, not
-// scaled to the motor); the gear ratio is stored as the log's gear_ratio. Nothing is guessed:
+// scaled to the motor), a position reference angle_ref_rad (position_ref_m) converted as the
+// output is; the gear ratio is stored as the log's gear_ratio. Nothing is guessed:
 // what was not said is named in a warning.
 #include <optional>
 #include <string>
@@ -22,6 +23,7 @@ namespace columns {
 inline constexpr const char* kForceRef = "force_ref_n";
 inline constexpr const char* kMotorPosition = "motor_position_m";
 inline constexpr const char* kMotorLinearVelocity = "motor_velocity_m_s";
+inline constexpr const char* kPositionRef = "position_ref_m";
 }  // namespace columns
 
 // The unit a position or velocity is stored in. Angles and angular velocities belong to a
@@ -47,8 +49,9 @@ std::optional<double> parseGearRatio(std::string_view text, std::string* why);
 struct LogMapping {
   // Where each signal is: a MATLAB expression in a .mat file (rec.act_torque_abs_nm(1,:)), a
   // header name in a CSV file (torque_motor_Nm), "column N" in a headerless table. Empty:
-  // the format's own (time_s, torque_ref_nm, motor_angle_rad, ...).
-  std::string time, input, output, arm;
+  // the format's own (time_s, torque_ref_nm, motor_angle_rad, ...). The reference (a closed
+  // loop's position reference) is in the output's unit and on its side.
+  std::string time, input, output, arm, reference;
   std::optional<SignalUnit> outputUnit, armUnit;
   std::optional<EncoderSide> outputSide;
   std::string gearRatio;   // as given ("1/256.86"); empty: not given
@@ -70,8 +73,8 @@ std::vector<std::string> describeMapping(const LogMapping& m);
 // The channels a reader found for the mapping: indices into data.channels (-1: none) and the
 // text that named them (an expression, a header name, "column 3").
 struct MappedChannels {
-  int input = -1, output = -1, arm = -1;
-  std::string inputSource, outputSource, armSource;
+  int input = -1, output = -1, arm = -1, reference = -1;
+  std::string inputSource, outputSource, armSource, referenceSource;
 };
 
 // Applies the mapping to the channels a reader found: scales the input, converts the output

@@ -361,8 +361,9 @@ bool readPlainVector(MatVariables& vars, const MatVariable& v, std::uint64_t bud
 }
 
 // The log the options ask for, from the variables of a checked file.
-LogReadResult readMatVariables(MatVariables& vars, const std::string& path,
-                               const LogReadOptions& options, std::uint64_t budget);
+// `skipped`: what the file's check skipped besides the variables it describes as unreadable.
+LogReadResult readMatVariables(MatVariables& vars, const std::string& path, const LogReadOptions& options,
+                               std::uint64_t budget, const std::vector<std::string>& skipped);
 
 }  // namespace
 
@@ -379,7 +380,8 @@ namespace {
 // the bytes the check walked, others through matio) within the budget. False with a sentence
 // when the file is not a readable .mat file.
 bool withVariables(const InputFile& file, const std::string& path, const LogReadOptions& options,
-                   const std::function<void(MatVariables&, std::uint64_t budget)>& use, std::string& problem) {
+                   const std::function<void(MatVariables&, std::uint64_t budget, const MatCheck&)>& use,
+                   std::string& problem) {
   // Only the parts the check reads (tags, names, dimensions, compressed variables) are read
   // into memory, in blocks; the numeric data go straight from the file to the signals.
   const auto size = static_cast<std::size_t>(file.size());
@@ -424,7 +426,7 @@ bool withVariables(const InputFile& file, const std::string& path, const LogRead
   } guard{mat};
   MatVariables vars(check, mat,
                     Level5Source{&file, reinterpret_cast<const unsigned char*>(bytes.get()), size, load});
-  use(vars, budget);
+  use(vars, budget, check);
   return true;
 }
 
@@ -475,8 +477,8 @@ LogReadResult io::readMatFile(const InputFile& file, const std::string& path, co
   LogReadResult result;
   std::string problem;
   if (!withVariables(file, path, options,
-                     [&](MatVariables& vars, std::uint64_t budget) {
-                       result = readMatVariables(vars, path, options, budget);
+                     [&](MatVariables& vars, std::uint64_t budget, const MatCheck& check) {
+                       result = readMatVariables(vars, path, options, budget, check.skipped);
                      },
                      problem))
     return failure(path, 0, 0, {}, problem);
@@ -494,13 +496,17 @@ SourceListing io::listMatSource(const std::string& path, const LogReadOptions& o
   };
   if (!file.open(path, options.maxFileBytes, &problem)) return fail();
   const bool ok = withVariables(file, path, options,
-                                [&](MatVariables& vars, std::uint64_t) {
+                                [&](MatVariables& vars, std::uint64_t, const MatCheck& check) {
                                   for (const MatVariable& v : vars.variables()) {
                                     if (v.name.empty()) continue;
                                     listing.entries.push_back(entryOf(v, v.name, v.name));
                                     if (!v.unreadable.empty())
                                       listing.notes.push_back("skipped " + v.name + " (" + v.unreadable + ")");
                                   }
+                                  for (const auto& s : check.skipped)
+                                    if (std::find(listing.notes.begin(), listing.notes.end(), "skipped " + s) ==
+                                        listing.notes.end())
+                                      listing.notes.push_back("skipped " + s);
                                 },
                                 problem);
   if (!ok) return fail();
@@ -519,7 +525,7 @@ SeriesRead io::readMatExpression(const std::string& path, const std::string& exp
   }
   LogReadResult fail;
   const bool ok = withVariables(file, path, options,
-                                [&](MatVariables& vars, std::uint64_t budget) {
+                                [&](MatVariables& vars, std::uint64_t budget, const MatCheck&) {
                                   out.ok = readMatSeries(vars, path, expression, budget, out.values, fail);
                                 },
                                 problem);
@@ -530,8 +536,8 @@ SeriesRead io::readMatExpression(const std::string& path, const std::string& exp
 
 namespace {
 
-LogReadResult readMatVariables(MatVariables& vars, const std::string& path,
-                               const LogReadOptions& options, std::uint64_t budget) {
+LogReadResult readMatVariables(MatVariables& vars, const std::string& path, const LogReadOptions& options,
+                               std::uint64_t budget, const std::vector<std::string>& checkSkipped) {
   LogReadResult fail;
   // Which variables: the mapping's expressions, else the FlexArm column names, else u/y; a
   // channel name the user chose (not the default u / y) names the variable when no variable
@@ -545,6 +551,8 @@ LogReadResult readMatVariables(MatVariables& vars, const std::string& path,
   for (const MatVariable& v : vars.variables())
     if (!v.unreadable.empty())
       skippedList.push_back((v.name.empty() ? std::string("a nameless variable") : v.name) + " (" + v.unreadable + ")");
+  for (const auto& s : checkSkipped)
+    if (std::find(skippedList.begin(), skippedList.end(), s) == skippedList.end()) skippedList.push_back(s);
   std::string skipped;
   for (const auto& s : skippedList) skipped += (skipped.empty() ? "" : ", ") + s;
   if (names.empty())
@@ -562,6 +570,7 @@ LogReadResult readMatVariables(MatVariables& vars, const std::string& path,
   if (out.expression.empty()) out.expression = has(columns::kMotorAngle) ? columns::kMotorAngle : "y";
   const std::string timeExpr = !m.time.empty() ? m.time : has(columns::kTime) ? columns::kTime : "";
   const std::string armExpr = !m.arm.empty() ? m.arm : has(columns::kArmAngle) ? columns::kArmAngle : "";
+  const std::string refExpr = m.reference;
   for (const Wanted* w : {&in, &out})
     if (!w->given && !has(w->expression)) {
       std::string list;
@@ -575,12 +584,14 @@ LogReadResult readMatVariables(MatVariables& vars, const std::string& path,
     }
 
   IdData data;
-  std::vector<double> u, y, t, a;
+  std::vector<double> u, y, t, a, ref;
   if (!readMatSeries(vars, path, in.expression, budget, u, fail)) return fail;
   if (!readMatSeries(vars, path, out.expression, budget, y, fail)) return fail;
   if (!armExpr.empty() && !readMatSeries(vars, path, armExpr, budget, a, fail)) return fail;
+  if (!refExpr.empty() && !readMatSeries(vars, path, refExpr, budget, ref, fail)) return fail;
   for (const auto& [expr, v] : {std::pair<const std::string&, const std::vector<double>&>{out.expression, y},
-                                {armExpr, a}})
+                                {armExpr, a},
+                                {refExpr, ref}})
     if (!expr.empty() && v.size() != u.size())
       return failure(path, 0, 0, expr,
                      "has " + std::to_string(v.size()) + " samples but '" + in.expression + "' has " +
@@ -637,6 +648,8 @@ LogReadResult readMatVariables(MatVariables& vars, const std::string& path,
   found.input = push(inputNamed ? options.inputName : channelNameFor(in.expression), std::move(u), ChannelRole::Input);
   found.output = push(outputNamed ? options.outputName : channelNameFor(out.expression), std::move(y), ChannelRole::Output);
   if (!armExpr.empty()) found.arm = push(channelNameFor(armExpr), std::move(a), ChannelRole::None);
+  if (!refExpr.empty()) found.reference = push(channelNameFor(refExpr), std::move(ref), ChannelRole::Reference);
+  found.referenceSource = refExpr;
   found.inputSource = in.expression;
   found.outputSource = out.expression;
   found.armSource = armExpr;
@@ -645,7 +658,8 @@ LogReadResult readMatVariables(MatVariables& vars, const std::string& path,
   // The file's other whole vectors of the same length are channels too.
   for (const MatVariable& v : vars.variables()) {
     const std::string name = v.name;
-    if (name == in.expression || name == out.expression || name == timeExpr || name == armExpr) continue;
+    if (name == in.expression || name == out.expression || name == timeExpr || name == armExpr || name == refExpr)
+      continue;
     if ((inputNamed && name == options.inputName) || (outputNamed && name == options.outputName)) continue;
     if (data.indexOf(name) >= 0) continue;
     std::vector<double> vec;

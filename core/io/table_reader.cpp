@@ -2,6 +2,7 @@
 // user's column mapping, as the DaISy files come.
 #include <algorithm>
 #include <filesystem>
+#include <tuple>
 
 #include "core/io/input_file.h"
 #include "core/io/log_io.h"
@@ -36,14 +37,16 @@ LogReadResult readTableText(std::string_view text, const std::string& path,
   std::string why;
   // Columns the mapping names ("column 3") take the place of the column numbers.
   LogReadOptions options = given;
-  int armColumn = 0;
+  int armColumn = 0, refColumn = 0;
   const LogMapping& m = given.mapping;
   if (!columnOf(m.input, options.inputColumn, &why) || !columnOf(m.output, options.outputColumn, &why) ||
-      !columnOf(m.time, options.timeColumn, &why) || !columnOf(m.arm, armColumn, &why))
+      !columnOf(m.time, options.timeColumn, &why) || !columnOf(m.arm, armColumn, &why) ||
+      !columnOf(m.reference, refColumn, &why))
     return failure(path, 0, 0, {}, "bad column mapping: " + why);
-  if (armColumn && (armColumn == options.inputColumn || armColumn == options.outputColumn ||
-                    armColumn == options.timeColumn))
-    return failure(path, 0, 0, {}, "bad column mapping: the arm angle's column is already used");
+  for (const int extra : {armColumn, refColumn})
+    if (extra && (extra == options.inputColumn || extra == options.outputColumn || extra == options.timeColumn ||
+                  armColumn == refColumn))
+      return failure(path, 0, 0, {}, "bad column mapping: the arm angle's or the reference's column is already used");
   if (!options.isValid(&why)) return failure(path, 0, 0, {}, "bad column mapping: " + why);
   if (std::string enc = textEncodingProblem(text); !enc.empty()) return failure(path, 1, 0, {}, enc);
   if (text.find_first_not_of(" \t\r\n") == std::string_view::npos)
@@ -76,7 +79,8 @@ LogReadResult readTableText(std::string_view text, const std::string& path,
         return failure(path, cursor.number(), 0, {},
                        "the table has more than " + std::to_string(maxColumns) +
                            " columns, more than FlexArm reads");
-      const int needed = std::max({options.inputColumn, options.outputColumn, options.timeColumn, armColumn});
+      const int needed =
+          std::max({options.inputColumn, options.outputColumn, options.timeColumn, armColumn, refColumn});
       if (static_cast<int>(fields.size()) < needed)
         return failure(path, cursor.number(), 0, {},
                        "the table has " + std::to_string(fields.size()) +
@@ -133,9 +137,14 @@ LogReadResult readTableText(std::string_view text, const std::string& path,
     if (col == options.timeColumn) continue;
     const int index = static_cast<int>(data.channels.size());
     const std::string source = "column " + std::to_string(col);
-    if (col == options.inputColumn) found = {index, found.output, found.arm, source, found.outputSource, found.armSource};
-    if (col == options.outputColumn) found = {found.input, index, found.arm, found.inputSource, source, found.armSource};
-    if (col == armColumn) found = {found.input, found.output, index, found.inputSource, found.outputSource, source};
+    for (auto [column, slot, named] : {std::tuple<int, int*, std::string*>{options.inputColumn, &found.input, &found.inputSource},
+                                      {options.outputColumn, &found.output, &found.outputSource},
+                                      {armColumn, &found.arm, &found.armSource},
+                                      {refColumn, &found.reference, &found.referenceSource}})
+      if (col == column) {
+        *slot = index;
+        *named = source;
+      }
     Channel c;
     if (col == options.inputColumn) {
       c.name = options.inputName;

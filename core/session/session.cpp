@@ -104,6 +104,7 @@ json readOptionsToJson(const LogReadOptions& o) {
   // FlexArm log reads as before.
   if (!m.time.empty()) j["time_variable"] = m.time;
   if (!m.arm.empty()) j["arm_variable"] = m.arm;
+  if (!m.reference.empty()) j["reference_variable"] = m.reference;
   if (m.outputUnit) j["output_unit"] = toString(*m.outputUnit);
   if (m.armUnit) j["arm_unit"] = toString(*m.armUnit);
   if (m.outputSide) j["output_side"] = toString(*m.outputSide);
@@ -134,6 +135,7 @@ bool readOptionsFromJson(const json& j, const std::string& where, LogReadOptions
   f.string(j, "output_variable", where, m.output, false);
   f.string(j, "time_variable", where, m.time, false);
   f.string(j, "arm_variable", where, m.arm, false);
+  f.string(j, "reference_variable", where, m.reference, false);
   for (const auto& [key, unit] : {std::pair<const char*, std::optional<SignalUnit>*>{"output_unit", &m.outputUnit},
                                   {"arm_unit", &m.armUnit}}) {
     std::string text;

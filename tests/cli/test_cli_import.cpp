@@ -35,7 +35,7 @@ const json* channel(const json& j, const std::string& name) {
 
 TEST(CliImport, KukaAxisWithUnitsSidesAndGearRatio) {
   auto r = runFlexarm(axisOne({"--output-unit", "deg", "--output-side", "arm", "--arm-unit", "deg",
-                               "--gear-ratio", "1/256.86", "--json"}));
+                               "--gear-ratio", "1/256.86", "--ref-var", "rec.ref_pos_deg(1,:)", "--json"}));
   ASSERT_EQ(r.code, 0) << r.err;
   const json j = json::parse(r.out);
   EXPECT_EQ(j["samples"].get<int>(), 2501);
@@ -46,6 +46,10 @@ TEST(CliImport, KukaAxisWithUnitsSidesAndGearRatio) {
   ASSERT_TRUE(motor && arm && tau) << r.out;
   EXPECT_EQ((*motor)["role"], "output");
   EXPECT_EQ((*tau)["role"], "input");
+  const json* ref = channel(j, "angle_ref_rad");
+  ASSERT_TRUE(ref) << r.out;
+  EXPECT_EQ((*ref)["role"], "reference");
+  EXPECT_TRUE(j["closed_loop"].get<bool>());
   // The motor shaft turns 256.86 times the arm: its range is that many times the arm's.
   const double motorSpan = (*motor)["max"].get<double>() - (*motor)["min"].get<double>();
   const double armSpan = (*arm)["max"].get<double>() - (*arm)["min"].get<double>();

@@ -77,7 +77,8 @@ class ImportDialogTest : public QObject {
     const std::pair<const char*, ImportDialog::Role> roles[] = {
         {"rec.act_torque_abs_nm", ImportDialog::Role::Input},
         {"rec.act_pos_mot_deg", ImportDialog::Role::Output},
-        {"rec.act_pos_se_deg", ImportDialog::Role::Arm}};
+        {"rec.act_pos_se_deg", ImportDialog::Role::Arm},
+        {"rec.ref_pos_deg", ImportDialog::Role::Reference}};
     for (const auto& [expression, role] : roles) {
       if (!pick(d, expression, axis)) return false;
       d->useSelectionAs(role);
@@ -183,6 +184,8 @@ class ImportDialogTest : public QObject {
       const Channel* arm = data->channel(columns::kArmAngle);
       QVERIFY(motor && arm);
       QCOMPARE(data->output(), motor);
+      QVERIFY(data->isClosedLoop());  // the reference, converted as the output
+      QCOMPARE(data->withRole(ChannelRole::Reference)->name, std::string(columns::kAngleRef));
       const int k = axis - 1;
       QVERIFY(std::abs(motor->values[1000] - kMotDeg[k] * kGear[k] * kPi / 180.0) < 1e-9);
       QVERIFY(std::abs(arm->values[1000] - kSeDeg[k] * kPi / 180.0) < 1e-14);

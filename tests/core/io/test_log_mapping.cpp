@@ -310,6 +310,7 @@ TEST(LogMapping, KukaAxesReadWithUnitsSidesAndGearRatio) {
   const double motDeg[3] = {-28.563801687531093, -6.402619697648896, -22.265377777092645};
   const double seDeg[3] = {-28.631050656665067, -6.331509595658599, -22.06368389539161};
   const double tauNm[3] = {1.6193037033081055, -13.719049453735352, -15.823418617248535};
+  const double refDeg[3] = {-28.40386962890625, -6.26862907409668, -21.86353874206543};
   for (int k = 1; k <= 3; ++k) {
     SCOPED_TRACE("axis " + std::to_string(k));
     LogReadOptions o = axis(k);
@@ -319,6 +320,7 @@ TEST(LogMapping, KukaAxesReadWithUnitsSidesAndGearRatio) {
     char ratio[32];
     std::snprintf(ratio, sizeof ratio, "1/%.2f", u[k - 1]);
     o.mapping.gearRatio = ratio;
+    o.mapping.reference = "rec.ref_pos_deg(" + std::to_string(k) + ",:)";
     const LogReadResult r = readLog(path, o);
     ASSERT_TRUE(r.ok) << r.error.toString();
     EXPECT_EQ(r.data.samples(), 2501u);
@@ -327,6 +329,10 @@ TEST(LogMapping, KukaAxesReadWithUnitsSidesAndGearRatio) {
     EXPECT_NEAR(r.data.channel(columns::kMotorAngle)->values[i], motDeg[k - 1] * u[k - 1] * kPi / 180.0, 1e-9);
     EXPECT_NEAR(r.data.channel(columns::kArmAngle)->values[i], seDeg[k - 1] * kPi / 180.0, 1e-14);
     EXPECT_EQ(r.data.channel(columns::kTorqueRef)->values[i], tauNm[k - 1]);
+    // The reference takes the output's unit and side: motor side in rad, and the log is closed loop.
+    ASSERT_NE(r.data.channel(columns::kAngleRef), nullptr);
+    EXPECT_NEAR(r.data.channel(columns::kAngleRef)->values[i], refDeg[k - 1] * u[k - 1] * kPi / 180.0, 1e-9);
+    EXPECT_TRUE(r.data.isClosedLoop());
     EXPECT_NEAR(std::stod(r.data.meta("gear_ratio")), 1.0 / u[k - 1], 1e-12);
     EXPECT_TRUE(anyContains(r.warnings, "skipped KR300 (a MATLAB object of class SerialLink)"));
   }
@@ -370,14 +376,15 @@ TEST(LogMapping, CsvWithOtherColumnNamesIsMappedByHeaderName) {
   const fs::path p = tempDir() / "other_names.csv";
   {
     std::ofstream f(p);
-    f << "# robot: test bench\nt_s,torque_motor_Nm,pos_motor_deg_linkside,pos_link_deg\n";
+    f << "# robot: test bench\nt_s,torque_motor_Nm,pos_motor_deg_linkside,pos_link_deg,pos_cmd_deg_linkside\n";
     for (int i = 0; i < 50; ++i)
-      f << 0.001 * i << "," << 0.5 * i << "," << 0.1 * i << "," << 0.1 * i - 0.002 << "\n";
+      f << 0.001 * i << "," << 0.5 * i << "," << 0.1 * i << "," << 0.1 * i - 0.002 << "," << 0.1 * i + 0.01 << "\n";
   }
   LogReadResult r = readLog(p.string());
   ASSERT_FALSE(r.ok);
   EXPECT_TRUE(r.needsMapping);
-  EXPECT_NE(r.error.toString().find("the header has t_s, torque_motor_Nm, pos_motor_deg_linkside, pos_link_deg"),
+  EXPECT_NE(r.error.toString().find("the header has t_s, torque_motor_Nm, pos_motor_deg_linkside, pos_link_deg, "
+                                    "pos_cmd_deg_linkside"),
             std::string::npos)
       << r.error.toString();
   LogReadOptions o;
@@ -389,9 +396,13 @@ TEST(LogMapping, CsvWithOtherColumnNamesIsMappedByHeaderName) {
   o.mapping.outputSide = EncoderSide::Arm;
   o.mapping.armUnit = SignalUnit::Deg;
   o.mapping.gearRatio = "1/100";
+  o.mapping.reference = "pos_cmd_deg_linkside";
   r = readLog(p.string(), o);
   ASSERT_TRUE(r.ok) << r.error.toString();
   EXPECT_NEAR(r.data.sampleTime, 0.001, 1e-12);
+  ASSERT_TRUE(r.data.isClosedLoop());
+  EXPECT_EQ(r.data.withRole(ChannelRole::Reference)->name, columns::kAngleRef);
+  EXPECT_NEAR(r.data.channel(columns::kAngleRef)->values[10], (1.0 + 0.01) * 100 * kPi / 180, 1e-12);
   EXPECT_EQ(r.data.input()->name, columns::kTorqueRef);
   EXPECT_EQ(r.data.input()->values[4], 2.0);
   EXPECT_EQ(r.data.output()->name, columns::kMotorAngle);
@@ -409,7 +420,7 @@ TEST(LogMapping, CsvWithOtherColumnNamesIsMappedByHeaderName) {
   // The listing gives the header names and every column's values.
   const SourceListing listing = listLogSource(p.string());
   ASSERT_TRUE(listing.ok) << listing.error.toString();
-  ASSERT_EQ(listing.entries.size(), 4u);
+  ASSERT_EQ(listing.entries.size(), 5u);
   EXPECT_EQ(listing.entries[2].expression, "pos_motor_deg_linkside");
   EXPECT_EQ(listing.columns[3][10], 1.0 - 0.002);
   fs::remove_all(tempDir());

@@ -22,6 +22,7 @@ LogReadOptions axisTwo() {
   m.input = "rec.act_torque_abs_nm(2,:)";
   m.output = "rec.act_pos_mot_deg(2,:)";
   m.arm = "rec.act_pos_se_deg(2,:)";
+  m.reference = "rec.ref_pos_deg(2,:)";
   m.outputUnit = SignalUnit::Deg;
   m.armUnit = SignalUnit::Deg;
   m.outputSide = EncoderSide::Arm;
@@ -57,6 +58,7 @@ TEST(ImportSession, MappingSurvivesTheSessionAndReplaysTheSameNumbers) {
   EXPECT_EQ(replayed.channel(columns::kMotorAngle)->values, direct.data.channel(columns::kMotorAngle)->values);
   EXPECT_EQ(replayed.channel(columns::kTorqueRef)->values, direct.data.channel(columns::kTorqueRef)->values);
   EXPECT_EQ(replayed.meta("gear_ratio"), direct.data.meta("gear_ratio"));
+  EXPECT_TRUE(replayed.isClosedLoop());
 
   // A session whose mapping is damaged is refused with the key named.
   std::string bad = text;
