@@ -201,6 +201,16 @@ bool applyMapping(IdData& data, const MappedChannels& found, const LogMapping& m
     if (k != 1.0)
       for (double& v : c.values) v *= k;
   };
+  // One channel cannot play two parts (a header name or column given twice).
+  const std::pair<int, const std::string*> parts[] = {{found.input, &found.inputSource},
+                                                      {found.output, &found.outputSource},
+                                                      {found.arm, &found.armSource},
+                                                      {found.reference, &found.referenceSource}};
+  for (std::size_t a = 0; a < 4; ++a)
+    for (std::size_t b = a + 1; b < 4; ++b)
+      if (parts[a].first >= 0 && parts[a].first == parts[b].first)
+        return fail(*parts[a].second + " is named for two parts (input, output, arm angle, reference): each "
+                                       "needs a signal of its own");
   Channel* in = channel(found.input);
   Channel* out = channel(found.output);
   Channel* arm = channel(found.arm);

@@ -410,6 +410,12 @@ TEST(LogMapping, CsvWithOtherColumnNamesIsMappedByHeaderName) {
   EXPECT_NEAR(r.data.channel(columns::kArmAngle)->values[10], (1.0 - 0.002) * kPi / 180, 1e-15);
   EXPECT_EQ(r.data.meta("robot"), "test bench");
   EXPECT_TRUE(r.warnings.empty());
+  // One column cannot be two signals.
+  LogReadOptions twice = o;
+  twice.mapping.reference = twice.mapping.output;
+  r = readLog(p.string(), twice);
+  ASSERT_FALSE(r.ok);
+  EXPECT_NE(r.error.problem.find("pos_motor_deg_linkside is named for two parts"), std::string::npos) << r.error.problem;
   // A name that is not in the header is named.
   o.mapping.arm = "pos_arm_deg";
   r = readLog(p.string(), o);
