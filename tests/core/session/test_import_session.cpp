@@ -60,6 +60,16 @@ TEST(ImportSession, MappingSurvivesTheSessionAndReplaysTheSameNumbers) {
   EXPECT_EQ(replayed.meta("gear_ratio"), direct.data.meta("gear_ratio"));
   EXPECT_TRUE(replayed.isClosedLoop());
 
+  // The report's Data section says how the log was read.
+  const ReplayResult replayed2 = replaySession(back.session, "/tmp/any.json");
+  ASSERT_EQ(replayed2.termination, Termination::Converged) << replayed2.message;
+  bool said = false;
+  for (const auto& section : replayed2.report.sections)
+    for (const auto& p : section.paragraphs)
+      said = said || p.find("Log 'log' read with time = rec.time_cont; input torque_ref_nm = 1.5 x "
+                            "rec.act_torque_abs_nm(2,:)") != std::string::npos;
+  EXPECT_TRUE(said);
+
   // A session whose mapping is damaged is refused with the key named.
   std::string bad = text;
   bad.replace(bad.find("\"arm\""), 5, "\"elbow\"");
