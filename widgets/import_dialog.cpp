@@ -204,7 +204,7 @@ ImportDialog::ImportDialog(const QString& path, SourceListing listing, const Log
   connect(slice_, &QComboBox::currentIndexChanged, this, &ImportDialog::updateSelection);
   connect(sliceIndex_, &QSpinBox::valueChanged, this, &ImportDialog::updateSelection);
   connect(selected_, &QLineEdit::editingFinished, this, [this] { showPreview(selected_->text().trimmed()); });
-  connect(&previewer_, &QFutureWatcher<SeriesRead>::finished, this, &ImportDialog::onPreviewRead);
+  connect(&previewer_, &QFutureWatcher<Preview>::finished, this, &ImportDialog::onPreviewRead);
   onItemChanged();
   // Fits a 1366x768 screen.
   const QRect screen = parent && parent->screen() ? parent->screen()->availableGeometry() : QRect(0, 0, 1366, 768);
@@ -290,34 +290,49 @@ void ImportDialog::showPreview(const QString& expression) {
   previewing_ = expression;
   previewLabel_->setText(tr("Reading %1...").arg(expression));
   const std::string path = path_.toStdString(), e = expression.toStdString();
+  const QString time = roles_[0]->text().trimmed();
+  const std::string t = time == expression ? std::string() : time.toStdString();
+  const auto read = [path, e, t](const SourceListing& listing) {
+    Preview p;
+    p.values = readSourceSeries(path, listing, e);
+    if (p.values.ok && !t.empty()) p.time = readSourceSeries(path, listing, t);
+    return p;
+  };
   if (listing_.format != LogFormat::Mat) {  // the columns are in memory already
-    SeriesRead r = readSourceSeries(path, listing_, e);
-    QFutureInterface<SeriesRead> done;
+    QFutureInterface<Preview> done;
     done.reportStarted();
-    done.reportResult(std::move(r));
+    done.reportResult(read(listing_));
     done.reportFinished();
     previewer_.setFuture(done.future());
     return;
   }
-  previewer_.setFuture(QtConcurrent::run([path, e, listing = listing_.format] {
+  previewer_.setFuture(QtConcurrent::run([read, format = listing_.format] {
     SourceListing l;
-    l.format = listing;
-    return readSourceSeries(path, l, e);
+    l.format = format;
+    return read(l);
   }));
 }
 
 void ImportDialog::onPreviewRead() {
-  const SeriesRead r = previewer_.result();
+  const Preview preview = previewer_.result();
+  const SeriesRead& r = preview.values;
   const QString expression = previewing_;
   QCPGraph* g = plot_->graph(0);
   points_ = 0;
   if (r.ok) {
+    // Against the chosen time when it has as many samples, else the sample time, else samples.
+    const bool timed = preview.time.ok && preview.time.values.size() == r.values.size();
+    const double ts = sampleTime_->value();
+    const auto xAt = [&](std::size_t i) {
+      return timed ? preview.time.values[i] : ts > 0.0 ? static_cast<double>(i) * ts : static_cast<double>(i + 1);
+    };
+    plot_->xAxis->setLabel(timed || ts > 0.0 ? tr("time (s)") : tr("sample"));
     // At most a few thousand points are drawn: min and max of each bucket keep the envelope.
     const std::size_t n = r.values.size(), buckets = 2000;
     QVector<double> x, y;
     if (n <= 2 * buckets) {
       for (std::size_t i = 0; i < n; ++i) {
-        x.append(static_cast<double>(i + 1));
+        x.append(xAt(i));
         y.append(r.values[i]);
       }
     } else {
@@ -325,10 +340,11 @@ void ImportDialog::onPreviewRead() {
         const std::size_t from = b * n / buckets, to = (b + 1) * n / buckets;
         const auto [lo, hi] = std::minmax_element(r.values.begin() + static_cast<std::ptrdiff_t>(from),
                                                   r.values.begin() + static_cast<std::ptrdiff_t>(to));
-        x.append(static_cast<double>(lo - r.values.begin() + 1));
-        y.append(*lo);
-        x.append(static_cast<double>(hi - r.values.begin() + 1));
-        y.append(*hi);
+        const auto first = std::min(lo, hi), second = std::max(lo, hi);  // in time order
+        x.append(xAt(static_cast<std::size_t>(first - r.values.begin())));
+        y.append(*first);
+        x.append(xAt(static_cast<std::size_t>(second - r.values.begin())));
+        y.append(*second);
       }
     }
     g->setData(x, y);
@@ -354,6 +370,7 @@ void ImportDialog::onPreviewRead() {
 }
 
 QString ImportDialog::previewTitle() const { return previewLabel_->text(); }
+QString ImportDialog::previewAxis() const { return plot_->xAxis->label(); }
 int ImportDialog::previewPoints() const { return points_; }
 
 LogReadOptions ImportDialog::options() const {

@@ -51,6 +51,9 @@ class ImportDialog : public QDialog {
   QCustomPlot* preview() const { return plot_; }
   QString previewTitle() const;
   int previewPoints() const;
+  // The preview's horizontal axis: "time (s)" once a time (or a sample time) is chosen,
+  // "sample" before.
+  QString previewAxis() const;
   // Open: checks the choices (input and output given, a gear ratio for an arm side, ...) and
   // closes only when they hold; otherwise says why above the buttons.
   void accept() override;
@@ -82,7 +85,11 @@ class ImportDialog : public QDialog {
   QDoubleSpinBox* inputScale_;
   QDoubleSpinBox* sampleTime_;
   QLabel* problem_;
-  QFutureWatcher<SeriesRead> previewer_;
+  // A preview's signal and, when a time is chosen, the time it is drawn against.
+  struct Preview {
+    SeriesRead values, time;
+  };
+  QFutureWatcher<Preview> previewer_;
   QString previewing_, pending_;
   int points_ = 0;
 };

@@ -14,6 +14,7 @@
 #include <QSignalSpy>
 #include <QTemporaryDir>
 #include <QTreeWidget>
+#include <qcustomplot.h>
 #include <QtTest>
 #include <algorithm>
 #include <cmath>
@@ -136,6 +137,13 @@ class ImportDialogTest : public QObject {
     QCOMPARE(d->selectedExpression(), QString("rec.act_pos_se_deg(2,:)"));
     QVERIFY2(d->previewTitle().startsWith("rec.act_pos_se_deg(2,:): 2501 samples"), qPrintable(d->previewTitle()));
     QCOMPARE(d->previewPoints(), 2501);
+    QCOMPARE(d->previewAxis(), QString("sample"));
+    // With the time chosen, the preview is drawn against it.
+    QVERIFY(pick(d, "rec.time_cont"));
+    d->useSelectionAs(ImportDialog::Role::Time);
+    QVERIFY(pick(d, "rec.act_pos_se_deg", 3));
+    QCOMPARE(d->previewAxis(), QString("time (s)"));
+    QVERIFY(std::abs(d->preview()->graph(0)->data()->at(2500)->key - 10.0) < 1e-6);
     test::saveShot(d->grab().toImage(), "import_dialog_kuka");
     d->reject();
   }
