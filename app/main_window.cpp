@@ -17,7 +17,6 @@
 #include <QLabel>
 #include <QMenuBar>
 #include <QMessageBox>
-#include <QScrollArea>
 #include <QMimeData>
 #include <QProgressDialog>
 #include <QSettings>
@@ -33,6 +32,7 @@
 
 #include "app/cli/cli.h"
 #include "app/log_importer.h"
+#include "app/panel_docks.h"
 #include "app/recent_files.h"
 #include "app/session_controller.h"
 #include "core/io/ranges.h"
@@ -52,6 +52,7 @@
 #include "widgets/recursive_panel.h"
 #include "widgets/residuals_panel.h"
 #include "widgets/transport_bar.h"
+#include "widgets/wheel_guard.h"
 #include "widgets/workspace.h"
 
 namespace flexarm {
@@ -81,6 +82,7 @@ MainWindow::MainWindow(QWidget* parent)
   setObjectName("mainWindow");
   setWindowTitle("FlexArm[*]");
   setAcceptDrops(true);
+  WheelGuard::install();  // the wheel scrolls panels, not the controls it passes over
   setCentralWidget(logPanel_);
   createMenus();
   // Panels: each a dock on the right, tabbed with the Preprocess panel unless it has its own
@@ -106,7 +108,6 @@ MainWindow::MainWindow(QWidget* parent)
                             "diagnosisDock", "Ctrl+Shift+G", preprocessDock_);
   recursiveDock_ = addPanel(recursivePanel_ = new RecursivePanel(workspace_, this), tr("Recursive"),
                             "recursiveDock", "Ctrl+Shift+I", preprocessDock_);
-  preprocessDock_->raise();
   // A row of the time-stamp report shows its place in the Log panel.
   connect(preprocessPanel_, &PreprocessPanel::timeSelected, logPanel_, &LogPanel::showAround);
   // The playhead spans the log as read (preprocessing keeps its times); every panel that
@@ -133,14 +134,14 @@ MainWindow::MainWindow(QWidget* parent)
       armPanel_->setExternalModel(tr("recursive estimate (run %1, at %2 s)")
                                       .arg(run->id)
                                       .arg(run->reached, 0, 'f', 1),
-                                  m);
+                                  m, {}, "recursive");
   });
   // The Arm view highlights the part whose parameter the diagnosis names at the playhead.
   connect(diagnosisPanel_, &DiagnosisPanel::verdictShown, this, [this](const QString& parameter) {
     if (parameter.isEmpty())
       armPanel_->clearFault();
     else
-      armPanel_->showParameterFault(parameter, tr("diagnosis: %1 changed").arg(parameter));
+      armPanel_->showParameterFault(parameter, tr("diagnosis: %1 changed").arg(parameter), "diagnosis");
   });
   transportBar_ = new TransportBar(playhead_, this);
   auto* transport = new QToolBar(tr("Playhead"), this);
@@ -150,15 +151,22 @@ MainWindow::MainWindow(QWidget* parent)
   addToolBar(Qt::BottomToolBarArea, transport);
   session_ = new SessionController(this, workspace_);  // File menu: sessions and reports
   importer_ = new LogImporter(this);
-  // The first size fits the screen (a 1366x768 laptop too); the docks scroll what is taller.
+  // The first size fits the screen (a 1366x768 laptop too); the docks scroll what is taller,
+  // and are arranged for the screen's size. A layout kept from the last run comes back when
+  // it was made for a screen of the same kind.
   const QRect screenRect = screen() ? screen()->availableGeometry() : QRect(0, 0, 1280, 860);
-  resize(std::min(1280, screenRect.width()), std::min(860, screenRect.height()));
+  const PanelDocks::Layout layout = PanelDocks::layoutFor(screenRect.size());
+  // A laptop's whole screen; nine tenths of a larger one.
+  if (layout == PanelDocks::Layout::Compact) resize(screenRect.size());
+  else resize(screenRect.width() * 9 / 10, screenRect.height() * 9 / 10);
+  docks_->arrange(layout);
   showWholeTabTitles();
   connect(this, &QMainWindow::tabifiedDockWidgetActivated, this, &MainWindow::showWholeTabTitles);
 
   QSettings settings;
   restoreGeometry(settings.value("window/geometry").toByteArray());
-  restoreState(settings.value("window/state").toByteArray());
+  if (settings.value("window/layout").toString() == PanelDocks::toString(docks_->layout()))
+    restoreState(settings.value("window/state").toByteArray());
   showWholeTabTitles();
   rebuildRecentMenu();
   statusBar()->showMessage(tr("Open a robot log with Ctrl+O, or drop it on the window"));
@@ -223,6 +231,7 @@ void MainWindow::createMenus() {
   data->addAction(tr("&Undo preprocessing"), this, [this] { preprocessPanel_->reset(); });
 
   viewMenu_ = menuBar()->addMenu(tr("&View"));
+  docks_ = new PanelDocks(this, viewMenu_);
 
   QMenu* edit = menuBar()->addMenu(tr("&Edit"));
   QAction* undo = workspace_->undoStack()->createUndoAction(this, tr("&Undo"));
@@ -252,33 +261,23 @@ void MainWindow::createMenus() {
 void MainWindow::showWholeTabTitles() {
   // Eleven panels share one dock area: their tabs keep whole titles and scroll, rather than
   // reading "Prepr...", "M...".
+  // A point smaller than the window's text, so that on a laptop's dock all eleven fit.
+  QFont small = font();
+  small.setPointSizeF(std::max(7.0, small.pointSizeF() - 1.0));
   for (QTabBar* bar : findChildren<QTabBar*>(Qt::FindDirectChildrenOnly)) {
     bar->setElideMode(Qt::ElideNone);
     bar->setUsesScrollButtons(true);
+    bar->setFont(small);
   }
 }
 
 QDockWidget* MainWindow::addPanel(QWidget* panel, const QString& title, const char* objectName,
-                                  const QString& shortcut, QDockWidget* tabWith) {
-  auto* dock = new QDockWidget(title, this);
-  dock->setObjectName(objectName);
-  if (panel == armPanel_) {  // the 3D view fills its dock at any size
-    dock->setWidget(panel);
-  } else {
-    // Tall panels scroll in a short dock, so that the window fits a 1366x768 screen.
-    auto* scroll = new QScrollArea(dock);
-    scroll->setObjectName(QString(objectName) + "Scroll");
-    scroll->setWidget(panel);
-    scroll->setWidgetResizable(true);
-    scroll->setFrameShape(QFrame::NoFrame);
-    dock->setWidget(scroll);
-  }
-  addDockWidget(Qt::RightDockWidgetArea, dock);
-  if (tabWith) tabifyDockWidget(tabWith, dock);
-  QAction* toggle = dock->toggleViewAction();
-  toggle->setShortcut(QKeySequence(shortcut));
-  viewMenu_->addAction(toggle);
-  return dock;
+                                  const QString& shortcut, QDockWidget* /*tabWith*/) {
+  // The layout for the screen places every panel (PanelDocks::arrange); the 3D view fills its
+  // dock at any size and has a place of its own on a wide screen.
+  const bool arm = panel == armPanel_;
+  return docks_->add(panel, title, objectName, shortcut,
+                     arm ? PanelDocks::Place::Own : PanelDocks::Place::Tabs, !arm);
 }
 
 void MainWindow::openDialog() {
@@ -490,6 +489,7 @@ void MainWindow::closeEvent(QCloseEvent* e) {
   QSettings settings;
   settings.setValue("window/geometry", saveGeometry());
   settings.setValue("window/state", saveState());
+  settings.setValue("window/layout", PanelDocks::toString(docks_->layout()));
   QMainWindow::closeEvent(e);
 }
 

@@ -30,6 +30,7 @@ class RecursivePanel;
 class TransportBar;
 class ResidualsPanel;
 class DiagnosisPanel;
+class PanelDocks;
 class SessionController;
 class Workspace;
 class LogImporter;
@@ -69,6 +70,8 @@ class MainWindow : public QMainWindow {
   DiagnosisPanel* diagnosisPanel() const { return diagnosisPanel_; }
   RecursivePanel* recursivePanel() const { return recursivePanel_; }
   QDockWidget* recursiveDock() const { return recursiveDock_; }
+  // Every panel's dock, its View menu entry, the switcher and the layout for the screen.
+  PanelDocks* docks() const { return docks_; }
   QStringList recentFiles() const;
   Playhead* playhead() const { return playhead_; }
   TransportBar* transportBar() const { return transportBar_; }
@@ -85,8 +88,8 @@ class MainWindow : public QMainWindow {
 
  private:
   void createMenus();
-  // Puts a panel in a dock on the right (tabbed with tabWith when given) and adds its View
-  // menu entry with the shortcut.
+  // Registers a panel with its dock, View menu entry, shortcut and switcher line
+  // (PanelDocks::add); where it goes is the screen's layout's choice (tabWith is not used).
   QDockWidget* addPanel(QWidget* panel, const QString& title, const char* objectName,
                         const QString& shortcut, QDockWidget* tabWith);
   // Tabs of tabified docks show whole titles and scroll when there are many.
@@ -130,6 +133,7 @@ class MainWindow : public QMainWindow {
   QDockWidget* recursiveDock_ = nullptr;
   QMenu* recentMenu_ = nullptr;
   QMenu* viewMenu_ = nullptr;
+  PanelDocks* docks_ = nullptr;
   // A log read in the background with its file's SHA-256 (empty when it could not be formed).
   struct ReadLog {
     LogReadResult result;

@@ -15,6 +15,8 @@
 #include <memory>
 #include <qcustomplot.h>
 
+#include "widgets/plots/plot_tools.h"
+
 namespace flexarm {
 namespace {
 
@@ -112,8 +114,18 @@ QString sectionHtml(const ReportSection& s) {
   return h;
 }
 
-// A QCustomPlot showing one report plot.
-std::unique_ptr<QCustomPlot> makePlot(const ReportPlot& p) {
+
+QString dataUri(const QImage& image) {
+  QByteArray png;
+  QBuffer buffer(&png);
+  buffer.open(QIODevice::WriteOnly);
+  image.save(&buffer, "PNG");
+  return "data:image/png;base64," + QString::fromLatin1(png.toBase64());
+}
+
+}  // namespace
+
+std::unique_ptr<QCustomPlot> reportPlot(const ReportPlot& p) {
   auto plot = std::make_unique<QCustomPlot>();
   plot->resize(kPlotWidth, kPlotHeight);
   plot->plotLayout()->insertRow(0);
@@ -147,6 +159,11 @@ std::unique_ptr<QCustomPlot> makePlot(const ReportPlot& p) {
     }
     item->setName(QString::fromStdString(s.name));
     item->setPen(pen);
+    // The legend names each curve once: a nameless series (the second bound of a band) or a
+    // repeated name has no entry of its own.
+    bool named = !s.name.empty();
+    for (std::size_t k = 0; k < i && named; ++k) named = p.series[k].name != s.name;
+    if (!named) item->removeFromLegend();
   }
   plot->xAxis->setLabel(QString::fromStdString(p.xLabel));
   plot->yAxis->setLabel(QString::fromStdString(p.yLabel));
@@ -158,30 +175,20 @@ std::unique_ptr<QCustomPlot> makePlot(const ReportPlot& p) {
   };
   if (p.logX) logAxis(plot->xAxis);
   if (p.logY) logAxis(plot->yAxis);
-  plot->legend->setVisible(p.series.size() > 1);
-  if (p.legendBottomLeft)
-    plot->axisRect()->insetLayout()->setInsetAlignment(0, Qt::AlignBottom | Qt::AlignLeft);
+  // The legend in a row of its own between the title and the data: it covers no curve.
+  plot->legend->setVisible(plot->legend->itemCount() > 1);
   plot->legend->setFont(QFont("sans", 8));
+  if (plot->legend->visible()) placeLegendAbove(plot.get());
   plot->rescaleAxes();
   if (p.xRange) plot->xAxis->setRange(p.xRange->first, p.xRange->second);
   if (p.yRange) plot->yAxis->setRange(p.yRange->first, p.yRange->second);
   return plot;
 }
 
-QString dataUri(const QImage& image) {
-  QByteArray png;
-  QBuffer buffer(&png);
-  buffer.open(QIODevice::WriteOnly);
-  image.save(&buffer, "PNG");
-  return "data:image/png;base64," + QString::fromLatin1(png.toBase64());
-}
-
-}  // namespace
-
 QList<QImage> reportPlotImages(const Report& report) {
   QList<QImage> images;
   for (const auto& s : report.sections)
-    for (const auto& p : s.plots) images.append(makePlot(p)->toPixmap(kPlotWidth, kPlotHeight, 2.0).toImage());
+    for (const auto& p : s.plots) images.append(reportPlot(p)->toPixmap(kPlotWidth, kPlotHeight, 2.0).toImage());
   return images;
 }
 
@@ -282,7 +289,7 @@ bool writeReportPdf(const Report& report, const QString& path, QString* why) {
         const double scale = width / kPlotWidth;
         const double h = kPlotHeight * scale;
         ensure(h + 8);
-        auto plot = makePlot(p);
+        auto plot = reportPlot(p);
         painter.save();
         painter.translate(0, y + 4);
         painter.scale(scale, scale);

@@ -6,12 +6,18 @@
 #include <QImage>
 #include <QList>
 #include <QString>
+#include <memory>
 #include <string>
 
 #include "core/session/report.h"
 
+class QCustomPlot;
+
 namespace flexarm {
 
+// The plot a report draws for p: its title, the legend in a row of its own between title and
+// data (each curve named once), the axes. GUI thread only.
+std::unique_ptr<QCustomPlot> reportPlot(const ReportPlot& p);
 // Every plot of the report as an image, in order. GUI thread only (QCustomPlot is a widget).
 QList<QImage> reportPlotImages(const Report& report);
 // The whole report as one HTML document with the plot images embedded as PNG. Any thread:

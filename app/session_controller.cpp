@@ -59,25 +59,16 @@ SessionController::SessionController(MainWindow* window, Workspace* workspace)
     setDirty(false);  // nothing of the new workspace is unsaved yet
   });
   // Preprocessing, ranges and model edits go through the undo stack: its clean state is the
-  // saved one. A panel's new result (discovery, diagnosis, recursive run) is recorded with
-  // the data it ran on and marks the workspace changed.
+  // saved one. A panel's new result (discovery, diagnosis, recursive run), recorded by its
+  // panel with the data it ran on (Workspace::recordResult), marks the workspace changed.
   connect(workspace_->undoStack(), &QUndoStack::cleanChanged, this, [this] { setDirty(dirty_); });
-  connect(window_->discoveryPanel(), &DiscoveryPanel::finished, this, [this] {
-    recordProvenance(*window_, "discovery");
-    markDirty();
-  });
-  connect(window_->diagnosisPanel(), &DiagnosisPanel::finished, this, [this] {
-    recordProvenance(*window_, "diagnosis");
-    markDirty();
-  });
+  connect(window_->discoveryPanel(), &DiscoveryPanel::finished, this, &SessionController::markDirty);
+  connect(window_->diagnosisPanel(), &DiagnosisPanel::finished, this, &SessionController::markDirty);
   connect(window_, &MainWindow::logOpened, this, &SessionController::offerRecompute);
   connect(window_->fitPanel(), &FitPanel::estimated, this, [this] {
     if (!recomputeQueue_.isEmpty()) recomputeNext();
   });
-  connect(window_->recursivePanel(), &RecursivePanel::runFinished, this, [this] {
-    recordProvenance(*window_, "recursive");
-    markDirty();
-  });
+  connect(window_->recursivePanel(), &RecursivePanel::runFinished, this, &SessionController::markDirty);
   autosaveTimer_->setInterval(kAutosaveMs);
   connect(autosaveTimer_, &QTimer::timeout, this, &SessionController::autosave);
   autosaveTimer_->start();

@@ -1,9 +1,11 @@
 #include "app/session_parts.h"
 
 #include <QByteArray>
+#include <QStringList>
 #include <QVariant>
 
 #include "app/main_window.h"
+#include "app/panel_docks.h"
 #include "core/diagnosis/diagnosis_json.h"
 #include "core/session/diagnosis_part.h"
 #include "core/session/discovery_part.h"
@@ -14,6 +16,7 @@
 #include "widgets/diagnosis_panel.h"
 #include "core/session/recursive_part.h"
 #include "widgets/discovery_panel.h"
+#include "widgets/fit_panel.h"
 #include "widgets/lqg_panel.h"
 #include "widgets/model_panel.h"
 #include "widgets/recursive_panel.h"
@@ -24,21 +27,26 @@ namespace {
 
 using nlohmann::json;
 
-// The data of the result a panel made last, as the window recorded it (recordProvenance).
-QByteArray provenanceProperty(const char* key) { return QByteArray("flexarmProvenance_") + key; }
-
+// The data of the result the part's panel shows, as the workspace records it
+// (Workspace::recordResult): a section is saved with them.
 json withProvenance(json section, const MainWindow& w, const char* key) {
-  const QByteArray p = w.property(provenanceProperty(key).constData()).toByteArray();
-  if (!p.isEmpty() && section.is_object() && !section.contains("provenance"))
-    section["provenance"] = json::parse(p.toStdString(), nullptr, false);
+  const auto p = w.workspace()->resultData(key);
+  if (p && section.is_object() && !section.contains("provenance")) section["provenance"] = provenanceToJson(*p);
   return section;
 }
 
-// A restored section's provenance becomes the window's record, so saving again keeps it.
-void keepProvenance(const json& section, MainWindow& w, const char* key) {
-  w.setProperty(provenanceProperty(key).constData(), section.is_object() && section.contains("provenance")
-                                             ? QByteArray::fromStdString(section["provenance"].dump())
-                                             : QByteArray());
+// A restored section's data become the panel's result record, so that saving again keeps
+// them and opening another log withdraws the result; a section without them (written
+// before provenance) is of the session's data. Raw: the part computes on the log as read.
+// False when the section names other data than the open ones: it is not to be shown.
+bool keepProvenance(const json& section, MainWindow& w, const char* key, bool raw) {
+  Workspace* ws = w.workspace();
+  if (section.is_null()) {
+    ws->forgetResult(key);
+    return true;
+  }
+  const auto stored = provenanceIn(section);
+  return ws->recordResult(key, stored.value_or(ws->dataProvenance()), raw);
 }
 
 json captureModels(const MainWindow& w) {
@@ -96,6 +104,7 @@ json captureFits(const MainWindow& w) {
 void restoreFits(const json& section, MainWindow& w) {
   Workspace* ws = w.workspace();
   json unattached = json::array();
+  std::optional<std::pair<FitRequest, int>> shown;  // the last fit with its estimate
   for (const auto& j : section["requests"]) {
     std::string why;
     auto request = fitRequestFromJson(j, &why);
@@ -109,6 +118,7 @@ void restoreFits(const json& section, MainWindow& w) {
       e.fitRequest = shared;
       ws->setModelDirect(static_cast<int>(i), e);
       attached = true;
+      shown = {*request, static_cast<int>(i)};
     }
     if (attached) continue;
     std::optional<PolynomialModel> estimate;
@@ -123,9 +133,20 @@ void restoreFits(const json& section, MainWindow& w) {
     e.polynomial = std::make_shared<const PolynomialModel>(std::move(*estimate));
     e.fitRequest = shared;
     ws->insertModelDirect(static_cast<int>(ws->models().size()), e);
+    shown = {*request, static_cast<int>(ws->models().size()) - 1};
   }
   w.setProperty(kUnattachedFits, unattached.empty() ? QByteArray()
                                                      : QByteArray::fromStdString(unattached.dump()));
+  // The Fit panel shows the last fit as it was left: its choices, table and numbers.
+  if (w.fitPanel()) {
+    if (shown) w.fitPanel()->showStored(shown->first, shown->second);
+    else w.fitPanel()->clearResult();
+  }
+}
+
+void resetFits(MainWindow& w) {
+  w.setProperty(kUnattachedFits, QByteArray());
+  if (w.fitPanel()) w.fitPanel()->clearResult();
 }
 
 // The Discovery panel's last request and the summary of its result; restoring shows the
@@ -134,6 +155,7 @@ void restoreFits(const json& section, MainWindow& w) {
 constexpr const char* kKeptDiscovery = "flexarmKeptDiscovery";
 
 json captureDiscovery(const MainWindow& w) {
+  if (!w.workspace()->hasResult("discovery")) return nullptr;  // none, or of other data
   const DiscoveryPanel* panel = w.discoveryPanel();
   if (panel && panel->lastRequest() && panel->result())
     return withProvenance({{"request", discoveryRequestToJson(*panel->lastRequest())},
@@ -145,13 +167,12 @@ json captureDiscovery(const MainWindow& w) {
 
 void resetDiscovery(MainWindow& w) {
   w.setProperty(kKeptDiscovery, QByteArray());
-  keepProvenance(nullptr, w, "discovery");
+  keepProvenance(nullptr, w, "discovery", false);
   if (w.discoveryPanel()) w.discoveryPanel()->clearResult();
 }
 
 void restoreDiscovery(const json& section, MainWindow& w) {
   resetDiscovery(w);
-  keepProvenance(section, w, "discovery");
   std::string why;
   auto request = discoveryRequestFromJson(section["request"], &why);
   std::optional<DiscoveryResult> result;
@@ -159,6 +180,7 @@ void restoreDiscovery(const json& section, MainWindow& w) {
     result = discoveryResultFromJson(section["result"], &why);
   if (w.discoveryPanel() && request && result) w.discoveryPanel()->showStored(*request, *result);
   else w.setProperty(kKeptDiscovery, QByteArray::fromStdString(section.dump()));
+  if (!keepProvenance(section, w, "discovery", false)) resetDiscovery(w);  // of other data
 }
 
 // The LQG panel's design: parameters and where they came from, weights, saturation.
@@ -190,12 +212,15 @@ constexpr const char* kDiagnosisReference = "diagnosis_reference";
 
 json captureDiagnosis(const MainWindow& w) {
   const DiagnosisPanel* panel = w.diagnosisPanel();
-  if (!panel) return nullptr;
+  if (!panel || !w.workspace()->hasResult("diagnosis")) return nullptr;
   const auto request = panel->sessionRequest(kDiagnosisReference);
   if (!request) return nullptr;
   json section = {{"request", diagnosisRequestToJson(*request)}};
   if (const DiagnosisRun* run = panel->lastRun(); run && run->ok()) {
     section["result"] = diagnosisResultJson(run->result);
+    section = withProvenance(section, w, "diagnosis");
+  } else if (!panel->storedResult().is_null()) {  // taken over from a session, not run again
+    section["result"] = panel->storedResult();
     section = withProvenance(section, w, "diagnosis");
   }
   return section;
@@ -211,21 +236,22 @@ std::vector<LogReference> diagnosisLogs(const MainWindow& w) {
   return {l};
 }
 
+void resetDiagnosis(MainWindow& w) {
+  keepProvenance(nullptr, w, "diagnosis", true);
+  if (w.diagnosisPanel()) w.diagnosisPanel()->clearResult();
+}
+
 void restoreDiagnosis(const json& section, MainWindow& w) {
-  keepProvenance(section, w, "diagnosis");
   std::string why;
   const auto request = diagnosisRequestFromJson(section["request"], &why);
   if (!request || !w.diagnosisPanel()) return;
   const QString path = request->referenceLog.empty() || !w.sessionController()
                            ? QString()
                            : w.sessionController()->sessionLogPath(request->referenceLog);
-  w.diagnosisPanel()->setRequest(*request, path);
+  w.diagnosisPanel()->setRequest(*request, path, section.contains("result") ? section["result"] : json());
+  if (!keepProvenance(section, w, "diagnosis", true)) resetDiagnosis(w);  // of another log
 }
 
-void resetDiagnosis(MainWindow& w) {
-  keepProvenance(nullptr, w, "diagnosis");
-  if (w.diagnosisPanel()) w.diagnosisPanel()->clearResult();
-}
 
 // The Recursive panel's runs (the overlaid previous one and the current one): each request
 // with the summary of its result when it ran to the end. Opening a session sets the panel's
@@ -234,6 +260,7 @@ void resetDiagnosis(MainWindow& w) {
 constexpr const char* kKeptRecursive = "flexarmKeptRecursive";
 
 json captureRecursive(const MainWindow& w) {
+  if (!w.workspace()->hasResult("recursive")) return nullptr;
   const RecursivePanel* panel = w.recursivePanel();
   json runs = json::array();
   if (panel)
@@ -249,27 +276,49 @@ json captureRecursive(const MainWindow& w) {
 
 void resetRecursive(MainWindow& w) {
   w.setProperty(kKeptRecursive, QByteArray());
-  keepProvenance(nullptr, w, "recursive");
+  keepProvenance(nullptr, w, "recursive", true);
   if (w.recursivePanel()) w.recursivePanel()->clearRuns();
 }
 
 void restoreRecursive(const json& section, MainWindow& w) {
   resetRecursive(w);
-  keepProvenance(section, w, "recursive");
   w.setProperty(kKeptRecursive, QByteArray::fromStdString(section.dump()));
   std::string why;
   if (!section["runs"].empty() && w.recursivePanel())
-    if (auto q = recursiveRequestFromJson(section["runs"].back()["request"], &why))
+    if (auto q = recursiveRequestFromJson(section["runs"].back()["request"], &why)) {
       w.recursivePanel()->setRequest(*q);
+      // The last run's end and final estimates, as stored: nothing runs while opening.
+      const json& last = section["runs"].back();
+      if (last.contains("result") && last["result"].is_object()) {
+        const json& r = last["result"];
+        QStringList finals;
+        if (r.contains("final") && r["final"].is_object())
+          for (const auto& [name, value] : r["final"].items())
+            if (value.is_number())
+              finals << QString("%1 = %2").arg(QString::fromStdString(name)).arg(value.get<double>(), 0, 'g', 5);
+        w.recursivePanel()->showStored(
+            QObject::tr("From the session: %1 (%2 after %3 samples); final %4. Play runs it again with its plots.")
+                .arg(QString::fromStdString(q->label.empty() ? std::string("the last run") : q->label),
+                     QString::fromStdString(r.value("termination", std::string("?"))))
+                .arg(r.value("samples", 0))
+                .arg(finals.isEmpty() ? QObject::tr("estimates not stored") : finals.join(", ")));
+      }
+    }
+  if (!keepProvenance(section, w, "recursive", true)) resetRecursive(w);  // of another log
 }
 
 json captureView(const MainWindow& w) {
   return {{"window_state", w.saveState().toBase64().toStdString()},
+          {"layout", PanelDocks::toString(w.docks()->layout())},
           {"selected_model", w.modelPanel() ? w.modelPanel()->currentIndex() : -1}};
 }
 
+// The docks come back as saved when they were saved for a screen of the same kind (a
+// laptop's layout on a large screen or the reverse keeps the layout chosen for this one).
 void restoreView(const json& section, MainWindow& w) {
-  if (section.contains("window_state") && section["window_state"].is_string())
+  const bool sameScreen = !section.contains("layout") || !section["layout"].is_string() ||
+                          section["layout"].get<std::string>() == PanelDocks::toString(w.docks()->layout());
+  if (sameScreen && section.contains("window_state") && section["window_state"].is_string())
     w.restoreState(QByteArray::fromBase64(QByteArray::fromStdString(section["window_state"].get<std::string>())));
   if (w.modelPanel() && section.contains("selected_model") && section["selected_model"].is_number_integer())
     w.modelPanel()->selectModel(section["selected_model"].get<int>());
@@ -277,16 +326,11 @@ void restoreView(const json& section, MainWindow& w) {
 
 }  // namespace
 
-void recordProvenance(MainWindow& window, const char* key) {
-  window.setProperty(provenanceProperty(key).constData(),
-                     QByteArray::fromStdString(provenanceToJson(window.workspace()->dataProvenance()).dump()));
-}
-
 const std::vector<WindowSessionPart>& windowSessionParts() {
   // In the order of core sessionParts(); later capabilities add their pair here.
   static const std::vector<WindowSessionPart> kParts = {
       {"models", &captureModels, &restoreModels},
-      {"fits", &captureFits, &restoreFits},
+      {"fits", &captureFits, &restoreFits, &resetFits},
       {"discovery", &captureDiscovery, &restoreDiscovery, &resetDiscovery},
       {"lqg", &captureLqg, &restoreLqg, &resetLqg},
       {"diagnosis", &captureDiagnosis, &restoreDiagnosis, &resetDiagnosis, &diagnosisLogs},

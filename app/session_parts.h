@@ -29,8 +29,4 @@ struct WindowSessionPart {
 
 const std::vector<WindowSessionPart>& windowSessionParts();
 
-// Records the workspace's data (Workspace::dataProvenance) as the data of the result the
-// part `key` ("discovery", "diagnosis", "recursive") holds now; its section is saved with it.
-void recordProvenance(MainWindow& window, const char* key);
-
 }  // namespace flexarm

@@ -7,6 +7,7 @@
 #include <QDoubleSpinBox>
 #include <QFileDialog>
 #include <QFormLayout>
+#include <QGridLayout>
 #include <QHBoxLayout>
 #include <QLabel>
 #include <QLineEdit>
@@ -34,9 +35,10 @@ namespace {
 constexpr int kLogSource = -1, kExternalSource = -2;
 constexpr int kTracePoints = 400;
 constexpr double kTraceSeconds = 1.0;
-// Auto scales: the log's largest motion about axis one is drawn at about this angle, and the
-// largest deflection at about that one (radians).
-constexpr double kMotionDrawn = 0.6, kDeflectionDrawn = 0.5;
+// Auto scales: the log's largest motion about axis one is drawn at about this angle; the
+// flexing at its median (half of the log flexes more) at about that one, unless the largest
+// deflection would then be drawn beyond the last (radians).
+constexpr double kMotionDrawn = 0.6, kDeflectionDrawn = 0.4, kDeflectionMost = 2.5;
 
 // v with a fixed number of decimals, without the "-0.0000" of a tiny negative (5e-22 rad
 // reads 0.0000, not 5.195e-22).
@@ -55,6 +57,29 @@ int niceDown(double x, int lo, int hi) {
   const double m = x / p;
   const double nice = (m >= 5 ? 5 : m >= 2 ? 2 : 1) * p;
   return static_cast<int>(std::clamp(nice, static_cast<double>(lo), static_cast<double>(hi)));
+}
+
+// How far the tip lags behind the rigid arm (the springs' deflections added up) at the median
+// of the log's samples: what the flexing looks like most of the time, where the largest
+// deflection is a moment's.
+double medianDeflection(const BodyAngles& a) {
+  std::vector<double> total(a.samples(), 0.0);
+  for (const auto* d : {&a.gearDeflection, &a.armDeflection})
+    for (std::size_t k = 0; k < d->size() && k < total.size(); ++k) total[k] += std::abs((*d)[k]);
+  if (total.empty()) return 0.0;
+  const auto middle = total.begin() + static_cast<std::ptrdiff_t>(total.size() / 2);
+  std::nth_element(total.begin(), middle, total.end());
+  return *middle;
+}
+
+// The one of 1, 2, 5 times a power of ten nearest to x (on a log scale), clamped to [lo, hi].
+int niceNearest(double x, int lo, int hi) {
+  if (!(x > 0) || !std::isfinite(x)) return lo;
+  const double p = std::pow(10.0, std::floor(std::log10(x)));
+  double best = p;
+  for (double m : {1.0, 2.0, 5.0, 10.0})
+    if (std::abs(std::log(m * p / x)) < std::abs(std::log(best / x))) best = m * p;
+  return static_cast<int>(std::clamp(best, static_cast<double>(lo), static_cast<double>(hi)));
 }
 
 double gearRatioOf(const IdData& d) {
@@ -134,13 +159,15 @@ ArmPanel::ArmPanel(Workspace* workspace, QWidget* parent)
   top->addWidget(new QLabel(tr("Angles"), this));
   top->addWidget(source_, 1);
   top->addWidget(measured_);
-  auto* controls = new QHBoxLayout;
-  controls->addWidget(magnify_);
-  controls->addWidget(exaggerate_);
-  controls->addWidget(ghost_);
-  controls->addWidget(trace_);
-  controls->addStretch(1);
-  controls->addWidget(export_);
+  // Two short rows of controls: the dock stays narrow enough to sit beside the Log panel.
+  auto* controls = new QGridLayout;
+  controls->setContentsMargins(0, 0, 0, 0);
+  controls->addWidget(magnify_, 0, 0);
+  controls->addWidget(exaggerate_, 0, 1);
+  controls->addWidget(ghost_, 1, 0);
+  controls->addWidget(trace_, 1, 1);
+  controls->setColumnStretch(2, 1);
+  controls->addWidget(export_, 0, 3);
   auto* busy = new QHBoxLayout;
   busy->addWidget(progress_, 1);
   busy->addWidget(cancel_);
@@ -173,6 +200,11 @@ ArmPanel::ArmPanel(Workspace* workspace, QWidget* parent)
   });
   connect(&watcher_, &QFutureWatcher<BodyAngles>::finished, this, &ArmPanel::onSimulated);
   connect(workspace_, &Workspace::logChanged, this, &ArmPanel::onLogChanged);
+  // What another panel handed in as its result leaves with that result's record.
+  connect(workspace_, &Workspace::resultWithdrawn, this, [this](const QString& key) {
+    if (!faultKey_.isEmpty() && key == faultKey_) clearFault();
+    if (external_ && !external_->resultKey.isEmpty() && key == external_->resultKey) clearExternalModel();
+  });
   connect(workspace_, &Workspace::modelsChanged, this, [this](int index) {
     const int shown = source_->currentData().toInt();
     refillSources();
@@ -248,12 +280,12 @@ bool ArmPanel::selectSource(int data) {
 }
 
 void ArmPanel::setExternalModel(const QString& name, std::shared_ptr<const PhysicalModel> model,
-                                std::vector<Effect> effects) {
-  if (!model) {
+                                std::vector<Effect> effects, const QString& resultKey) {
+  if (!model || (!resultKey.isEmpty() && !workspace_->hasResult(resultKey))) {
     clearExternalModel();
     return;
   }
-  external_ = External{name, std::move(model), std::move(effects)};
+  external_ = External{name, resultKey, std::move(model), std::move(effects)};
   refillSources();
   selectSource(kExternalSource);
 }
@@ -354,7 +386,10 @@ void ArmPanel::onSimulated() {
     const double largest = angles_->maxGearDeflection + angles_->maxArmDeflection;
     scene_->setDeflectionRange(std::max({angles_->maxGearDeflection, angles_->maxArmDeflection,
                                          angles_->maxParallelDeflection}));
-    exaggerate_->setValue(niceDown(kDeflectionDrawn / std::max(1e-12, largest), 1, 1000000));
+    // The exaggeration shows the flexing of most of the log, not only of its largest moment.
+    const double scale = std::min(kDeflectionDrawn / std::max(1e-12, medianDeflection(*angles_)),
+                                  kDeflectionMost / std::max(1e-12, largest));
+    exaggerate_->setValue(niceNearest(scale, 1, 1000000));
     scene_->setGhostVisible(ghost_->isChecked());
     placeParameterFault();
   }
@@ -447,8 +482,10 @@ void ArmPanel::showTime(double t) {
   view_->requestRender();
 }
 
-void ArmPanel::showFault(ArmPart part, const QString& reason) {
+void ArmPanel::showFault(ArmPart part, const QString& reason, const QString& resultKey) {
+  if (!resultKey.isEmpty() && !workspace_->hasResult(resultKey)) return;  // not of the open data
   faultParameter_.clear();
+  faultKey_ = resultKey;
   if (fault_) scene_->setHighlight(*fault_, false);
   fault_ = part;
   faultReason_ = reason;
@@ -457,10 +494,10 @@ void ArmPanel::showFault(ArmPart part, const QString& reason) {
   redraw();
 }
 
-bool ArmPanel::showParameterFault(const QString& parameter, const QString& reason) {
+bool ArmPanel::showParameterFault(const QString& parameter, const QString& reason, const QString& resultKey) {
   const auto part = armPartForParameter(shownStructure(), parameter.toStdString());
-  if (!part) return false;
-  showFault(*part, reason);
+  if (!part || (!resultKey.isEmpty() && !workspace_->hasResult(resultKey))) return false;
+  showFault(*part, reason, resultKey);
   faultParameter_ = parameter;
   return true;
 }
@@ -472,12 +509,13 @@ void ArmPanel::placeParameterFault() {
   const auto part = armPartForParameter(shownStructure(), faultParameter_.toStdString());
   if (!part || part == fault_) return;
   const QString parameter = faultParameter_;
-  showFault(*part, faultReason_);
+  showFault(*part, faultReason_, faultKey_);
   faultParameter_ = parameter;
 }
 
 void ArmPanel::clearFault() {
   faultParameter_.clear();
+  faultKey_.clear();
   if (!fault_) return;
   scene_->clearHighlights();
   fault_.reset();

@@ -56,8 +56,10 @@ class ArmPanel : public QWidget {
   bool selectModel(int index);
   // A model from outside the list (e.g. the recursive estimator's current model), shown under
   // `name` and selected. A new call replaces it.
+  // With a resultKey the model is a result of that record (Workspace::recordResult): it is
+  // refused when the record does not stand and leaves the view when it is withdrawn.
   void setExternalModel(const QString& name, std::shared_ptr<const PhysicalModel> model,
-                        std::vector<Effect> effects = {});
+                        std::vector<Effect> effects = {}, const QString& resultKey = {});
   void clearExternalModel();
   // What the arm plays now: the simulated masses (null while rigid or computing).
   std::shared_ptr<const BodyAngles> bodyAngles() const { return angles_; }
@@ -78,8 +80,10 @@ class ArmPanel : public QWidget {
   void setGhostVisible(bool on);
   void setTraceVisible(bool on);
 
-  // Diagnosis hook: draws part in red with the reason on the view until cleared.
-  void showFault(ArmPart part, const QString& reason);
+  // Diagnosis hook: draws part in red with the reason on the view until cleared. With a
+  // resultKey the fault is a result of that record (Workspace::recordResult): it is refused
+  // when the record does not stand and cleared when it is withdrawn (another log opened).
+  void showFault(ArmPart part, const QString& reason, const QString& resultKey = {});
   void clearFault();
   // The highlighted part, if any.
   std::optional<ArmPart> fault() const { return fault_; }
@@ -101,7 +105,7 @@ class ArmPanel : public QWidget {
   // gear spring of the two-mass model and the arm spring of the three-mass one, so choosing
   // another source moves the highlight. A name that is no part of the arm (r, or unknown)
   // changes nothing and returns false.
-  bool showParameterFault(const QString& parameter, const QString& reason);
+  bool showParameterFault(const QString& parameter, const QString& reason, const QString& resultKey = {});
 
  signals:
   // A source's simulation finished (or failed: message says why); the arm plays it.
@@ -142,6 +146,7 @@ class ArmPanel : public QWidget {
   int simGeneration_ = -1;  // the choice the running simulation is for
   struct External {
     QString name;
+    QString resultKey;
     std::shared_ptr<const PhysicalModel> model;
     std::vector<Effect> effects;
   };
@@ -154,6 +159,7 @@ class ArmPanel : public QWidget {
   std::optional<ArmPart> fault_;
   QString faultReason_;
   QString faultParameter_;  // set when the fault came by parameter name
+  QString faultKey_;        // the result record the fault belongs to
   QString sourceText_;
   ArmOverlay overlay_;
   QString computingName_;

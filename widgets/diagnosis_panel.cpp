@@ -37,8 +37,7 @@ void setupPlot(QCustomPlot* p, const QString& y) {
   p->legend->setFont(QFont(p->font().family(), 7));
   p->setInteractions(QCP::iRangeDrag | QCP::iRangeZoom);
   PlotTools::install(p);
-  p->legend->setBrush(QColor(255, 255, 255, 190));  // the curves stay visible beneath it
-  p->setMinimumHeight(90);
+  p->setMinimumHeight(150);
 }
 
 }  // namespace
@@ -115,6 +114,7 @@ DiagnosisPanel::DiagnosisPanel(Workspace* workspace, QWidget* parent)
   estimates_->setMinimumHeight(170);
   setupPlot(cusum_, tr("g / h [-]"));
   setupPlot(hypothesis_, tr("T [-]"));
+  for (QCustomPlot* p : {cusum_, hypothesis_}) showLegendAbove(p);  // none until a result
   setupPlot(timeline_, "");
   timeline_->legend->setVisible(false);
   timeline_->yAxis->setRange(-0.3, 5.0);
@@ -204,7 +204,16 @@ DiagnosisPanel::DiagnosisPanel(Workspace* workspace, QWidget* parent)
   });
   connect(&watcher_, &QFutureWatcher<Outcome>::finished, this, &DiagnosisPanel::onFinished);
   connect(workspace_, &Workspace::modelsChanged, this, &DiagnosisPanel::refillReferences);
-  connect(workspace_, &Workspace::logChanged, this, &DiagnosisPanel::clearResult);
+  // A result is shown only beside its log: another log drops it with its request (a run in
+  // flight too), and the Arm view's highlight goes with the verdict.
+  auto drop = [this] {
+    clearResult();
+    request_.reset();
+  };
+  connect(workspace_, &Workspace::logChanged, this, drop);
+  connect(workspace_, &Workspace::resultWithdrawn, this, [drop](const QString& key) {
+    if (key == "diagnosis") drop();
+  });
   auto* poll = new QTimer(this);
   poll->setInterval(100);
   connect(poll, &QTimer::timeout, this, [this] {
@@ -310,6 +319,8 @@ void DiagnosisPanel::diagnose() {
   stored.options = request.options;
   stored.calibrate = false;
   request_ = stored;
+  storedResult_ = nullptr;  // this run replaces what a session stored
+  runData_ = workspace_->dataProvenance();
   cancelFlag_ = std::make_shared<std::atomic<bool>>(false);
   progressValue_ = std::make_shared<std::atomic<double>>(0.0);
   const int id = ++runId_;
@@ -349,9 +360,16 @@ void DiagnosisPanel::clearResult() {
   if (isBusy()) cancel();
   ++runId_;
   shownRun_.reset();
+  storedResult_ = nullptr;
+  workspace_->forgetResult("diagnosis");
+  if (!shownVerdict_.isEmpty()) {
+    shownVerdict_.clear();
+    emit verdictShown({});
+  }
   for (QCustomPlot* p : {estimates_, cusum_, hypothesis_, timeline_}) {
     p->clearGraphs();
     p->clearItems();
+    showLegendAbove(p);  // without entries: out of the layout
     p->replot();
   }
   shown_.clear();
@@ -378,6 +396,11 @@ void DiagnosisPanel::onFinished() {
     verdict_->setStyleSheet("color: rgb(200,40,40)");
     return;
   }
+  if (!workspace_->recordResult("diagnosis", runData_, true)) {  // the log changed meanwhile
+    clearResult();
+    request_.reset();
+    return;
+  }
   shownRun_ = out.run;
   if (shownRun_->calibration) {
     storedCalibration_ = calibrationJson(*shownRun_->calibration);
@@ -400,8 +423,10 @@ std::optional<DiagnosisSessionRequest> DiagnosisPanel::sessionRequest(const std:
   return q;
 }
 
-void DiagnosisPanel::setRequest(const DiagnosisSessionRequest& request, const QString& referencePath) {
+void DiagnosisPanel::setRequest(const DiagnosisSessionRequest& request, const QString& referencePath,
+                                const nlohmann::json& storedResult) {
   clearResult();
+  storedResult_ = storedResult.is_object() ? storedResult : nlohmann::json();
   request_ = request;
   storedOptions_ = request.options;
   storedCalibration_ = request.calibration;
@@ -414,7 +439,11 @@ void DiagnosisPanel::setRequest(const DiagnosisSessionRequest& request, const QS
   const int k = request.model.empty() ? reference_->findData(QString::fromStdString(request.structure))
                                       : reference_->findText(QString::fromStdString(request.model));
   if (k >= 0) reference_->setCurrentIndex(k);
-  verdict_->setText(tr("Restored from the session: press \"Diagnose\" to run it."));
+  if (storedResult_.contains("summary") && storedResult_["summary"].is_string())
+    verdict_->setText(tr("From the session: %1 Press \"Diagnose\" to draw its plots again.")
+                          .arg(QString::fromStdString(storedResult_["summary"].get<std::string>())));
+  else
+    verdict_->setText(tr("Restored from the session: press \"Diagnose\" to run it."));
 }
 
 }  // namespace flexarm

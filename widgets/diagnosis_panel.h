@@ -62,8 +62,12 @@ class DiagnosisPanel : public QWidget {
   // What the shown result was asked, as a session stores it (null before the first run).
   std::optional<DiagnosisSessionRequest> sessionRequest(const std::string& referenceLogName) const;
   // Takes over a session's request (reference, options, the calibration's summary) without
-  // running; "Diagnose" then runs it.
-  void setRequest(const DiagnosisSessionRequest& request, const QString& referencePath);
+  // running, with the summary of its stored result (diagnosisResultJson) when the session
+  // has one: its verdict is shown and saved again until "Diagnose" runs it anew.
+  void setRequest(const DiagnosisSessionRequest& request, const QString& referencePath,
+                  const nlohmann::json& storedResult = nullptr);
+  // The stored result taken over with the request; null once the panel ran or cleared.
+  const nlohmann::json& storedResult() const { return storedResult_; }
   void clearResult();
 
  public slots:
@@ -128,6 +132,8 @@ class DiagnosisPanel : public QWidget {
   std::vector<Shown> shown_;
   std::size_t shownSample_ = static_cast<std::size_t>(-1);
   QString shownVerdict_;
+  Provenance runData_;  // the data of the run in flight, recorded with its result
+  nlohmann::json storedResult_;
 };
 
 }  // namespace flexarm

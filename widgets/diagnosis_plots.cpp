@@ -7,6 +7,7 @@
 
 #include "widgets/diagnosis_panel.h"
 #include "widgets/plots/playhead_cursor.h"
+#include "widgets/plots/plot_tools.h"
 
 namespace flexarm {
 
@@ -89,6 +90,7 @@ void DiagnosisPanel::buildPlots() {
     rect->axis(QCPAxis::atLeft)->ticker()->setTickCount(2);
     level(estimates_, rect, 0.0, kColors[4]);
   }
+  keepRectsTall(estimates_, 110);
 
   // cap: the axis stops at cap times the level, so that the approach to it stays readable.
   auto simple = [&](QCustomPlot* p, const TestTrace* t, bool ratio, double line, double cap,
@@ -156,6 +158,7 @@ void DiagnosisPanel::buildPlots() {
                                  : QString::fromStdString(defaultThresholdsProvenance());
   thresholds_->setText(tr("Thresholds (sigma units, CUSUM alpha_2, level): %1. %2. Reference: %3.")
                            .arg(th.join("; "), from, QString::fromStdString(r.referenceSource)));
+  for (QCustomPlot* p : {cusum_, hypothesis_}) showLegendAbove(p);  // above the data, no curve under it
   for (QCustomPlot* p : {estimates_, cusum_, hypothesis_, timeline_}) p->replot();
 }
 

@@ -166,6 +166,9 @@ DiscoveryPanel::DiscoveryPanel(Workspace* workspace, QWidget* parent)
   connect(add_, &QPushButton::clicked, this, &DiscoveryPanel::addToModel);
   connect(&watcher_, &QFutureWatcher<Outcome>::finished, this, &DiscoveryPanel::onFinished);
   connect(workspace_, &Workspace::modelsChanged, this, &DiscoveryPanel::refillModels);
+  connect(workspace_, &Workspace::resultWithdrawn, this, [this](const QString& key) {
+    if (key == "discovery") clearResult();
+  });
   refillModels();
 }
 
@@ -209,6 +212,7 @@ std::unique_ptr<PhysicalModel> DiscoveryPanel::chosenBase(std::vector<Effect>* e
 void DiscoveryPanel::clearResult() {
   if (watcher_.isRunning()) cancel();
   ++run_;
+  workspace_->forgetResult("discovery");
   request_.reset();
   result_.reset();
   added_ = false;
@@ -262,6 +266,7 @@ void DiscoveryPanel::findMissingEffect() {
   }
   // Estimation and validation data from the workspace ranges (whole log if none is set).
   const IdData all = workspace_->currentWithRanges();
+  pendingData_ = workspace_->dataProvenance();
   auto est = std::make_shared<IdData>(all.estimationRange && !all.estimationRange->empty()
                                           ? all.select(*all.estimationRange)
                                           : all);
@@ -350,6 +355,12 @@ void DiscoveryPanel::onFinished() {
   }
   if (out.result->termination == Termination::Failed) {
     verdict_->setText(tr("Discovery failed: %1").arg(QString::fromStdString(out.result->message)));
+    emit finished();
+    return;
+  }
+  if (!workspace_->recordResult("discovery", pendingData_)) {  // the data changed meanwhile
+    clearResult();
+    verdict_->setText(tr("The data changed while discovery ran: press \"Find missing effect\" again."));
     emit finished();
     return;
   }

@@ -105,6 +105,7 @@ class DiscoveryPanel : public QWidget {
   std::shared_ptr<DiscoveryResult> result_;
   DiscoveryOptions options_;
   std::optional<DiscoveryRequest> request_, pendingRequest_;
+  Provenance pendingData_;  // the data of the run in flight, recorded with its result
   int run_ = 0;  // increases with every run started and every stored result shown
   QString baseName_;
   bool added_ = false;

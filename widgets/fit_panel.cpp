@@ -11,12 +11,12 @@
 #include <QHeaderView>
 #include <QLabel>
 #include <QListWidget>
-#include <QPlainTextEdit>
 #include <QProgressBar>
 #include <QPushButton>
 #include <QSpinBox>
 #include <QLineEdit>
 #include <QTableWidget>
+#include <QEvent>
 #include <QTimer>
 #include <QVBoxLayout>
 #include <QtConcurrent>
@@ -59,7 +59,7 @@ FitPanel::FitPanel(Workspace* workspace, QWidget* parent)
       noise_(new QComboBox(this)), closedLoop_(new QComboBox(this)), starts_(new QSpinBox(this)), iterations_(new QSpinBox(this)),
       estimate_(new QPushButton(tr("Estimate"), this)),
       cancel_(new QPushButton(tr("Cancel"), this)), progress_(new QProgressBar(this)),
-      table_(new QTableWidget(0, 6, this)), summary_(new QPlainTextEdit(this)),
+      table_(new QTableWidget(0, 6, this)), summary_(new QLabel(this)),
       studyRuns_(new QSpinBox(this)), study_button_(new QPushButton(tr("Run study"), this)),
       studyTable_(new QTableWidget(0, 3, this)), studySummary_(new QLabel(this)),
       poll_(new QTimer(this)), permille_(std::make_shared<std::atomic<int>>(0)),
@@ -72,14 +72,15 @@ FitPanel::FitPanel(Workspace* workspace, QWidget* parent)
   const char* orderNames[] = {"na", "nb", "nc", "nd", "nf", "nk"};
   QSpinBox* orders[] = {na_, nb_, nc_, nd_, nf_, nk_};
   const int defaults[] = {2, 4, 2, 2, 4, 1};
-  auto* orderRow = new QHBoxLayout;
+  auto* orderRow = new QGridLayout;  // two rows of three: the panel stays narrow
+  orderRow->setContentsMargins(0, 0, 0, 0);
   for (int i = 0; i < 6; ++i) {
     orders[i]->setRange(0, 60);
     orders[i]->setValue(defaults[i]);
     orders[i]->setObjectName(QString("%1Spin").arg(orderNames[i]));
     orders[i]->setToolTip(tr("Order %1 of (4.8)").arg(orderNames[i]));
-    orderRow->addWidget(new QLabel(orderNames[i], this));
-    orderRow->addWidget(orders[i]);
+    orderRow->addWidget(new QLabel(orderNames[i], this), i / 3, 2 * (i % 3));
+    orderRow->addWidget(orders[i], i / 3, 2 * (i % 3) + 1);
   }
   // The named effects a physical model can carry in the fit (extra_mass is a larger
   // structure, chosen as the model).
@@ -98,7 +99,7 @@ FitPanel::FitPanel(Workspace* workspace, QWidget* parent)
     box->setToolTip(tr("Fit the model with this effect (nonlinear grey-box estimation, the plant "
                        "simulated from the measured torque): ") + meaning.join("; "));
     const int n = static_cast<int>(effectChecks_.size());
-    effectGrid->addWidget(box, n / 3, n % 3);
+    effectGrid->addWidget(box, n / 2, n % 2);
     effectChecks_.emplace_back(k, box);
     connect(box, &QCheckBox::toggled, this, [this] { refillEffectParameters(); });
   }
@@ -156,23 +157,33 @@ FitPanel::FitPanel(Workspace* workspace, QWidget* parent)
   iterations_->setValue(100);
   iterations_->setToolTip(tr("Most Gauss-Newton iterations of the prediction-error criterion (4.6)"));
 
+  // Two columns, the model on the left and the data and estimator on the right: the panel
+  // holds its Estimate button and results on a laptop screen without scrolling.
+  for (QComboBox* c : {model_, noise_, closedLoop_}) {
+    c->setSizeAdjustPolicy(QComboBox::AdjustToMinimumContentsLengthWithIcon);
+    c->setMinimumContentsLength(14);
+  }
   auto* form = new QFormLayout;
   form->addRow(tr("Model"), model_);
   form->addRow(tr("Orders"), orderRow);
   form->addRow(tr("Effects"), effectsBox_);
   form->addRow(tr("Free parameters"), free_);
   form->addRow(tr("Starts, bounds"), startsBounds_);
-  form->addRow(tr("Ranges"), ranges_);
+  auto* data = new QFormLayout;
+  data->addRow(tr("Ranges"), ranges_);
   auto* moreRow = new QHBoxLayout;
   moreRow->setContentsMargins(0, 0, 0, 0);
   moreRow->addWidget(more_, 1);
   moreRow->addWidget(moreBrowse_);
-  form->addRow(tr("More experiments"), moreRow);
-  form->addRow(tr("Decimation"), decimation_);
-  form->addRow(tr("Noise model"), noise_);
-  form->addRow(tr("Closed loop"), closedLoop_);
-  form->addRow(tr("Extra starts"), starts_);
-  form->addRow(tr("Max iterations"), iterations_);
+  data->addRow(tr("More experiments"), moreRow);
+  data->addRow(tr("Decimation"), decimation_);
+  data->addRow(tr("Noise model"), noise_);
+  data->addRow(tr("Closed loop"), closedLoop_);
+  data->addRow(tr("Extra starts"), starts_);
+  data->addRow(tr("Max iterations"), iterations_);
+  auto* forms = new QHBoxLayout;
+  forms->addLayout(form, 1);
+  forms->addLayout(data, 1);
 
   estimate_->setObjectName("estimateButton");
   cancel_->setObjectName("fitCancelButton");
@@ -194,13 +205,14 @@ FitPanel::FitPanel(Workspace* workspace, QWidget* parent)
   table_->horizontalHeader()->setSectionResizeMode(QHeaderView::ResizeToContents);
   table_->verticalHeader()->setVisible(false);
   table_->setEditTriggers(QAbstractItemView::NoEditTriggers);
-  // Read-only and scrolling: the method, the controller and the warnings may run long.
+  // The whole summary at once, however long (the method, the controller, why a fit stopped
+  // at a bound or the iteration limit): it wraps and grows, and the panel scrolls.
   summary_->setObjectName("fitSummary");
-  summary_->setReadOnly(true);
-  summary_->setLineWrapMode(QPlainTextEdit::WidgetWidth);
-  summary_->setFrameShape(QFrame::NoFrame);
-  summary_->setMinimumHeight(7 * summary_->fontMetrics().lineSpacing());
-  summary_->setMaximumHeight(11 * summary_->fontMetrics().lineSpacing());
+  summary_->setWordWrap(true);
+  summary_->setTextFormat(Qt::PlainText);
+  summary_->setTextInteractionFlags(Qt::TextSelectableByMouse);
+  summary_->setAlignment(Qt::AlignLeft | Qt::AlignTop);
+  summary_->installEventFilter(this);  // its height follows its text (eventFilter)
 
   auto* studyBox = new QGroupBox(tr("Sensitivity study (Section 5.3.3)"), this);
   studyRuns_->setRange(1, 100000);
@@ -232,7 +244,7 @@ FitPanel::FitPanel(Workspace* workspace, QWidget* parent)
   studyLayout->addWidget(studySummary_);
 
   auto* layout = new QVBoxLayout(this);
-  layout->addLayout(form);
+  layout->addLayout(forms);
   layout->addLayout(buttons);
   layout->addWidget(table_, 3);
   layout->addWidget(summary_);
@@ -256,6 +268,9 @@ FitPanel::FitPanel(Workspace* workspace, QWidget* parent)
   });
   for (auto signal : {&Workspace::currentChanged, &Workspace::rangesChanged})
     connect(workspace_, signal, this, &FitPanel::showRanges);
+  connect(workspace_, &Workspace::resultWithdrawn, this, [this](const QString& key) {
+    if (key == "fit") withdraw();
+  });
   refillModels();
   showRanges();
 }
@@ -471,7 +486,7 @@ void FitPanel::startProgress() {
 
 void FitPanel::cancel() {
   abort_->store(true);
-  summary_->setPlainText(tr("Cancelling..."));
+  setSummary(tr("Cancelling..."));
 }
 
 // The pipeline's options from the panel's choices and the workspace's data and ranges;
@@ -509,7 +524,7 @@ std::optional<FitOptions> FitPanel::options(QString* name, std::vector<Experimen
     auto start = clonePhysical(*base);
     const QStringList names = freeParameters();
     if (names.isEmpty()) {
-      summary_->setPlainText(tr("Check at least one parameter to estimate."));
+      setSummary(tr("Check at least one parameter to estimate."));
       return std::nullopt;
     }
     for (const auto& p : base->parameters()) start->setFree(p.name, names.contains(QString::fromStdString(p.name)));
@@ -522,23 +537,23 @@ std::optional<FitOptions> FitPanel::options(QString* name, std::vector<Experimen
     o.randomStarts = starts_->value();
     std::string bad;
     if (!startsAndBoundsFromText(startsBounds_->text().toStdString(), o.startValues, o.bounds, &bad)) {
-      summary_->setPlainText(tr("Starts and bounds: %1.").arg(QString::fromStdString(bad)));
+      setSummary(tr("Starts and bounds: %1.").arg(QString::fromStdString(bad)));
       return std::nullopt;
     }
   }
   if (!workspace_->current()) {
-    summary_->setPlainText(tr("Open a log with an input and an output channel first."));
+    setSummary(tr("Open a log with an input and an output channel first."));
     return std::nullopt;
   }
   useWorkspaceData(*workspace_, o);
   std::string why;
   if (!o.isValid(&why)) {
-    summary_->setPlainText(tr("The fit cannot run: %1").arg(QString::fromStdString(why)));
+    setSummary(tr("The fit cannot run: %1").arg(QString::fromStdString(why)));
     return std::nullopt;
   }
   auto list = experimentListFromText(more_->text().toStdString(), &why);
   if (!list) {
-    summary_->setPlainText(tr("More experiments: %1.").arg(QString::fromStdString(why)));
+    setSummary(tr("More experiments: %1.").arg(QString::fromStdString(why)));
     return std::nullopt;
   }
   *more = *list;
@@ -563,7 +578,7 @@ bool FitPanel::recompute(const FitRequest& request) {
   useWorkspaceData(*workspace_, o);
   std::string why;
   if (!o.isValid(&why)) {
-    summary_->setPlainText(tr("%1 cannot be recomputed on the open data: %2")
+    setSummary(tr("%1 cannot be recomputed on the open data: %2")
                                .arg(QString::fromStdString(request.name), QString::fromStdString(why)));
     return false;
   }
@@ -599,7 +614,8 @@ void FitPanel::start(const FitOptions& o, const QString& name, const std::vector
   record->provenance->estimation = record->estimation;
   record->provenance->validation = record->validation;
   table_->setRowCount(0);
-  summary_->setPlainText(tr("Estimating %1...").arg(QString::fromStdString(o.model.name())));
+  workspace_->forgetResult("fit");
+  setSummary(tr("Estimating %1...").arg(QString::fromStdString(o.model.name())));
   startProgress();
   const auto progress = progressCallback();
   // The one fit pipeline (core/ident/fit.h), as `flexarm fit` and a session's replay run it.
@@ -632,30 +648,13 @@ void FitPanel::onFinished() {
   progress_->setValue(ok ? 1000 : 0);
   if (!ok) {
     const QString reason = !out.error.isEmpty() ? out.error : QString::fromStdString(r.message);
-    summary_->setPlainText(r.termination == Termination::Cancelled ? tr("Cancelled: %1").arg(reason)
+    setSummary(r.termination == Termination::Cancelled ? tr("Cancelled: %1").arg(reason)
                                                               : tr("The fit failed: %1").arg(reason));
     updateControls();
     emit estimated(false);
     return;
   }
-  table_->setRowCount(static_cast<int>(r.parameters.size()));
-  for (int i = 0; i < static_cast<int>(r.parameters.size()); ++i) {
-    const FitParameter& row = r.parameters[static_cast<std::size_t>(i)];
-    const QString label = row.effect.empty() ? QString::fromStdString(row.name)
-                                             : QString("%1 (%2)").arg(QString::fromStdString(row.name),
-                                                                      QString::fromStdString(row.effect));
-    const QStringList cells = {label,
-                               number(row.value),
-                               row.free ? number(row.std) : tr("fixed"),
-                               row.free ? number(row.lower) : QString(),
-                               row.free ? number(row.upper) : QString(),
-                               QString::fromStdString(row.unit)};
-    for (int c = 0; c < cells.size(); ++c) {
-      auto* item = new QTableWidgetItem(cells[c]);
-      if (!row.free) item->setForeground(QColor(130, 130, 130));
-      table_->setItem(i, c, item);
-    }
-  }
+  fillTable(r.parameters);
   ModelEntry entry;
   if (r.physical) {
     entry.model = r.physical;
@@ -739,13 +738,136 @@ void FitPanel::onFinished() {
   out.request->stored = storedFitOf(r);
   entry.fitRequest = out.request;
   lines << tr("Added to the model list as \"%1\".").arg(name);
-  summary_->setPlainText(lines.join("\n"));
+  setSummary(lines.join("\n"));
   lastIndex_ = workspace_->addModel(entry);
+  lastName_ = name;
+  // Shown only beside its data: the open data changed while it ran, it stays in the list.
+  if (!workspace_->recordResult("fit", *out.request->provenance)) withdraw();
   updateControls();
   emit estimated(true);
 }
 
-QString FitPanel::summaryText() const { return summary_->toPlainText(); }
+void FitPanel::fillTable(const std::vector<FitParameter>& parameters) {
+  table_->setRowCount(static_cast<int>(parameters.size()));
+  for (int i = 0; i < static_cast<int>(parameters.size()); ++i) {
+    const FitParameter& row = parameters[static_cast<std::size_t>(i)];
+    const QString label = row.effect.empty() ? QString::fromStdString(row.name)
+                                             : QString("%1 (%2)").arg(QString::fromStdString(row.name),
+                                                                      QString::fromStdString(row.effect));
+    const QStringList cells = {label,
+                               number(row.value),
+                               row.free ? number(row.std) : tr("fixed"),
+                               row.free ? number(row.lower) : QString(),
+                               row.free ? number(row.upper) : QString(),
+                               QString::fromStdString(row.unit)};
+    for (int c = 0; c < cells.size(); ++c) {
+      auto* item = new QTableWidgetItem(cells[c]);
+      if (!row.free) item->setForeground(QColor(130, 130, 130));
+      table_->setItem(i, c, item);
+    }
+  }
+}
+
+void FitPanel::setChoices(const FitRequest& request) {
+  const FitOptions& o = request.options;
+  iterations_->setValue(o.maxIterations);
+  decimation_->setValue(o.decimation);
+  more_->setText(QString::fromStdString(experimentListText(request.experiments)));
+  if (!request.physical()) {
+    setModelChoice(toString(o.model.structure));
+    setOrders(o.model.orders);
+    return;
+  }
+  // A physical fit shows its structure with the free parameters, effects and options it
+  // was fitted with; its own start values are in the list's tooltips and the starts field.
+  if (o.model.start) setModelChoice(QString::fromStdString(o.model.start->structureName()));
+  QStringList effects, free;
+  for (const FitEffect& f : o.model.effects) {
+    effects << QString::fromStdString(toString(f.effect.kind));
+    const auto& info = effectParameters(f.effect.kind);
+    for (std::size_t k = 0; k < info.size() && k < f.free.size(); ++k)
+      if (f.free[k])
+        free << QString("%1 (%2)").arg(QString::fromStdString(info[k].name), toString(f.effect.kind));
+  }
+  setEffects(effects);
+  if (o.model.start)
+    for (const auto& p : o.model.start->parameters())
+      if (p.free) free << QString::fromStdString(p.name);
+  setFreeParameters(free);
+  setNoiseModel(o.noiseModel);
+  setClosedLoopMethod(o.closedLoop);
+  setStarts(o.randomStarts);
+  startsBounds_->setText(QString::fromStdString(startsAndBoundsText(o.startValues, o.bounds)));
+}
+
+void FitPanel::showStored(const FitRequest& request, int modelIndex) {
+  if (isBusy()) return;
+  setChoices(request);
+  lastIndex_ = modelIndex;
+  lastName_ = QString::fromStdString(request.name);
+  last_ = {};
+  studyTable_->setRowCount(0);
+  studySummary_->clear();
+  progress_->setValue(0);
+  QStringList lines;
+  lines << tr("%1: restored from the session, computed on %2.")
+               .arg(lastName_, request.provenance ? QString::fromStdString(longDescription(*request.provenance))
+                                                  : tr("the session's log"));
+  if (const auto& s = request.stored) {
+    fillTable(s->parameters);
+    QString fits = s->fitEstimation ? tr("Fit %1 % (5.2) on the estimation data").arg(*s->fitEstimation, 0, 'f', 1)
+                                    : tr("No fit % (the simulated output diverges)");
+    if (s->fitValidation) fits += tr(", %1 % (5.2) on the validation data").arg(*s->fitValidation, 0, 'f', 1);
+    lines << tr("Loss %1. %2.").arg(number(s->loss), fits);
+    lines << tr("Notches: %1. Peaks: %2.").arg(joined(s->notches), joined(s->peaks));
+  } else {
+    table_->setRowCount(0);
+    lines << tr("The session keeps no numbers of this fit: Estimate computes them again.");
+  }
+  lines << tr("Estimate runs the fit again with these choices; the sensitivity study needs a new estimate.");
+  setSummary(lines.join("\n"));
+  if (!workspace_->recordResult("fit", request.provenance.value_or(workspace_->dataProvenance()))) withdraw();
+  updateControls();
+}
+
+void FitPanel::clearResult() {
+  lastName_.clear();
+  withdraw();
+}
+
+void FitPanel::withdraw() {
+  workspace_->forgetResult("fit");
+  table_->setRowCount(0);
+  last_ = {};
+  studyTable_->setRowCount(0);
+  studySummary_->clear();
+  progress_->setValue(0);
+  setSummary(lastName_.isEmpty()
+                             ? QString()
+                             : tr("The last estimate, \"%1\", was computed on other data than the open "
+                                  "ones: it stays in the model list under its name. Estimate again to fit "
+                                  "these data.").arg(lastName_));
+  updateControls();
+}
+
+void FitPanel::setSummary(const QString& text) {
+  summary_->setText(text);
+  fitSummaryHeight();
+}
+
+// A scroll area lays the panel out by its minimum height, which knows nothing of wrapped
+// text: the summary asks for the height its lines need at its width.
+void FitPanel::fitSummaryHeight() {
+  const int need = std::max(4 * summary_->fontMetrics().lineSpacing(), summary_->heightForWidth(summary_->width()));
+  if (summary_->minimumHeight() != need) summary_->setMinimumHeight(need);
+}
+
+bool FitPanel::eventFilter(QObject* watched, QEvent* event) {
+  if (watched == summary_ && event->type() == QEvent::Resize) fitSummaryHeight();
+  return QWidget::eventFilter(watched, event);
+}
+
+QString FitPanel::summaryText() const { return summary_->text(); }
 QString FitPanel::studyText() const { return studySummary_->text(); }
 
 void FitPanel::runStudy() {

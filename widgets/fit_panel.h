@@ -23,7 +23,6 @@ class QCheckBox;
 class QComboBox;
 class QLabel;
 class QListWidget;
-class QPlainTextEdit;
 class QProgressBar;
 class QPushButton;
 class QSpinBox;
@@ -69,9 +68,19 @@ class FitPanel : public QWidget {
   QString summaryText() const;
   // Index in the shared model list of the latest estimate (-1 before the first).
   int lastModelIndex() const { return lastIndex_; }
+  // Shows a stored fit as a session keeps it (the request's choices in the controls, its
+  // parameter table and numbers in the results) without estimating; modelIndex is its
+  // estimate in the model list. Its data become the panel's result record ("fit").
+  void showStored(const FitRequest& request, int modelIndex);
+  // Shows no result (a session without fits).
+  void clearResult();
   QTableWidget* studyTable() const { return studyTable_; }
   QString studyText() const;
   void setStudyRuns(int runs);
+
+ protected:
+  // Keeps the summary as tall as its wrapped text at the width it has.
+  bool eventFilter(QObject* watched, QEvent* event) override;
 
  public slots:
   void estimate();
@@ -114,6 +123,13 @@ class FitPanel : public QWidget {
   void updateControls();
   void onFinished();
   void onStudyFinished();
+  void fillTable(const std::vector<FitParameter>& parameters);
+  void setSummary(const QString& text);
+  void fitSummaryHeight();
+  // Sets the controls to what a request asked.
+  void setChoices(const FitRequest& request);
+  // The result shown was of other data than the open ones (Workspace::resultWithdrawn).
+  void withdraw();
   void showRanges();
   // Runs the fit pipeline on options in the background; name is the model's base name.
   // The more experiments are read there, off the GUI thread.
@@ -146,7 +162,7 @@ class FitPanel : public QWidget {
   QPushButton* cancel_;
   QProgressBar* progress_;
   QTableWidget* table_;
-  QPlainTextEdit* summary_;
+  QLabel* summary_;
   QSpinBox* studyRuns_;
   QPushButton* study_button_;
   QTableWidget* studyTable_;
@@ -158,6 +174,7 @@ class FitPanel : public QWidget {
   std::shared_ptr<std::atomic<bool>> abort_;
   StudyInput last_;  // the latest physical estimate (for the study)
   int lastIndex_ = -1;
+  QString lastName_;  // of the estimate shown
 };
 
 }  // namespace flexarm

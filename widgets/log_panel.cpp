@@ -53,12 +53,12 @@ LogPanel::LogPanel(Workspace* workspace, QWidget* parent)
     return b;
   };
   navigateButton_ = makeButton(tr("Zoom / pan"), tr("Wheel zooms time, drag pans"), "Z");
-  estimationButton_ =
-      makeButton(tr("Select estimation range"), tr("Drag in the plot to select"), "E");
-  validationButton_ =
-      makeButton(tr("Select validation range"), tr("Drag in the plot to select"), "V");
-  loopButton_ = makeButton(tr("Select loop"), tr("Drag in the plot to select what the playhead "
-                                                 "loops over"), "L");
+  // Short names, the whole sentence in the tooltip: the panel stays narrow enough for a laptop.
+  estimationButton_ = makeButton(tr("Estimation range"),
+                                 tr("Select the estimation range: drag in the plot"), "E");
+  validationButton_ = makeButton(tr("Validation range"),
+                                 tr("Select the validation range: drag in the plot"), "V");
+  loopButton_ = makeButton(tr("Loop"), tr("Select what the playhead loops over: drag in the plot"), "L");
   loopButton_->setObjectName("loopSelectButton");
   navigateButton_->setObjectName("navigateButton");
   estimationButton_->setObjectName("estimationButton");
@@ -83,6 +83,9 @@ LogPanel::LogPanel(Workspace* workspace, QWidget* parent)
   mono.setFamily("monospace");
   mono.setStyleHint(QFont::Monospace);
   readout_->setFont(mono);
+  // The readout's length follows the mouse: it never widens the panel (a range dragged in
+  // the plot would land elsewhere than aimed as the plot changed width under the mouse).
+  readout_->setSizePolicy(QSizePolicy::Ignored, QSizePolicy::Preferred);
 
   rangeTable_->setObjectName("rangeTable");
   rangeTable_->setHorizontalHeaderLabels({tr("Range"), tr("From [s]"), tr("To [s]"), tr("Samples")});

@@ -117,7 +117,7 @@ PreprocessPanel::PreprocessPanel(Workspace* workspace, QWidget* parent)
   form->addRow(tr("Spectrum of"), channel_);
 
   plot_->setObjectName("spectrumPlot");
-  plot_->setMinimumSize(280, 200);
+  plot_->setMinimumSize(280, 240);  // tall enough for its amplitude axis' label
   for (QCPAxis* a : {plot_->xAxis, plot_->yAxis}) {
     a->setScaleType(QCPAxis::stLogarithmic);
     a->setTicker(QSharedPointer<QCPAxisTickerLog>(new QCPAxisTickerLog));
@@ -166,9 +166,10 @@ PreprocessPanel::PreprocessPanel(Workspace* workspace, QWidget* parent)
   auto* inner = new QVBoxLayout(content);
   inner->setContentsMargins(0, 0, 0, 0);
   inner->addWidget(resample_);
-  auto* timingLabel = new QLabel(tr("Time stamps (click a row to show it in the Log panel):"), content);
-  timingLabel->setObjectName("timingLabel");
-  inner->addWidget(timingLabel);
+  timingLabel_ = new QLabel(content);
+  timingLabel_->setObjectName("timingLabel");
+  timingLabel_->setWordWrap(true);
+  inner->addWidget(timingLabel_);
   inner->addWidget(timing_);
   inner->addLayout(form);
   inner->addWidget(plot_, 1);
@@ -211,9 +212,18 @@ PreprocessPanel::PreprocessPanel(Workspace* workspace, QWidget* parent)
   onLogChanged();
 }
 
+void PreprocessPanel::showTiming(const std::vector<TimingReport>& reports) {
+  timing_->setReports(reports);
+  // A log with regular stamps says so in a line; the table's room goes to the spectra.
+  const bool events = timing_->rowCount() > 0;
+  timing_->setVisible(events);
+  timingLabel_->setText(events ? tr("Time stamps (click a row to show it in the Log panel):")
+                               : tr("Time stamps: regular (no jitter, gap, duplicate or reversal)."));
+}
+
 void PreprocessPanel::onLogChanged() {
   result_.reset();
-  timing_->setReports({});
+  showTiming({});
   const IdData* raw = workspace_->raw();
   // A log with irregular time stamps cannot be used without resampling: the step is on.
   const bool irregular = raw && !raw->isUniform();
@@ -352,7 +362,7 @@ void PreprocessPanel::onFinished() {
   if (running_ != generation_) return;  // cancelled or superseded
   busy_->setVisible(false);
   cancel_->setVisible(false);
-  timing_->setReports(out.timing);
+  showTiming(out.timing);
   if (!out.error.isEmpty() || !out.data) {
     result_.reset();
     summary_->setText(tr("Preprocessing failed: %1").arg(out.error));

@@ -64,6 +64,8 @@ class PreprocessPanel : public QWidget {
   void onFinished();
   void refillChannels();
   void onLogChanged();
+  // Fills the time-stamp report; with nothing to list, a line says the stamps are regular.
+  void showTiming(const std::vector<TimingReport>& reports);
 
   Workspace* workspace_;
   QGroupBox* resample_;
@@ -71,6 +73,7 @@ class PreprocessPanel : public QWidget {
   QComboBox* method_;
   QDoubleSpinBox* maxGap_;
   TimingTable* timing_;
+  QLabel* timingLabel_ = nullptr;
   QCheckBox* differentiate_;
   QSpinBox* factor_;
   QComboBox* filter_;

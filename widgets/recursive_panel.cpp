@@ -203,6 +203,9 @@ RecursivePanel::RecursivePanel(Workspace* workspace, QWidget* parent)
   algorithmChanged();
   connect(workspace_, &Workspace::modelsChanged, this, &RecursivePanel::refillModels);
   connect(workspace_, &Workspace::logChanged, this, &RecursivePanel::clearRuns);
+  connect(workspace_, &Workspace::resultWithdrawn, this, [this](const QString& key) {
+    if (key == "recursive") clearRuns();
+  });
   connect(plot_, &QCustomPlot::afterReplot, this, &RecursivePanel::frameDrawn);
   refillModels();
   buildPlot();
@@ -325,6 +328,7 @@ std::vector<const RecursivePanel::Run*> RecursivePanel::runs() const {
 
 void RecursivePanel::clearRuns() {
   runner_.stop();
+  workspace_->forgetResult("recursive");
   current_.reset();
   previous_.reset();
   shown_ = 0;
@@ -335,6 +339,10 @@ void RecursivePanel::clearRuns() {
   status_->setToolTip({});
   status_->setText(workspace_->hasLog() ? tr("Pick the model and the parameters, and press Play.")
                                         : tr("Open a log, pick the model and the parameters, and press Play."));
+}
+
+void RecursivePanel::showStored(const QString& summary) {
+  if (!current_) status_->setText(summary);
 }
 
 QString RecursivePanel::statusText() const { return status_->text(); }
@@ -407,6 +415,8 @@ void RecursivePanel::startRun() {
   showProgress();
   status_->setToolTip({});
   status_->setText(tr("Preparing the log and choosing P(0)..."));
+  // The runs are results of the log as read from their start (Workspace::recordResult).
+  workspace_->recordResult("recursive", workspace_->dataProvenance(), true);
   auto log = std::make_shared<const IdData>(*workspace_->raw());
   runner_.start(current_->id, log, model, q.data, q.options, [this](RecursiveRunner::Chunk c) {
     QMetaObject::invokeMethod(this, [this, c = std::move(c)]() mutable { onChunk(std::move(c)); },
@@ -616,8 +626,11 @@ void RecursivePanel::buildPlot() {
   epsilonRect_->axis(QCPAxis::atLeft)->setRange(-1.0, 1.0);
   plot_->setInteractions(QCP::iRangeDrag | QCP::iRangeZoom);
   PlotTools::install(plot_);
+  keepRectsTall(plot_, 80);  // the parameters, P and the prediction error stacked
+  plot_->setMinimumHeight(std::max(340, plot_->minimumHeight()));
   drawOverlay();
   buildLegend();
+  if (graphs_.empty()) plot_->plotLayout()->simplify();  // no legend: no empty row above
   cursor_->attach();
   shown_ = 0;
   plot_->replot();

@@ -49,6 +49,9 @@ class RecursivePanel : public QWidget {
   RecursiveRequest request() const;
   // Sets the controls from a request (a session's); runs nothing.
   void setRequest(const RecursiveRequest& request);
+  // Says what a session stored of the last run (its end and final estimates) under the
+  // controls, until a run of the panel's own replaces it.
+  void showStored(const QString& summary);
 
   // One run: what was asked and what it computed so far (every row, also past the playhead).
   struct Run {

@@ -1,6 +1,7 @@
 #include "widgets/workspace.h"
 
 #include <QFileInfo>
+#include <QStringList>
 
 #include <QUndoCommand>
 #include <QUndoStack>
@@ -122,6 +123,7 @@ void Workspace::setLog(IdData data, const QString& path, const LogReadOptions& r
   sha256_.clear();
   read_ = read;
   undo_->clear();
+  withdrawResults(true);  // a log opened is a new analysis, even of the same file
   emit logChanged();
   emit currentChanged();
   emit rangesChanged();
@@ -139,6 +141,44 @@ Provenance Workspace::dataProvenance() const {
   return p;
 }
 
+bool Workspace::recordResult(const QString& key, const Provenance& data, bool raw) {
+  forgetResult(key);
+  ResultRecord r{key, data, raw};
+  if (raw) r.data.preprocessing.clear();
+  Provenance open = dataProvenance();
+  if (raw) open.preprocessing.clear();
+  if (!raw_ || !sameData(r.data, open)) return false;
+  results_.push_back(std::move(r));
+  return true;
+}
+
+void Workspace::forgetResult(const QString& key) {
+  results_.erase(std::remove_if(results_.begin(), results_.end(),
+                                [&](const ResultRecord& r) { return r.key == key; }),
+                 results_.end());
+}
+
+std::optional<Provenance> Workspace::resultData(const QString& key) const {
+  for (const auto& r : results_)
+    if (r.key == key) return r.data;
+  return std::nullopt;
+}
+
+void Workspace::withdrawResults(bool all) {
+  const std::vector<std::string> now = processed_ ? describePreprocessing(options_) : std::vector<std::string>{};
+  QStringList withdrawn;
+  for (auto it = results_.begin(); it != results_.end();) {
+    // A result of the log as read keeps its data whatever the preprocessing.
+    if (all || (!it->raw && it->data.preprocessing != now)) {
+      withdrawn << it->key;
+      it = results_.erase(it);
+    } else {
+      ++it;
+    }
+  }
+  for (const QString& key : withdrawn) emit resultWithdrawn(key);
+}
+
 void Workspace::setPreprocessed(IdData data, const PreprocessOptions& options) {
   undo_->push(new PreprocessCommand(this, processed_, options_,
                                     std::make_shared<IdData>(std::move(data)), options));
@@ -152,6 +192,7 @@ void Workspace::clearPreprocessed() {
 void Workspace::setPreprocessedDirect(std::shared_ptr<IdData> data, const PreprocessOptions& options) {
   processed_ = std::move(data);
   options_ = processed_ ? options : PreprocessOptions{};
+  withdrawResults(false);
   emit currentChanged();
   emit rangesChanged();  // sample counts change with the rate
 }

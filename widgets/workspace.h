@@ -64,6 +64,23 @@ class Workspace : public QObject {
   // preprocessing steps, the ranges, the time (core/session/provenance.h).
   Provenance dataProvenance() const;
 
+  // Results and the data they were computed on: the one record that keeps a result beside
+  // its data. A panel records its result under a key ("fit", "diagnosis", "discovery",
+  // "recursive") when it shows it, with the provenance it took when the work started (raw:
+  // computed on the log as read, so preprocessing does not change its data). When the data
+  // change under a record - another log opened, other preprocessing applied or undone - the
+  // workspace drops it and emits resultWithdrawn(key) before the data signals: whatever shows
+  // that result (its panel, the Arm view's highlight) clears it, and a session or report
+  // captured afterwards holds nothing of it.
+  // False, recording nothing, when data are not the open data (they changed while the work
+  // ran): the result must not be shown.
+  bool recordResult(const QString& key, const Provenance& data, bool raw = false);
+  // The panel cleared its result itself (a new run started, the user cleared it): no signal.
+  void forgetResult(const QString& key);
+  // The data of the result recorded under key; nullopt when none is shown.
+  std::optional<Provenance> resultData(const QString& key) const;
+  bool hasResult(const QString& key) const { return resultData(key).has_value(); }
+
   // The preprocessed data if preprocessing was applied, otherwise the raw log; null when
   // there is no log or its time stamps are irregular (it must be resampled first).
   const IdData* current() const {
@@ -113,6 +130,8 @@ class Workspace : public QObject {
   void currentChanged();  // the log or its preprocessing changed
   void rangesChanged();
   void modelsChanged(int index);  // index of the changed model, -1 when the list changed
+  // The result recorded under key is no longer of the open data (see recordResult).
+  void resultWithdrawn(const QString& key);
 
  private:
   std::shared_ptr<IdData> raw_, processed_;
@@ -123,6 +142,14 @@ class Workspace : public QObject {
   std::optional<TimeRange> estimation_, validation_;
   std::vector<ModelEntry> models_;
   QUndoStack* undo_;
+  struct ResultRecord {
+    QString key;
+    Provenance data;
+    bool raw = false;
+  };
+  std::vector<ResultRecord> results_;
+  // Drops the records whose data the open data no longer are (all of them: a new log).
+  void withdrawResults(bool all);
 };
 
 const char* toString(RangeKind kind);

@@ -22,12 +22,30 @@ bool needsRefinement(std::complex<double> a, std::complex<double> b, std::comple
   return std::abs(b - a) > o.maxChordRatio * nearest;
 }
 
+// True when the curve's direction turns by more than o.maxBendStep at v (from before to after), both
+// chords visible at the scale of the distance to p.
+bool bendsSharply(std::complex<double> before, std::complex<double> v, std::complex<double> after,
+                  std::complex<double> p, const NyquistOptions& o) {
+  const std::complex<double> d1 = v - before, d2 = after - v;
+  const double a = std::abs(d1), b = std::abs(d2);
+  if (!std::isfinite(a) || !std::isfinite(b) || a == 0.0 || b == 0.0) return false;
+  if (std::max(a, b) <= o.bendMinChord * std::abs(v - p)) return false;
+  return std::abs(std::arg(d2 / d1)) > o.maxBendStep;
+}
+
 // Refines the parameter grid x (with values v = g(x)) by inserting midpoints where the curve
-// turns or jumps too much around p; returns false when the point limit stopped it.
+// turns or jumps too much around p, and (geometric: the frequency axis) where it bends;
+// returns false when the point limit stopped it.
 template <class Eval>
 bool refine(std::vector<double>& x, std::vector<std::complex<double>>& v, const Eval& g,
             std::complex<double> p, const NyquistOptions& o, bool geometric) {
   for (;;) {
+    // Intervals to halve: those that turn or jump around p, and both sides of a sharp bend.
+    std::vector<char> split(x.size(), 0);
+    for (std::size_t i = 0; i + 1 < x.size(); ++i) {
+      if (needsRefinement(v[i], v[i + 1], p, o)) split[i] = 1;
+      if (geometric && i > 0 && bendsSharply(v[i - 1], v[i], v[i + 1], p, o)) split[i - 1] = split[i] = 1;
+    }
     std::vector<double> nx;
     std::vector<std::complex<double>> nv;
     nx.reserve(2 * x.size());
@@ -36,7 +54,7 @@ bool refine(std::vector<double>& x, std::vector<std::complex<double>>& v, const 
     for (std::size_t i = 0; i < x.size(); ++i) {
       nx.push_back(x[i]);
       nv.push_back(v[i]);
-      if (i + 1 == x.size() || !needsRefinement(v[i], v[i + 1], p, o)) continue;
+      if (i + 1 == x.size() || !split[i]) continue;
       if (static_cast<int>(x.size() + (nx.size() - i)) >= o.maxPoints) return false;
       const double mid = geometric ? std::sqrt(x[i] * x[i + 1]) : 0.5 * (x[i] + x[i + 1]);
       if (!(mid > x[i] && mid < x[i + 1])) continue;
@@ -67,6 +85,8 @@ bool NyquistOptions::isValid(std::string* why) const {
   if (maxPoints < initialPoints) return fail("maxPoints must be at least initialPoints");
   if (!(maxAngleStep > 0.0 && maxAngleStep < 1.0)) return fail("maxAngleStep must be in (0, 1)");
   if (!(maxChordRatio > 0.0)) return fail("maxChordRatio must be positive");
+  if (!(maxBendStep > 0.0 && maxBendStep < 1.0)) return fail("maxBendStep must be in (0, 1)");
+  if (!(bendMinChord > 0.0) || !std::isfinite(bendMinChord)) return fail("bendMinChord must be positive");
   if (!(minFrequency >= 0.0) || !(maxFrequency >= 0.0))
     return fail("frequency limits must not be negative");
   if (minFrequency > 0.0 && maxFrequency > 0.0 && !(maxFrequency > minFrequency))

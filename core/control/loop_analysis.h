@@ -17,6 +17,11 @@ struct NyquistOptions {
   int maxPoints = 6000;         // refinement stops here (gridLimitReached)
   double maxAngleStep = 0.2;    // rad: largest turn of f - point between neighbours
   double maxChordRatio = 0.25;  // largest |f_i+1 - f_i| / min(|f_i - point|, |f_i+1 - point|)
+  // rad: largest turn of the curve's direction from one chord to the next, for chords longer
+  // than bendMinChord |f_i - point|: the curve is sampled densely where it bends, so that it
+  // is drawn smooth (a turn of 0.1 rad is a polygon the eye does not see).
+  double maxBendStep = 0.1;
+  double bendMinChord = 0.005;
   // Frequency range in rad/s; 0 picks it from the characteristic frequencies.
   double minFrequency = 0.0, maxFrequency = 0.0;
   bool isValid(std::string* why = nullptr) const;

@@ -48,7 +48,6 @@ std::vector<ReportPlot> bodeWithBand(const FrequencyResponse& r, const std::stri
     ph.series.push_back({"upper " + band, r.omega, hi, true, 1});
     ph.series.push_back({"lower " + band, r.omega, lo, true, 1});
   }
-  mag.legendBottomLeft = ph.legendBottomLeft = true;
   return {mag, ph};
 }
 

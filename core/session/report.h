@@ -29,7 +29,6 @@ struct ReportPlot {
   std::string title, xLabel, yLabel;
   bool logX = false, logY = false;
   std::vector<ReportSeries> series;
-  bool legendBottomLeft = false;  // where the curves leave room (Bode plots); else top right
   // Series are curves in the plane (x need not increase), e.g. a Nyquist curve.
   bool parametric = false;
   // Axis ranges to show; unset: every point.

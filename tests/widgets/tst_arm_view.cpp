@@ -13,6 +13,7 @@
 #include <QtTest>
 
 #include "app/main_window.h"
+#include "core/io/log_io.h"
 #include "core/sim/body_angles.h"
 #include "widget_test_support.h"
 #include "widgets/arm/arm_scene.h"
@@ -83,6 +84,17 @@ class ArmViewTest : public QObject {
   QImage picture() {
     QApplication::processEvents();
     return arm_->view()->grabFramebuffer();
+  }
+  // The share of the view's pixels where the arm flexing by exaggeration E differs from the
+  // rigid one (the same view with the deflections drawn at 0) at time t.
+  double flexibleAgainstRigid(double t, int E) {
+    arm_->setExaggeration(E);
+    at(t);
+    const QImage flexible = picture();
+    arm_->setExaggeration(0);
+    const QImage rigid = picture();
+    arm_->setExaggeration(E);
+    return static_cast<double>(test::differingPixels(flexible, rigid)) / (flexible.width() * flexible.height());
   }
 
  private slots:
@@ -170,17 +182,7 @@ class ArmViewTest : public QObject {
     arm_->setTraceVisible(false);
     arm_->setGhostVisible(false);
     const int E = arm_->exaggeration();
-    // The flexible arm against the rigid one (the same view with the deflections drawn at 0).
-    auto flexAgainstRigid = [&](double t) {
-      arm_->setExaggeration(E);
-      at(t);
-      const QImage flexible = picture();
-      arm_->setExaggeration(0);
-      const QImage rigid = picture();
-      arm_->setExaggeration(E);
-      return static_cast<double>(test::differingPixels(flexible, rigid)) /
-             (flexible.width() * flexible.height());
-    };
+    auto flexAgainstRigid = [&](double t) { return flexibleAgainstRigid(t, E); };
     // The peak of the resonant swing at the end of the excitation.
     double peakT = 1.9, peak = 0.0;
     for (double t = 1.9; t < 1.92; t += kTs) {
@@ -199,6 +201,31 @@ class ArmViewTest : public QObject {
     test::saveShot(picture(), "arm_resonance_with_ghost");
     arm_->setAnnotationsVisible(true);
     arm_->setTraceVisible(true);
+  }
+
+  // Issue 31, problem 8: on the sample chirp log the exaggeration chosen for the data shows
+  // the flexing of most of the log, not only of its largest moment: at a moment of median
+  // deflection the arm is drawn at least 0.2 rad (11 degrees) behind the rigid ghost, and at
+  // the largest deflection never turned around (less than 3 rad).
+  void flexingShowsAtTheDefaultExaggeration() {
+    const auto read = readLog(QString(FLEXARM_SAMPLE_DIR "/three_mass_estimation_chirp.csv").toStdString());
+    QVERIFY(read.ok);
+    load(read.data, "three-mass");
+    const BodyAngles& a = *arm_->bodyAngles();
+    std::vector<std::pair<double, std::size_t>> lag;  // the tip's lag behind the rigid arm
+    for (std::size_t k = 0; k < a.samples(); ++k)
+      lag.push_back({std::abs(a.gearDeflection[k]) + std::abs(a.armDeflection[k]), k});
+    std::sort(lag.begin(), lag.end());
+    auto drawnLagAt = [&](std::size_t k) {
+      at(a.startTime + a.sampleTime * static_cast<double>(k));
+      return std::abs(arm_->scene()->drawnAngle(ArmPart::Arm) - arm_->scene()->ghostAngle());
+    };
+    const double median = drawnLagAt(lag[lag.size() / 2].second);
+    const double largest = drawnLagAt(lag.back().second);
+    QVERIFY2(median >= 0.2, qPrintable(QString("x%1: %2 rad").arg(arm_->exaggeration()).arg(median)));
+    QVERIFY2(largest < 3.0, qPrintable(QString("x%1: %2 rad").arg(arm_->exaggeration()).arg(largest)));
+    at(a.startTime + a.sampleTime * static_cast<double>(lag[lag.size() / 2].second));
+    test::saveShot(picture(), "arm_sample_log_median_deflection");
   }
 
   void rendersOnlyWhenSomethingChanged() {

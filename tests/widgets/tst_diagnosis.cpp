@@ -10,16 +10,19 @@
 #include <QPushButton>
 #include <QSignalSpy>
 #include <QTableWidget>
+#include <QTemporaryDir>
 #include <QtTest>
 #include <qcustomplot.h>
 
 #include "app/main_window.h"
+#include "app/panel_docks.h"
 #include "app/session_controller.h"
 #include "core/session/session.h"
 #include "widget_test_support.h"
 #include "widgets/arm_panel.h"
 #include "widgets/diagnosis_panel.h"
 #include "widgets/playhead.h"
+#include "widgets/workspace.h"
 
 using namespace flexarm;
 
@@ -57,6 +60,7 @@ class DiagnosisPanelTest : public QObject {
   void initTestCase() {
     window_ = new MainWindow;
     window_->resize(1366, 768);
+    window_->docks()->arrange(PanelDocks::Layout::Compact);  // as on a 1366x768 laptop
     window_->show();
     QVERIFY(QTest::qWaitForWindowExposed(window_));
     auto* dock = window_->findChild<QDockWidget*>("diagnosisDock");
@@ -101,6 +105,15 @@ class DiagnosisPanelTest : public QObject {
     QTest::qWait(200);
     test::saveShot(window_->grab().toImage(), "diagnosis_window_at_alarm");
     test::saveShot(panel()->grab().toImage(), "diagnosis_panel_at_alarm");
+    // Issue 31, problem 4: each parameter's estimate gets a plot tall enough for its labels,
+    // and no legend lies over the data.
+    const auto rects = panel()->estimatesPlot()->axisRects();
+    QCOMPARE(rects.size(), 3);
+    for (QCPAxisRect* rect : rects) QVERIFY2(rect->height() >= 60, qPrintable(QString::number(rect->height())));
+    for (QCustomPlot* p : {panel()->cusumPlot(), panel()->hypothesisPlot()}) {
+      QVERIFY(p->legend->visible() && !qobject_cast<QCPLayoutInset*>(p->legend->layout()));
+      QVERIFY(!p->legend->outerRect().intersects(p->axisRect()->rect()));
+    }
   }
 
   void sessionKeepsTheRequest() {
@@ -112,6 +125,69 @@ class DiagnosisPanelTest : public QObject {
     bool named = false;
     for (const auto& l : s.logs) named = named || (l.name == "diagnosis_reference" && l.path.find("diagnosis_no_fault") != std::string::npos);
     QVERIFY(named);
+  }
+
+  // Issue 31: a reopened session shows the stored verdict (without diagnosing again) and
+  // saves it again; nothing of it is lost.
+  void reopenedSessionShowsTheStoredVerdict() {
+    QTemporaryDir dir;
+    const QString path = dir.filePath("diagnosed.json");
+    QString why;
+    QVERIFY2(window_->sessionController()->save(path, &why), qPrintable(why));
+    MainWindow other;
+    other.sessionController()->setOfferRecovery(false);
+    QSignalSpy opened(other.sessionController(), &SessionController::sessionOpened);
+    other.sessionController()->open(path);
+    QVERIFY(opened.wait(30000));
+    QVERIFY(!other.diagnosisPanel()->isBusy());
+    QVERIFY2(other.diagnosisPanel()->verdictText().contains("k_T"), qPrintable(other.diagnosisPanel()->verdictText()));
+    const Session again = other.sessionController()->capture(path);
+    QVERIFY(again.parts.contains("diagnosis"));
+    QCOMPARE(again.parts["diagnosis"]["result"]["verdict"].get<std::string>(), std::string("k_T"));
+    QVERIFY(again.parts["diagnosis"].contains("provenance"));
+    // A stored diagnosis of another log is not shown beside this one.
+    Session edited = loadSession(path.toStdString()).session;
+    edited.parts["diagnosis"]["provenance"]["sha256"] = std::string(64, '0');
+    const QString otherPath = dir.filePath("other_log.json");
+    std::string message;
+    QVERIFY2(saveSession(edited, otherPath.toStdString(), &message), message.c_str());
+    MainWindow third;
+    third.sessionController()->setOfferRecovery(false);
+    QSignalSpy reopened(third.sessionController(), &SessionController::sessionOpened);
+    third.sessionController()->open(otherPath);
+    QVERIFY(reopened.wait(30000));
+    QVERIFY2(!third.diagnosisPanel()->verdictText().contains("k_T"), qPrintable(third.diagnosisPanel()->verdictText()));
+    QVERIFY(!third.sessionController()->capture(otherPath).parts.contains("diagnosis"));
+  }
+
+  // Issue 31, problem 1: another log opened (Discard) shows no fault of the diagnosed one, and
+  // neither the session nor the report of the new log has a diagnosis.
+  void anotherLogDropsTheDiagnosis() {
+    window_->playhead()->setTime(panel()->lastRun()->result.decision.verdictTime.value_or(0.0) + 0.01);
+    QTest::qWait(50);
+    QVERIFY(window_->armPanel()->fault().has_value());
+    SessionController* session = window_->sessionController();
+    window_->workspace()->setRange(RangeKind::Validation, {1.0, 2.0});  // unsaved work to discard
+    QVERIFY(session->isDirty());
+    session->setReplaceDecision([](const QString&) { return ReplaceDecision::Discard; });
+    QSignalSpy opened(window_, &MainWindow::logOpened);
+    window_->requestOpenFile(kHealthy);
+    QVERIFY(opened.wait(30000));
+    session->setReplaceDecision({});
+    QVERIFY(!window_->armPanel()->fault());
+    QVERIFY2(!window_->armPanel()->captionText().contains("Fault"), qPrintable(window_->armPanel()->captionText()));
+    QVERIFY(!panel()->lastRun());
+    QVERIFY(!session->capture(QString()).parts.contains("diagnosis"));
+    QTemporaryDir dir;
+    const QString path = dir.filePath("report.html");
+    QSignalSpy exported(session, &SessionController::reportExported);
+    session->exportReport(path);
+    QVERIFY(exported.wait(120000));
+    QFile f(path);
+    QVERIFY(f.open(QIODevice::ReadOnly));
+    const QString html = QString::fromUtf8(f.readAll());
+    QVERIFY(html.contains("diagnosis_step_none.csv"));
+    QVERIFY2(!html.contains(">Diagnosis<") && !html.contains("isolated"), "the report diagnoses the new log");
   }
 
   void healthyLogStaysGreen() {

@@ -8,6 +8,7 @@
 #include <cmath>
 #include <QComboBox>
 #include <QDockWidget>
+#include <QLabel>
 #include <QLineEdit>
 #include <QListWidget>
 #include <QPushButton>
@@ -244,6 +245,12 @@ class IdentificationTest : public QObject {
     QVERIFY2(std::abs(t->item(0, 1)->text().toDouble() - 3e-4) < 1e-9, qPrintable(t->item(0, 1)->text()));
     QVERIFY2(fit->summaryText().contains("Note: J_m sits on its upper bound 0.0003; the data would push it above"),
              qPrintable(fit->summaryText()));
+    // Issue 31, problem 4: why the fit stopped is shown whole, not in a box to scroll.
+    QApplication::processEvents();
+    auto* summary = fit->findChild<QLabel*>("fitSummary");
+    QVERIFY(summary && summary->wordWrap());
+    QVERIFY2(summary->height() >= summary->heightForWidth(summary->width()),
+             qPrintable(QString("%1 px of %2").arg(summary->height()).arg(summary->heightForWidth(summary->width()))));
     test::saveShot(fit->grab().toImage(), "fit_panel_bounds");
     edit->setText("J_m=abc");
     QSignalSpy refused(fit, &FitPanel::estimated);

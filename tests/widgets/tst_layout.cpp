@@ -33,6 +33,7 @@
 #include <qcustomplot.h>
 
 #include "app/main_window.h"
+#include "app/panel_docks.h"
 #include "app/report_writer.h"
 #include "core/session/report.h"
 #include "widget_test_support.h"
@@ -167,8 +168,10 @@ class LayoutTest : public QObject {
 
   QDockWidget* dock(const char* name) const { return window_->findChild<QDockWidget*>(name); }
 
+  // The window at a screen's size (less a task bar) with the docks arranged for that screen.
   void showAt(QSize size) {
     window_->resize(size);
+    window_->docks()->arrange(PanelDocks::layoutFor(size + QSize(0, 40)));
     QTest::qWait(50);
     QApplication::processEvents();
   }
@@ -505,12 +508,6 @@ class LayoutTest : public QObject {
   }
 };
 
-int main(int argc, char** argv) {
-  VtkView::installDefaultSurfaceFormat();
-  QApplication app(argc, argv);
-  QApplication::setOrganizationName("FlexArmLayoutTests");
-  LayoutTest t;
-  return QTest::qExec(&t, argc, argv);
-}
+int main(int argc, char** argv) { return test::runWidgetTest<LayoutTest>(argc, argv, "FlexArmLayoutTests"); }
 
 #include "tst_layout.moc"

@@ -190,6 +190,9 @@ class RecursivePanelTest : public QObject {
     for (const auto& p : windowSessionParts())
       if (std::string(p.key) == "recursive") p.restore(section, *window_);
     QCOMPARE(panel_->lambdaBox()->value(), 0.98);
+    // What the session stored of the last run is said under the controls (issue 31).
+    QVERIFY2(panel_->statusText().startsWith("From the session") && panel_->statusText().contains("J_a = "),
+             qPrintable(panel_->statusText()));
     QCOMPARE(capture("recursive", *window_).dump(), section.dump());  // kept as read
   }
 

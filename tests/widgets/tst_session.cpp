@@ -15,6 +15,8 @@
 #include <QSignalSpy>
 #include <QTemporaryDir>
 #include <QUndoStack>
+#include <QRegularExpression>
+#include <QSpinBox>
 #include <QtTest>
 
 #include "app/main_window.h"
@@ -204,6 +206,24 @@ class SessionTest : public QObject {
     QVERIFY(models.back().polynomial->parameterVector() == blackBox.polynomial->parameterVector());
     QCOMPARE(QString::fromStdString(stateOf(*other, path).dump(1)),
              QString::fromStdString(stateOf(*window_, path).dump(1)));
+    // Issue 31, problem 2: the Fit panel comes back as it was left, the last fit's choices,
+    // its parameter table and fit % shown, nothing estimated.
+    FitPanel* restored = other->fitPanel();
+    QVERIFY(!restored->isBusy());
+    QCOMPARE(restored->modelChoice(), QString("oe"));
+    QCOMPARE(restored->findChild<QSpinBox*>("nfSpin")->value(), 4);
+    QCOMPARE(restored->findChild<QSpinBox*>("fitDecimationSpin")->value(), 2);
+    QTableWidget* before = fit->resultsTable();
+    QTableWidget* after = restored->resultsTable();
+    QVERIFY(before->rowCount() > 0);
+    QCOMPARE(after->rowCount(), before->rowCount());
+    for (int row = 0; row < before->rowCount(); ++row)
+      for (int col : {0, 1, 2})
+        QCOMPARE(after->item(row, col)->text(), before->item(row, col)->text());
+    const auto shownFit = QRegularExpression("Fit ([0-9.]+) % \\(5\\.2\\)").match(blackBoxSummary);
+    QVERIFY(shownFit.hasMatch());
+    QVERIFY2(restored->summaryText().contains(shownFit.captured(0)), qPrintable(restored->summaryText()));
+    QVERIFY2(restored->summaryText().contains(blackBox.name), qPrintable(restored->summaryText()));
 
     const ReplayResult r = replaySession(loaded.session, path.toStdString());
     QVERIFY2(r.termination == Termination::Converged, r.message.c_str());

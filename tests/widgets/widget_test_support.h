@@ -6,11 +6,24 @@
 #include <QMessageBox>
 #include <QMouseEvent>
 #include <QString>
+#include <QTest>
 #include <QWidget>
 
 #include "widgets/arm/vtk_view.h"
 
 namespace flexarm::test {
+
+// main() of a widget test: the VTK surface format before the application, the settings under
+// organisation org (each test its own: no layout or recent files left by another), then the
+// test object's slots.
+template <class Test>
+int runWidgetTest(int argc, char** argv, const char* org) {
+  VtkView::installDefaultSurfaceFormat();
+  QApplication app(argc, argv);
+  QApplication::setOrganizationName(org);
+  Test t;
+  return QTest::qExec(&t, argc, argv);
+}
 
 // Saves a screenshot under the build tree's screenshots/ folder and returns its path.
 inline QString saveShot(const QImage& image, const QString& name) {

@@ -188,8 +188,10 @@ int BodePlot::addCurve(const BodeCurve& curve) {
     }
   }
   curves_.push_back(std::move(e));
-  rescale();
-  return static_cast<int>(curves_.size()) - 1;
+  const int index = static_cast<int>(curves_.size()) - 1;
+  if (hidden_.contains(curve.name)) setCurveVisible(index, false);  // hidden by the user before
+  else rescale();
+  return index;
 }
 
 void BodePlot::setCurveVisible(int index, bool visible) {
@@ -200,7 +202,10 @@ void BodePlot::setCurveVisible(int index, bool visible) {
   for (auto* g : e.band) g->setVisible(visible);
   if (auto* item = plot_->legend->itemWithPlottable(e.mag))
     item->setTextColor(visible ? Qt::black : QColor(170, 170, 170));
-  plot_->replot();
+  // The choice outlives a refresh that draws the curves anew (a tick of SPA, a new level).
+  if (visible) hidden_.remove(e.curve.name);
+  else hidden_.insert(e.curve.name);
+  rescale();  // the axes follow what is shown
 }
 
 bool BodePlot::isCurveVisible(int index) const {
@@ -208,18 +213,49 @@ bool BodePlot::isCurveVisible(int index) const {
 }
 
 void BodePlot::rescale() {
-  bool first = true;
+  // The axes span what is shown: the visible curves, and their bands where these stay near
+  // them. A band that dives at a notch (-6000 dB where the lower bound nears zero) widens the
+  // axis by its 2nd-98th percentile at most, and never by more than the curves' own span.
+  struct Span {
+    double lo = 1e300, hi = -1e300;
+    void add(double v) {
+      if (std::isfinite(v)) lo = std::min(lo, v), hi = std::max(hi, v);
+    }
+    bool valid() const { return lo <= hi; }
+  };
+  Span frequency, lines[2];
+  std::vector<double> bandValues[2];
+  QCPAxis* magAxis = magRect_->axis(QCPAxis::atLeft);
   for (const auto& e : curves_) {
     if (!e.mag->visible()) continue;
-    e.mag->rescaleAxes(!first);
-    e.phase->rescaleAxes(!first);
-    for (auto* g : e.band) g->rescaleValueAxis(true);
-    first = false;
+    for (double w : e.curve.frequency)
+      if (w > 0.0) frequency.add(w);
+    for (double v : e.magnitudeDb) lines[0].add(v);
+    for (double v : e.phaseDeg) lines[1].add(v);
+    for (const QCPGraph* g : e.band) {
+      const int k = g->valueAxis() == magAxis ? 0 : 1;
+      for (auto it = g->data()->constBegin(); it != g->data()->constEnd(); ++it)
+        if (std::isfinite(it->value)) bandValues[k].push_back(it->value);
+    }
   }
-  for (QCPAxisRect* r : {magRect_, phaseRect_}) {
-    QCPAxis* y = r->axis(QCPAxis::atLeft);
-    const double pad = std::max(1.0, 0.05 * y->range().size());
-    y->setRange(y->range().lower - pad, y->range().upper + pad);
+  if (!frequency.valid()) {
+    plot_->replot();
+    return;
+  }
+  magRect_->axis(QCPAxis::atBottom)->setRange(frequency.lo, frequency.hi);
+  for (int k = 0; k < 2; ++k) {
+    Span range = lines[k];
+    if (!range.valid()) continue;
+    const double span = std::max(range.hi - range.lo, k == 0 ? 10.0 : 20.0);
+    std::vector<double>& band = bandValues[k];
+    if (!band.empty()) {
+      std::sort(band.begin(), band.end());
+      const auto at = [&band](double q) { return band[static_cast<std::size_t>(q * static_cast<double>(band.size() - 1))]; };
+      range.lo = std::min(range.lo, std::max(at(0.02), range.lo - span));
+      range.hi = std::max(range.hi, std::min(at(0.98), range.hi + span));
+    }
+    const double pad = std::max(1.0, 0.05 * (range.hi - range.lo));
+    (k == 0 ? magRect_ : phaseRect_)->axis(QCPAxis::atLeft)->setRange(range.lo - pad, range.hi + pad);
   }
   plot_->replot();
 }

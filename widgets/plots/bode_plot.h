@@ -4,6 +4,7 @@
 // estimates). Clicking near a curve reads the nearest peak or notch; clicking a legend entry
 // hides or shows its curve; the plot exports to PNG, PDF or SVG.
 #include <QColor>
+#include <QSet>
 #include <QString>
 #include <QWidget>
 #include <complex>
@@ -50,9 +51,12 @@ class BodePlot : public QWidget {
   // Adds a curve and returns its index.
   int addCurve(const BodeCurve& curve);
   int curveCount() const { return static_cast<int>(curves_.size()); }
+  // Hides or shows a curve and rescales to what is shown. The choice is kept by the curve's
+  // name: a curve drawn again under that name (after clear()) comes back hidden.
   void setCurveVisible(int index, bool visible);
   bool isCurveVisible(int index) const;
-  // Rescales both axes to the visible curves.
+  // Rescales both axes to the visible curves, their bands widening the magnitude and phase
+  // axes only where the bands stay near the curves (never to a notch's -6000 dB).
   void rescale();
 
   // The peak or notch of curve `index` (BodeCurve::extrema) nearest to frequency w, within a
@@ -83,6 +87,7 @@ class BodePlot : public QWidget {
   QCPAxisRect* phaseRect_;
   QLabel* readout_;
   std::vector<Entry> curves_;
+  QSet<QString> hidden_;  // names of the curves the user hid
 };
 
 // Notches and peaks of a sampled response by magnitudeExtrema (core/models/analysis.h), the

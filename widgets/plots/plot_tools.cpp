@@ -176,6 +176,25 @@ void PlotTools::exportDialog() {
 
 void PlotTools::copyData() const { QApplication::clipboard()->setText(dataAsCsv()); }
 
+void keepRectsTall(QCustomPlot* plot, int perRect) {
+  const int rects = static_cast<int>(plot->axisRects().size());
+  // What is not a rect (title, legend rows, the last time axis' labels) on top.
+  plot->setMinimumHeight(std::max(1, rects) * perRect + 40);
+}
+
+void showLegendAbove(QCustomPlot* plot) {
+  QCPLegend* legend = plot->legend;
+  if (!legend) return;
+  const bool entries = legend->itemCount() > 0;
+  auto* grid = qobject_cast<QCPLayoutGrid*>(legend->layout());
+  if (entries && !grid) placeLegendAbove(plot);
+  if (!entries && grid) {
+    grid->take(legend);
+    grid->simplify();
+  }
+  legend->setVisible(entries);
+}
+
 void placeLegendAbove(QCustomPlot* plot, QCPAxisRect* rect) {
   QCPLegend* legend = plot->legend;
   if (!rect) rect = plot->axisRect();

@@ -55,6 +55,15 @@ class PlotTools : public QObject {
   std::function<void()> reset_;
 };
 
+// Keeps every axis rect of the plot at least perRect pixels tall, so that stacked rects keep
+// their labels apart: the plot asks for that much height (a panel that scrolls then scrolls
+// instead of squeezing them). Call after the rects are laid out.
+void keepRectsTall(QCustomPlot* plot, int perRect);
+
+// Shows the legend in its own row above the data (placeLegendAbove) while it has entries;
+// without entries it leaves the layout (an empty legend row would narrow the whole plot).
+void showLegendAbove(QCustomPlot* plot);
+
 // Places the plot's legend outside its data: in its own row above axis rect `rect` (the
 // default rect when null), entries side by side, so no curve is hidden under it.
 void placeLegendAbove(QCustomPlot* plot, QCPAxisRect* rect = nullptr);

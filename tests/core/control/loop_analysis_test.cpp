@@ -69,11 +69,34 @@ TEST(DescribingFunction, CrossingOfThirdOrderLoop) {
   EXPECT_TRUE(describingFunctionCrossings(low, nyquist(low, -1.0, {1.0})).empty());
 }
 
+TEST(Nyquist, SampledDenselyWhereItBends) {
+  // A lightly damped resonance draws a large circle far from -1: the curve is sampled so
+  // that its direction turns by at most maxBendStep between chords a reader can see, and the
+  // circle has enough points to look round (its radius is about 25 around 25 - 25i).
+  const auto l = [](C s) { return 50.0 / (s * s + 0.02 * s + 1.0) / (s / 50.0 + 1.0); };
+  const NyquistOptions o;
+  const NyquistCurve c = nyquist(l, -1.0, {1.0, 50.0}, o);
+  EXPECT_FALSE(c.gridLimitReached);
+  double worst = 0.0;
+  int onCircle = 0;
+  for (std::size_t i = 1; i + 1 < c.values.size(); ++i) {
+    const C d1 = c.values[i] - c.values[i - 1], d2 = c.values[i + 1] - c.values[i];
+    if (std::max(std::abs(d1), std::abs(d2)) <= o.bendMinChord * std::abs(c.values[i] + 1.0)) continue;
+    worst = std::max(worst, std::abs(std::arg(d2 / d1)));
+    if (std::abs(c.values[i]) > 10.0) ++onCircle;
+  }
+  EXPECT_LE(worst, o.maxBendStep + 1e-9);
+  EXPECT_GE(onCircle, 60);  // 2 pi / 0.1 turns of a smooth circle
+}
+
 TEST(Nyquist, InvalidOptionsThrow) {
   NyquistOptions o;
   o.maxAngleStep = 0.0;
   EXPECT_THROW(nyquist([](C s) { return 1.0 / (s + 1.0); }, -1.0, {1.0}, o), std::invalid_argument);
   EXPECT_THROW(nyquist([](C s) { return 1.0 / (s + 1.0); }, -1.0, {}), std::invalid_argument);
+  NyquistOptions bend;
+  bend.maxBendStep = 0.0;
+  EXPECT_THROW(nyquist([](C s) { return 1.0 / (s + 1.0); }, -1.0, {1.0}, bend), std::invalid_argument);
 }
 
 }  // namespace
