@@ -6,6 +6,7 @@
 #include <QStatusBar>
 #include <QtConcurrent>
 
+#include "app/busy_progress.h"
 #include "app/main_window.h"
 #include "widgets/import_dialog.h"
 
@@ -23,19 +24,8 @@ void LogImporter::start(const QString& path, const LogReadOptions& start, const 
   path_ = path;
   start_ = start;
   problem_ = problem;
-  cancelled_ = false;
-  if (!progress_) {
-    progress_ = new QProgressDialog(window_);
-    progress_->setWindowTitle(tr("Import"));
-    progress_->setRange(0, 0);
-    progress_->setMinimumDuration(400);
-    progress_->setAutoClose(false);
-    progress_->setAutoReset(false);
-    connect(progress_, &QProgressDialog::canceled, this, [this] { cancelled_ = true; });
-  }
-  progress_->setLabelText(tr("Reading what %1 holds").arg(QFileInfo(path).fileName()));
-  progress_->reset();
-  progress_->setRange(0, 0);
+  startBusyProgress(progress_, window_, tr("Import"), tr("Reading what %1 holds").arg(QFileInfo(path).fileName()),
+                    &cancelled_);
   window_->statusBar()->showMessage(tr("Reading what %1 holds...").arg(path));
   const std::string p = path.toStdString();
   LogReadOptions limits;

@@ -30,6 +30,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "app/busy_progress.h"
 #include "app/cli/cli.h"
 #include "app/log_importer.h"
 #include "app/panel_docks.h"
@@ -310,21 +311,10 @@ void MainWindow::openFile(const QString& path, const LogReadOptions& options) {
   }
   readingPath_ = path;
   readingOptions_ = options;
-  readCancelled_ = false;
   readStartMs_ = QDateTime::currentMSecsSinceEpoch();
   statusBar()->showMessage(tr("Reading %1...").arg(path));
-  if (!progress_) {
-    progress_ = new QProgressDialog(this);
-    progress_->setWindowTitle(tr("Opening log"));
-    progress_->setRange(0, 0);
-    progress_->setMinimumDuration(400);
-    progress_->setAutoClose(false);
-    progress_->setAutoReset(false);
-    connect(progress_, &QProgressDialog::canceled, this, [this] { readCancelled_ = true; });
-  }
-  progress_->setLabelText(tr("Reading %1").arg(QFileInfo(path).fileName()));
-  progress_->reset();
-  progress_->setRange(0, 0);
+  startBusyProgress(progress_, this, tr("Opening log"), tr("Reading %1").arg(QFileInfo(path).fileName()),
+                    &readCancelled_);
   const std::string p = path.toStdString();
   reader_.setFuture(QtConcurrent::run([p, options] {
     ReadLog r{readLog(p, options), {}};
