@@ -217,6 +217,12 @@ bool applyMapping(IdData& data, const MappedChannels& found, const LogMapping& m
   Channel* ref = channel(found.reference);
   double outputFactor = 1.0;  // what the output was multiplied by (the reference shares it)
   if (in) {
+    // Nothing said of the input of a foreign file (no scale, no units at all): read as stored,
+    // which a physical model takes as the motor torque in N m.
+    if (foreign && !m.convertsOutput() && m.inputScale == 1.0 && in->name != columns::kTorqueRef)
+      warnings.push_back("the input " + found.inputSource +
+                         " is read as stored: a physical model takes it as the motor torque in N m (say its scale "
+                         "and the output's unit: --input-scale K, --output-unit)");
     scale(*in, m.inputScale);
     if ((m.convertsOutput() || m.inputScale != 1.0) &&
         !rename(*in, prismatic ? columns::kForceRef : columns::kTorqueRef, prismatic ? "N" : "N m",

@@ -577,6 +577,7 @@ LogReadResult readMatVariables(MatVariables& vars, const std::string& path, cons
       for (const auto& n : names) list += (list.empty() ? "" : ", ") + n;
       LogReadResult r = failure(path, 0, 0, w->expression,
                                 "the variable '" + w->expression + "' is missing; the file holds " + list +
+                                    (skipped.empty() ? std::string() : "; skipped: " + skipped) +
                                     " (name the input and output with --input-var and --output-var, e.g. "
                                     "--input-var 'rec.tau(1,:)')");
       r.needsMapping = true;

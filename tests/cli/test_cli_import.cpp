@@ -66,11 +66,16 @@ TEST(CliImport, WhatIsNotSaidIsAWarning) {
   auto r = runFlexarm(axisOne({"--json"}));
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_NE(r.err.find("the output rec.act_pos_mot_deg(1,:) is read as stored"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("the input rec.act_torque_abs_nm(1,:) is read as stored: a physical model takes it as the "
+                       "motor torque in N m"),
+            std::string::npos)
+      << r.err;
   EXPECT_NE(r.err.find("the arm angle rec.act_pos_se_deg(1,:) is taken in rad"), std::string::npos) << r.err;
   r = runFlexarm(axisOne({"--output-unit", "deg", "--json"}));
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_NE(r.err.find("its side was not given (--output-side motor|arm)"), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("no gear ratio was given"), std::string::npos) << r.err;
+  EXPECT_EQ(r.err.find("the input rec.act_torque_abs_nm(1,:) is read as stored"), std::string::npos) << r.err;
 }
 
 TEST(CliImport, BadExpressionsAndUnitsNameTheFileAndTheProblem) {
@@ -96,5 +101,7 @@ TEST(CliImport, BadExpressionsAndUnitsNameTheFileAndTheProblem) {
   r = runFlexarm({"info", kKuka});
   EXPECT_EQ(r.code, 3);
   EXPECT_NE(r.err.find("the file holds n_axis"), std::string::npos) << r.err;
+  // What was skipped is named too, so a user looking for the robot object learns why it is not listed.
+  EXPECT_NE(r.err.find("skipped: KR300 (a MATLAB object of class SerialLink)"), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("--input-var 'rec.tau(1,:)'"), std::string::npos) << r.err;
 }
