@@ -31,7 +31,9 @@
 #include <fstream>
 #include <sstream>
 
+#include "app/busy_progress.h"
 #include "app/cli/cli.h"
+#include "app/log_importer.h"
 #include "app/panel_docks.h"
 #include "app/recent_files.h"
 #include "app/session_controller.h"
@@ -73,45 +75,6 @@ bool looksLikeTable(const QString& path) {
     return (c >= '0' && c <= '9') || c == '-' || c == '+' || c == '.';
   }
   return false;
-}
-
-// Asks for the column mapping and sample time of a headerless table.
-bool askTableMapping(QWidget* parent, const QString& path, LogReadOptions& o) {
-  QDialog dialog(parent);
-  dialog.setWindowTitle(QObject::tr("Import a headerless table"));
-  auto* form = new QFormLayout(&dialog);
-  form->addRow(new QLabel(QObject::tr("%1 has no header. Which columns are the input u and "
-                                      "the output y?").arg(QFileInfo(path).fileName())));
-  auto* in = new QSpinBox;
-  auto* out = new QSpinBox;
-  auto* time = new QSpinBox;
-  in->setRange(1, 1000);
-  out->setRange(1, 1000);
-  time->setRange(0, 1000);
-  in->setValue(o.inputColumn);
-  out->setValue(o.outputColumn);
-  time->setValue(o.timeColumn);
-  time->setSpecialValueText(QObject::tr("none"));
-  auto* ts = new QDoubleSpinBox;
-  ts->setDecimals(6);
-  ts->setRange(1e-6, 1e6);
-  ts->setValue(o.sampleTime > 0.0 ? o.sampleTime : 1.0);
-  ts->setSuffix(" s");
-  form->addRow(QObject::tr("Input u column"), in);
-  form->addRow(QObject::tr("Output y column"), out);
-  form->addRow(QObject::tr("Time column"), time);
-  form->addRow(QObject::tr("Sample time (without time column)"), ts);
-  auto* buttons = new QDialogButtonBox(QDialogButtonBox::Ok | QDialogButtonBox::Cancel);
-  form->addRow(buttons);
-  QObject::connect(buttons, &QDialogButtonBox::accepted, &dialog, &QDialog::accept);
-  QObject::connect(buttons, &QDialogButtonBox::rejected, &dialog, &QDialog::reject);
-  if (dialog.exec() != QDialog::Accepted) return false;
-  o.format = LogFormat::Table;
-  o.inputColumn = in->value();
-  o.outputColumn = out->value();
-  o.timeColumn = time->value();
-  o.sampleTime = ts->value();
-  return true;
 }
 
 }  // namespace
@@ -214,6 +177,7 @@ MainWindow::MainWindow(QWidget* parent)
   transport->addWidget(transportBar_);
   addToolBar(Qt::BottomToolBarArea, transport);
   session_ = new SessionController(this, workspace_);  // File menu: sessions and reports
+  importer_ = new LogImporter(this);
   // The first size fits the screen (a 1366x768 laptop too); the docks scroll what is taller,
   // and are arranged for the screen's size. A layout kept from the last run comes back when
   // it was made for a screen of the same kind.
@@ -265,6 +229,11 @@ bool MainWindow::isBusy() const {
 void MainWindow::createMenus() {
   QMenu* file = menuBar()->addMenu(tr("&File"));
   QAction* open = file->addAction(tr("&Open log..."), this, &MainWindow::openDialog);
+  file->addAction(tr("&Import log..."), this, [this] {
+    const QString path = QFileDialog::getOpenFileName(this, tr("Import robot log"), QSettings().value("lastDir").toString(),
+                                                      tr("Robot logs (*.csv *.dat *.txt *.mat);;All files (*)"));
+    if (!path.isEmpty()) importFile(path);
+  })->setShortcut(QKeySequence("Ctrl+I"));
   open->setShortcut(QKeySequence::Open);
   recentMenu_ = file->addMenu(tr("Open &recent"));
   QAction* exportAction = file->addAction(tr("&Export data as CSV..."), this, &MainWindow::exportData);
@@ -351,12 +320,14 @@ void MainWindow::requestOpenFile(const QString& path) {
 }
 
 void MainWindow::openFile(const QString& path) {
-  LogReadOptions options;
-  if (looksLikeTable(path) && !askTableMapping(this, path, options)) {
-    statusBar()->showMessage(tr("Opening %1 cancelled").arg(path), 5000);
-    return;
-  }
-  openFile(path, options);
+  // A headerless table names nothing: the import dialog asks which column is what.
+  if (looksLikeTable(path)) importer_->start(path, LogReadOptions{});
+  else openFile(path, LogReadOptions{});
+}
+
+void MainWindow::importFile(const QString& path) {
+  if (session_->confirmReplace(tr("opening %1").arg(QFileInfo(path).fileName())))
+    importer_->start(path, workspace_->logPath() == path ? workspace_->logReadOptions() : LogReadOptions{});
 }
 
 void MainWindow::openFile(const QString& path, const LogReadOptions& options) {
@@ -366,21 +337,10 @@ void MainWindow::openFile(const QString& path, const LogReadOptions& options) {
   }
   readingPath_ = path;
   readingOptions_ = options;
-  readCancelled_ = false;
   readStartMs_ = QDateTime::currentMSecsSinceEpoch();
   statusBar()->showMessage(tr("Reading %1...").arg(path));
-  if (!progress_) {
-    progress_ = new QProgressDialog(this);
-    progress_->setWindowTitle(tr("Opening log"));
-    progress_->setRange(0, 0);
-    progress_->setMinimumDuration(400);
-    progress_->setAutoClose(false);
-    progress_->setAutoReset(false);
-    connect(progress_, &QProgressDialog::canceled, this, [this] { readCancelled_ = true; });
-  }
-  progress_->setLabelText(tr("Reading %1").arg(QFileInfo(path).fileName()));
-  progress_->reset();
-  progress_->setRange(0, 0);
+  startBusyProgress(progress_, this, tr("Opening log"), tr("Reading %1").arg(QFileInfo(path).fileName()),
+                    &readCancelled_);
   const std::string p = path.toStdString();
   reader_.setFuture(QtConcurrent::run([p, options] {
     ReadLog r{readLog(p, options), {}};
@@ -419,6 +379,12 @@ void MainWindow::onReadFinished() {
     }
     return;
   }
+  if (!r.ok && (r.needsMapping || readingOptions_.mapping != LogMapping{})) {
+    // Signals named otherwise, or choices that did not hold: the import dialog asks (again).
+    importer_->start(readingPath_, readingOptions_,
+                     r.needsMapping ? QString() : QString::fromStdString(r.error.toString()));
+    return;
+  }
   if (!r.ok) {
     const QString msg = QString::fromStdString(r.error.toString());
     statusBar()->showMessage(tr("Could not open %1").arg(readingPath_), 10000);
@@ -442,6 +408,18 @@ void MainWindow::onReadFinished() {
                                .arg(samples)
                                .arg(rate, 0, 'g', 6)
                                .arg(seconds, 0, 'f', 2));
+  if (!r.warnings.empty()) {
+    // What was assumed or skipped, where the user sees it.
+    QString text;
+    for (const auto& w : r.warnings) text += (text.isEmpty() ? "" : "\n") + QString::fromStdString(w);
+    statusBar()->showMessage(tr("Opened %1 - %2").arg(QFileInfo(readingPath_).fileName(), text.section('\n', 0, 0)), 15000);
+    auto* box = new QMessageBox(QMessageBox::Information, tr("Read with assumptions"),
+                                tr("%1 was read; note:\n\n%2").arg(QFileInfo(readingPath_).fileName(), text),
+                                QMessageBox::Ok, this);
+    box->setObjectName("readWarningsBox");
+    box->setAttribute(Qt::WA_DeleteOnClose);
+    box->open();
+  }
   if (!workspace_->raw()->isUniform()) {
     statusBar()->showMessage(tr("Opened %1 with irregular time stamps: resample it in the Preprocess panel")
                                  .arg(QFileInfo(readingPath_).fileName()));

@@ -33,6 +33,7 @@ class DiagnosisPanel;
 class PanelDocks;
 class SessionController;
 class Workspace;
+class LogImporter;
 
 class MainWindow : public QMainWindow {
   Q_OBJECT
@@ -40,10 +41,13 @@ class MainWindow : public QMainWindow {
   explicit MainWindow(QWidget* parent = nullptr);
   ~MainWindow() override;
 
-  // Reads a log in the background; a headerless table first asks for its column mapping
-  // unless options are given. Emits logOpened or openFailed.
+  // Reads a log in the background; a headerless table, a CSV file with other column names and
+  // a .mat file whose signals are not named the FlexArm way go through the import dialog
+  // (app/log_importer.h) unless options are given. Emits logOpened or openFailed.
   void openFile(const QString& path);
   void openFile(const QString& path, const LogReadOptions& options);
+  // File -> Import log: the import dialog for path whatever it holds (after confirmReplace).
+  void importFile(const QString& path);
   bool isOpening() const { return reader_.isRunning(); }
   // Opens a log as File -> Open, a recent file or a drop does: with unsaved changes it first
   // asks Save / Discard / Cancel (SessionController::confirmReplace); Cancel keeps everything.
@@ -121,6 +125,7 @@ class MainWindow : public QMainWindow {
   LqgPanel* lqgPanel_ = nullptr;
   QDockWidget* lqgDock_ = nullptr;
   SessionController* session_ = nullptr;
+  LogImporter* importer_ = nullptr;
   QDockWidget* discoveryDock_ = nullptr;
   DiagnosisPanel* diagnosisPanel_ = nullptr;
   QDockWidget* diagnosisDock_ = nullptr;

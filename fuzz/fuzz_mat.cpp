@@ -3,6 +3,7 @@
 #include <cstdint>
 #include <string_view>
 
+#include "core/io/log_source.h"
 #include "core/io/mat_check.h"
 #include "fuzz/fuzz_support.h"
 
@@ -13,6 +14,19 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     if (check.problem.empty()) __builtin_trap();
     return 0;
   }
-  flexarm::fuzz::readAsMatFile(data, size, "fuzz");
+  const std::string& path = flexarm::fuzz::readAsMatFile(data, size, "fuzz");
+  // The import dialog's listing walks every struct field and cell; the first numeric entry
+  // it lists is read by its expression (a row of a matrix).
+  flexarm::LogReadOptions o;
+  o.format = flexarm::LogFormat::Mat;
+  const flexarm::SourceListing listing = flexarm::listLogSource(path, o);
+  if (!listing.ok && listing.error.problem.empty()) __builtin_trap();
+  for (const auto& e : listing.entries)
+    if (e.numeric) {
+      const std::string expression = e.rows > 1 && e.cols > 1 ? e.expression + "(end,:)" : e.expression;
+      const flexarm::SeriesRead s = flexarm::readSourceSeries(path, listing, expression, o);
+      if (!s.ok && s.error.problem.empty()) __builtin_trap();
+      break;
+    }
   return 0;
 }

@@ -12,7 +12,8 @@
 
 namespace flexarm::fuzz {
 
-inline void readAsMatFile(const std::uint8_t* data, std::size_t size, const char* tag) {
+// Returns the scratch file, for targets that read it further.
+inline const std::string& readAsMatFile(const std::uint8_t* data, std::size_t size, const char* tag) {
   const char* dir = std::getenv("FLEXARM_FUZZ_TMP");
   static const std::string path =
       std::string(dir ? dir : "/tmp") + "/flexarm_" + tag + "_" + std::to_string(::getpid()) + ".mat";
@@ -24,6 +25,7 @@ inline void readAsMatFile(const std::uint8_t* data, std::size_t size, const char
   o.format = LogFormat::Mat;
   const LogReadResult r = readLog(path, o);
   if (!r.ok && r.error.problem.empty()) __builtin_trap();  // a refusal always says why
+  return path;
 }
 
 }  // namespace flexarm::fuzz

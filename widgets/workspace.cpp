@@ -133,6 +133,7 @@ Provenance Workspace::dataProvenance() const {
   Provenance p;
   p.log = QFileInfo(path_).fileName().toStdString();
   p.sha256 = sha256_;
+  p.reading = describeMapping(read_.mapping);
   if (processed_) p.preprocessing = describePreprocessing(options_);
   p.estimation = estimation_;
   p.validation = validation_;

@@ -10,7 +10,9 @@ namespace flexarm::cli {
 
 std::vector<std::string> logReadOptionNames() {
   return {"format",     "input-column", "output-column", "time-column", "sample-time",
-          "input-name", "output-name",  "input-var",     "output-var"};
+          "input-name", "output-name",  "input-var",     "output-var",  "time-var",
+          "arm-var",    "ref-var",      "output-unit",   "arm-unit",    "output-side",
+          "gear-ratio", "input-scale"};
 }
 
 const char* logReadOptionsHelp() {
@@ -26,8 +28,24 @@ const char* logReadOptionsHelp() {
          "                        name, and a variable NAME is the input)\n"
          "  --output-name NAME    channel name for the output (default y; .mat: the\n"
          "                        variable's name, and a variable NAME is the output)\n"
-         "  --input-var NAME      .mat: variable holding the input\n"
-         "  --output-var NAME     .mat: variable holding the output\n";
+         "  --input-var EXPR      the input: a .mat variable or MATLAB expression\n"
+         "                        (rec.act_torque_abs_nm(1,:), data(:,2)), a CSV header\n"
+         "                        name (torque_motor_Nm) or a table's 'column N'\n"
+         "  --output-var EXPR     the output, named the same ways\n"
+         "  --time-var EXPR       the time in s, named the same ways (rec.time_cont, t_s)\n"
+         "  --arm-var EXPR        the arm-side encoder, read as arm_angle_rad\n"
+         "  --ref-var EXPR        a closed loop's position reference, in the output's unit\n"
+         "                        and side: angle_ref_rad (position_ref_m)\n"
+         "  --output-unit U       the output's unit: rad, deg, rev (rad/s, deg/s, rpm for\n"
+         "                        a velocity) or, for a prismatic axis, m, mm (m/s, mm/s);\n"
+         "                        converted, and named motor_angle_rad (motor_velocity_rad_s,\n"
+         "                        motor_position_m, motor_velocity_m_s)\n"
+         "  --arm-unit U          the arm encoder's unit: rad, deg or rev\n"
+         "  --output-side S       motor, or arm when a motor encoder is stored scaled to the\n"
+         "                        arm side (motor angle = value / gear ratio)\n"
+         "  --gear-ratio R        arm/motor as the log's gear_ratio, e.g. 1/256.86\n"
+         "  --input-scale K       the input times K is the torque in N m (force in N),\n"
+         "                        e.g. 35.15 for a drive command in V at 35.15 N/V\n";
 }
 
 std::optional<LogReadOptions> logReadOptions(ArgParser& args, std::ostream& err) {
@@ -51,8 +69,34 @@ std::optional<LogReadOptions> logReadOptions(ArgParser& args, std::ostream& err)
   }
   if (auto v = args.value("input-name")) o.inputName = *v;
   if (auto v = args.value("output-name")) o.outputName = *v;
-  if (auto v = args.value("input-var")) o.inputVariable = *v;
-  if (auto v = args.value("output-var")) o.outputVariable = *v;
+  LogMapping& m = o.mapping;
+  if (auto v = args.value("input-var")) m.input = *v;
+  if (auto v = args.value("output-var")) m.output = *v;
+  if (auto v = args.value("time-var")) m.time = *v;
+  if (auto v = args.value("arm-var")) m.arm = *v;
+  if (auto v = args.value("ref-var")) m.reference = *v;
+  for (const auto& [option, unit] : {std::pair<const char*, std::optional<SignalUnit>*>{"output-unit", &m.outputUnit},
+                                     {"arm-unit", &m.armUnit}})
+    if (auto v = args.value(option)) {
+      *unit = signalUnitFromString(*v);
+      if (!*unit) {
+        err << "flexarm: --" << option << " must be rad, deg, rev, rad/s, deg/s, rpm, m, mm, m/s or mm/s, not '"
+            << *v << "'\n";
+        return std::nullopt;
+      }
+    }
+  if (auto v = args.value("output-side")) {
+    m.outputSide = encoderSideFromString(*v);
+    if (!m.outputSide) {
+      err << "flexarm: --output-side must be motor or arm, not '" << *v << "'\n";
+      return std::nullopt;
+    }
+  }
+  if (auto v = args.value("gear-ratio")) m.gearRatio = *v;
+  if (!args.number("input-scale", m.inputScale)) {
+    err << "flexarm: " << args.error() << "\n";
+    return std::nullopt;
+  }
   std::string why;
   if (!o.isValid(&why)) {
     err << "flexarm: " << why << "\n";
@@ -68,6 +112,7 @@ std::optional<IdData> loadLog(const std::string& path, const LogReadOptions& opt
     err << "flexarm: " << r.error.toString() << "\n";
     return std::nullopt;
   }
+  for (const auto& w : r.warnings) err << "flexarm: warning: " << path << ": " << w << "\n";
   std::string why;
   if (!applyStoredRanges(r.data, &why)) {
     err << "flexarm: " << path << ": " << why << "\n";

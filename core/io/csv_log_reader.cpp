@@ -156,14 +156,16 @@ struct Head {
   double declaredRate = 0.0;
   std::size_t dataStart = 0;  // byte offset of the first line after the header
   std::size_t timeIndex = 0;
+  // Header indices of the columns the mapping names (-1: not named).
+  long inputIndex = -1, outputIndex = -1, armIndex = -1, referenceIndex = -1;
 };
 
 enum class HeadStatus { Ok, Failed, NeedMore };
 
 // Reads metadata and header from text, the whole file (whole) or its first bytes. NeedMore
 // when the first bytes end before the header does.
-HeadStatus parseHead(std::string_view text, bool whole, const std::string& path, Head& h,
-                     LogReadResult& fail) {
+HeadStatus parseHead(std::string_view text, bool whole, const std::string& path,
+                     const LogReadOptions& options, Head& h, LogReadResult& fail) {
   if (std::string enc = textEncodingProblem(text); !enc.empty()) {
     fail = failure(path, 1, 0, {}, enc);
     return HeadStatus::Failed;
@@ -242,12 +244,44 @@ HeadStatus parseHead(std::string_view text, bool whole, const std::string& path,
     return fails(failure(path, h.headerLine, 1, {},
                          "expected a header of column names (time_s,torque_ref_nm,motor_angle_rad,"
                          "...) but found numbers; open it as a headerless table instead"));
-  for (const char* required : {columns::kTime, columns::kTorqueRef, columns::kMotorAngle})
-    if (std::find(h.header.begin(), h.header.end(), required) == h.header.end())
-      return fails(failure(path, h.headerLine, 0, required,
-                           std::string("the required column '") + required + "' is missing"));
-  h.timeIndex = static_cast<std::size_t>(
-      std::find(h.header.begin(), h.header.end(), columns::kTime) - h.header.begin());
+  // The columns the mapping names (a CSV with other names), else FlexArm's.
+  const LogMapping& m = options.mapping;
+  const auto indexOf = [&](const std::string& name) {
+    const auto it = std::find(h.header.begin(), h.header.end(), name);
+    return it == h.header.end() ? -1L : static_cast<long>(it - h.header.begin());
+  };
+  std::string headerList;
+  for (std::size_t i = 0; i < h.header.size() && i < 40; ++i) headerList += (i ? ", " : "") + h.header[i];
+  if (h.header.size() > 40) headerList += ", ...";
+  const bool mapped = !m.time.empty() || !m.input.empty() || !m.output.empty();
+  struct Need {
+    const std::string& given;
+    const char* flexArmName;
+    const char* option;
+    long* index;
+  };
+  long timeIndex = -1;
+  for (const Need& n : {Need{m.time, columns::kTime, "--time-var", &timeIndex},
+                        Need{m.input, columns::kTorqueRef, "--input-var", &h.inputIndex},
+                        Need{m.output, columns::kMotorAngle, "--output-var", &h.outputIndex},
+                        Need{m.arm, nullptr, "--arm-var", &h.armIndex},
+                        Need{m.reference, nullptr, "--ref-var", &h.referenceIndex}}) {
+    if (!n.flexArmName && n.given.empty()) continue;
+    const std::string name = n.given.empty() ? std::string(n.flexArmName) : n.given;
+    *n.index = indexOf(name);
+    if (*n.index >= 0) continue;
+    LogReadResult r = failure(path, h.headerLine, 0, name,
+                              n.given.empty()
+                                  ? "the required column '" + name + "' is missing; the header has " + headerList +
+                                        (mapped ? "" : ": say which column is which (--time-var, --input-var, "
+                                                       "--output-var with their units) or use the import dialog")
+                                  : "the column '" + name + "' that " + n.option + " names is not in the header; it has " +
+                                        headerList);
+    r.needsMapping = !mapped;
+    return fails(std::move(r));
+  }
+  h.timeIndex = static_cast<std::size_t>(timeIndex);
+  if (m.arm.empty()) h.armIndex = indexOf(columns::kArmAngle);
   h.dataStart = std::min(cursor.offset(), text.size());
   return HeadStatus::Ok;
 }
@@ -421,7 +455,7 @@ LogReadResult finishLog(Head& h, std::vector<Chunk>& chunks, bool haveText, std:
   IdData& data = h.data;
   LogReadResult fail;
   const bool timeOk = io::checkTime(path, cols[h.timeIndex], lineOfChecked, allLines,
-                                    static_cast<int>(h.timeIndex + 1), columns::kTime, options, data, fail);
+                                    static_cast<int>(h.timeIndex + 1), h.header[h.timeIndex], options, data, fail);
   if (lineless) return wantText();
   if (!timeOk) return fail;
   if (holes && data.timeStamps.empty()) {  // channels at different rates: stamps and NaN holes
@@ -451,6 +485,26 @@ LogReadResult finishLog(Head& h, std::vector<Chunk>& chunks, bool haveText, std:
   if (data.meta("source").empty())
     data.setMeta("source", std::filesystem::path(path).filename().string());
   LogReadResult ok;
+  if (options.mapping != LogMapping{}) {
+    // Header indices to channel indices (the time is no channel).
+    const auto channelOf = [&](long i) {
+      return i < 0 ? -1 : static_cast<int>(i - (static_cast<std::size_t>(i) > h.timeIndex ? 1 : 0));
+    };
+    const LogMapping& m = options.mapping;
+    MappedChannels found;
+    if (!m.input.empty() || m.inputScale != 1.0 || m.convertsOutput()) found.input = channelOf(h.inputIndex);
+    if (!m.output.empty() || m.convertsOutput()) found.output = channelOf(h.outputIndex);
+    if (!m.arm.empty() || m.armUnit) found.arm = channelOf(h.armIndex);
+    if (!m.reference.empty()) found.reference = channelOf(h.referenceIndex);
+    for (const auto& [index, source] : {std::pair<long, std::string*>{h.inputIndex, &found.inputSource},
+                                        {h.outputIndex, &found.outputSource},
+                                        {h.armIndex, &found.armSource},
+                                        {h.referenceIndex, &found.referenceSource}})
+      if (index >= 0) *source = h.header[static_cast<std::size_t>(index)];
+    std::string why;
+    if (!applyMapping(data, found, m, !m.output.empty(), ok.warnings, &why))
+      return failure(path, h.headerLine, 0, {}, why);
+  }
   ok.ok = true;
   ok.data = std::move(data);
   return ok;
@@ -470,7 +524,7 @@ LogReadResult readFlexArmCsvText(std::string_view text, const std::string& path,
                                  const LogReadOptions& options) {
   Head h;
   LogReadResult fail;
-  if (parseHead(text, true, path, h, fail) != HeadStatus::Ok) return fail;
+  if (parseHead(text, true, path, options, h, fail) != HeadStatus::Ok) return fail;
   std::vector<Chunk> chunks = parseRowsInMemory(text, h, options);
   bool needText = false;
   return finishLog(h, chunks, true, text, path, options, needText);
@@ -497,7 +551,7 @@ LogReadResult io::readFlexArmCsvFile(const InputFile& file, const std::string& p
   if (file.readFully(0, head.data(), kHead) < kHead) return readWholeFile(file, path, options);
   Head h;
   LogReadResult fail;
-  switch (parseHead(head, false, path, h, fail)) {
+  switch (parseHead(head, false, path, options, h, fail)) {
     case HeadStatus::Failed: return fail;
     case HeadStatus::NeedMore: return readWholeFile(file, path, options);
     case HeadStatus::Ok: break;

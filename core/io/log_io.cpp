@@ -81,7 +81,7 @@ bool LogReadOptions::isValid(std::string* why) const {
   if (sampleTime != 0.0 && (!(sampleTime >= IdData::kMinSampleTime) || !(sampleTime <= 1e6)))
     return fail("the sample time must lie between 1e-06 s (1 MHz) and 1e+06 s");
   if (!(maxSampleJitter > 0.0)) return fail("the sampling tolerance must be positive");
-  return true;
+  return mapping.isValid(why);
 }
 
 LogReadResult readLog(const std::string& path, const LogReadOptions& options) {

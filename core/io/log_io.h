@@ -9,6 +9,7 @@
 #include <string_view>
 #include <vector>
 
+#include "core/io/log_mapping.h"
 #include "core/signal/id_data.h"
 
 namespace flexarm {
@@ -33,6 +34,13 @@ struct LogReadResult {
   // Refused because the file stores no time and no sample time was given (a .mat file
   // without time_s or a scalar Ts/dt/sample_time): read again with LogReadOptions::sampleTime.
   bool needsSampleTime = false;
+  // Refused because a CSV file with a header names its columns otherwise (t_s,
+  // torque_motor_Nm, ...) and no mapping says which is which: the import dialog asks.
+  bool needsMapping = false;
+  // What the user should know about a log that was read: what was assumed because it was not
+  // said (a unit, a side, a gear ratio), variables skipped as unreadable. Each is a sentence;
+  // the command line prints them, the window shows them.
+  std::vector<std::string> warnings;
 };
 
 enum class LogFormat { Auto, FlexArmCsv, Table, Mat };
@@ -61,11 +69,14 @@ struct LogReadOptions {
   double sampleTime = 0.0;
   // Channel names of the input and output; a .mat file's channels keep their variable names
   // unless these differ from the defaults u and y, and a .mat variable named like outputName
-  // (inputName) is the output (input) when outputVariable (inputVariable) is empty.
+  // (inputName) is the output (input) when mapping.output (mapping.input) is empty.
   std::string inputName = "u";
   std::string outputName = "y";
-  std::string inputVariable;   // .mat: variable holding u (default: torque_ref_nm or u)
-  std::string outputVariable;  // .mat: variable holding y (default: motor_angle_rad or y)
+  // Which variable (a MATLAB expression), header name or column ("column 3") holds the time,
+  // input, output and arm angle, their units and sides, the gear ratio and the input scale
+  // (core/io/log_mapping.h). A .mat file's defaults are torque_ref_nm or u, motor_angle_rad
+  // or y, time_s; a CSV file's its FlexArm names.
+  LogMapping mapping;
 
   bool isValid(std::string* why) const;
 };

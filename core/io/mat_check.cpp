@@ -17,6 +17,7 @@ using Byte = unsigned char;
 
 constexpr std::uint32_t kMiInt8 = 1, kMiInt32 = 5, kMiUint32 = 6, kMiMatrix = 14,
                         kMiCompressed = 15;
+constexpr std::uint32_t kOpaque = 17;  // array class of a classdef object
 constexpr std::uint64_t kMaxName = 4096;  // MATLAB names have at most 63 characters
 constexpr int kMaxDepth = 16;             // cells and structs nested deeper are refused
 constexpr std::uint64_t kMaxElements = 1ull << 40;
@@ -98,8 +99,8 @@ class Level5 {
     return true;
   }
 
-  // The contents of one miMATRIX element, [p, end); a top-level one (out set) is described
-  // in *out as it is checked.
+  // The contents of one miMATRIX element, [p, end), described in *out as it is checked (no
+  // description when out is null).
   bool matrix(const Byte* p, const Byte* end, const std::string& where0, int depth,
               MatVariable* out = nullptr) {
     if (p == end) return true;  // an empty array
@@ -113,6 +114,11 @@ class Level5 {
     const std::uint32_t cls = word & 0xff;
     const bool complex = (word & (1u << 11)) != 0;
     p += flags.total;
+    if (out) {
+      out->arrayClass = cls;
+      out->complex = complex;
+    }
+    if (cls == kOpaque) return opaque(p, end, where0, out);
     if (!tag(p, end, dims, where0)) return false;
     if (dims.type != kMiInt32 || dims.nbytes % 4 != 0 || dims.nbytes < 8 || dims.nbytes > 4 * 32)
       return fail(where0 + ": the dimensions are damaged");
@@ -126,19 +132,12 @@ class Level5 {
       if (count > kMaxElements) return fail(where0 + ": the array claims more elements than the file can hold");
     }
     p += dims.total;
-    if (!tag(p, end, name, where0)) return false;
-    if (name.type != kMiInt8 || name.nbytes > kMaxName)
-      return fail(where0 + ": the variable name is damaged or longer than 4096 characters");
-    if (!need(name.data, name.nbytes)) return false;
-    const std::string where =
-        name.nbytes ? "variable '" + std::string(reinterpret_cast<const char*>(name.data), name.nbytes) + "'"
-                    : where0;
+    std::string text;
+    if (!nameTag(p, end, where0, name, text)) return false;
+    const std::string where = name.nbytes ? "variable '" + text + "'" : where0;
     p += name.total;
     if (out) {
-      const auto* text = reinterpret_cast<const char*>(name.data);
-      out->name.assign(text, strnlen(text, name.nbytes));  // as matio reads it: up to a NUL
-      out->arrayClass = cls;
-      out->complex = complex;
+      if (name.nbytes) out->name = text;  // a field keeps the name its struct gives it
       out->elements = count;
     }
     const auto left = static_cast<std::uint64_t>(end - p);
@@ -146,7 +145,7 @@ class Level5 {
       case 1: {  // cell: count nested arrays
         if (count > left / 8) return fail(where + ": the cell array claims more cells than its bytes hold");
         for (std::uint64_t i = 0; i < count; ++i)
-          if (!nested(p, end, where, depth)) return false;
+          if (!nested(p, end, where, depth, child(out, {}))) return false;
         return true;
       }
       case 2: {  // struct: field-name length, names, then count * fields nested arrays
@@ -164,12 +163,26 @@ class Level5 {
         const auto rest = static_cast<std::uint64_t>(end - p);
         if (fields && count > rest / 8 / fields)
           return fail(where + ": the struct claims more fields than its bytes hold");
+        if (out && fields) {
+          if (fields > nodesLeft_) return fail(where + ": the struct has more fields than FlexArm lists");
+          if (!need(names.data, names.nbytes)) return false;
+          for (std::uint64_t f = 0; f < fields; ++f) {
+            const auto* n = reinterpret_cast<const char*>(names.data + f * l);
+            out->fields.emplace_back(n, strnlen(n, l));
+          }
+        }
         for (std::uint64_t i = 0; i < count * fields; ++i)
-          if (!nested(p, end, where, depth)) return false;
+          if (!nested(p, end, where, depth, child(out, out && fields ? out->fields[i % fields] : std::string())))
+            return false;
         return true;
       }
-      case 3: return fail(where + " is a MATLAB object, which FlexArm does not read; save the signals as numeric vectors");
-      case 5: return fail(where + " is a sparse matrix, which FlexArm does not read; save the signals as full numeric vectors");
+      case 3: {  // object: a struct with a class name, which FlexArm does not read
+        Tag className;
+        std::string classText;
+        if (!nameTag(p, end, where, className, classText)) return false;
+        return skip(out, "a MATLAB object of class " + classText);
+      }
+      case 5: return skip(out, "a sparse matrix (save the signals as full numeric vectors)");
       case 4: case 6: case 7: case 8: case 9: case 10: case 11: case 12: case 13: case 14: case 15: {
         for (int part = 0; part < (complex ? 2 : 1); ++part) {
           if (p == end && count == 0) return true;
@@ -188,16 +201,63 @@ class Level5 {
         }
         return true;
       }
-      default: return fail(where + ": an array class FlexArm does not read (function handle or opaque object)");
+      default: return skip(out, "an array class FlexArm does not read (a function handle or an opaque object)");
     }
   }
 
-  // One nested miMATRIX element at p; advances p.
-  bool nested(const Byte*& p, const Byte* end, const std::string& where, int depth) {
+  // An opaque object (class 17, as MATLAB stores classdef objects such as a Robotics Toolbox
+  // SerialLink): its name, type system and class name, then contents FlexArm does not read.
+  bool opaque(const Byte* p, const Byte* end, const std::string& where0, MatVariable* out) {
+    Tag name, system, className;
+    std::string text, systemText, classText;
+    if (!nameTag(p, end, where0, name, text)) return false;
+    p += name.total;
+    const std::string where = name.nbytes ? "variable '" + text + "'" : where0;
+    if (!nameTag(p, end, where, system, systemText)) return false;
+    p += system.total;
+    if (!nameTag(p, end, where, className, classText)) return false;
+    if (out && name.nbytes) out->name = text;
+    return skip(out, "a MATLAB object of class " + classText);
+  }
+
+  // A name tag (miINT8 text of at most kMaxName bytes) at p, its text up to a NUL as matio
+  // reads it.
+  bool nameTag(const Byte* p, const Byte* end, const std::string& where, Tag& t, std::string& text) {
+    if (!tag(p, end, t, where)) return false;
+    if (t.type != kMiInt8 || t.nbytes > kMaxName)
+      return fail(where + ": the variable name is damaged or longer than 4096 characters");
+    if (!need(t.data, t.nbytes)) return false;
+    const auto* chars = reinterpret_cast<const char*>(t.data);
+    text.assign(chars, strnlen(chars, t.nbytes));
+    return true;
+  }
+
+  // Marks the array described in out as skipped (what FlexArm does not read); always true.
+  static bool skip(MatVariable* out, const std::string& why) {
+    if (out) out->unreadable = why;
+    return true;
+  }
+
+  // The description of the next child of parent (a field named `name` or a cell), or null
+  // when parent is not described or the file has used up its listing budget.
+  MatVariable* child(MatVariable* parent, const std::string& name) {
+    if (!parent) return nullptr;
+    if (nodesLeft_ == 0) {
+      parent->childrenCut = true;
+      return nullptr;
+    }
+    --nodesLeft_;
+    parent->children.emplace_back();
+    parent->children.back().name = name;
+    return &parent->children.back();
+  }
+
+  // One nested miMATRIX element at p, described in out; advances p.
+  bool nested(const Byte*& p, const Byte* end, const std::string& where, int depth, MatVariable* out) {
     Tag t;
     if (!tag(p, end, t, where)) return false;
     if (t.type != kMiMatrix) return fail(where + ": a cell or field is not an array");
-    if (!matrix(t.data, t.data + t.nbytes, where, depth + 1)) return false;
+    if (!matrix(t.data, t.data + t.nbytes, where, depth + 1, out)) return false;
     p += t.total;
     return true;
   }
@@ -266,8 +326,13 @@ class Level5 {
 
  private:
   // A described variable joins the list (an empty miMATRIX element has nothing to describe).
+  // An unreadable one is named among the skipped.
   void keep(MatVariable&& v, bool any) {
-    if (any) found_.variables.push_back(std::move(v));
+    if (!any) return;
+    if (!v.unreadable.empty())
+      found_.skipped.push_back((v.name.empty() ? std::string("a nameless variable") : v.name) + " (" +
+                               v.unreadable + ")");
+    found_.variables.push_back(std::move(v));
   }
   bool fail(const std::string& text) {
     problem = text;
@@ -279,6 +344,7 @@ class Level5 {
   const Byte* base_;
   std::uint64_t size_;
   const MatLoad& load_;
+  std::uint64_t nodesLeft_ = MatCheck::kMaxNodes;
 };
 
 // Level 4: records of five int32 (type MOPT, rows, columns, imaginary flag, name length),

@@ -3,9 +3,9 @@
 // file states (a 48 KB file claiming 2^31 - 1 elements or a 2 GB variable name made it
 // allocate that much), so every size is first checked against the bytes that hold it: an
 // element may not reach past its parent or the end of the file, the elements of an array must
-// fit its data, a compressed variable may not inflate beyond a budget derived from the file's
-// size, and only what FlexArm can use is let through (numeric, logical, char, cell and struct
-// arrays; sparse matrices and objects are refused by name).
+// fit its data, and a compressed variable may not inflate beyond a budget derived from the
+// file's size. What FlexArm cannot read (MATLAB objects such as a Robotics Toolbox SerialLink,
+// sparse matrices, function handles) is skipped and named, so the rest of the file still reads.
 #include <cstdint>
 #include <functional>
 #include <memory>
@@ -17,18 +17,27 @@ namespace flexarm {
 
 enum class MatKind { Unknown, V4, V5, V73 };
 
-// A top-level variable of a level-5 file as the check found it: its array class (MATLAB's
-// numbering: 6 double, 7 single, 10 int16, 12 int32, ...; 1 cell, 2 struct, 4 char), its
-// dimensions, and for a numeric array where its real part lies. The data were checked to hold
-// at least the elements the dimensions claim.
+// A variable of a level-5 file (or a field or cell inside one) as the check found it: its
+// array class (MATLAB's numbering: 6 double, 7 single, 10 int16, 12 int32, ...; 1 cell,
+// 2 struct, 4 char), its dimensions, and for a numeric array where its real part lies. The
+// data were checked to hold at least the elements the dimensions claim.
 struct MatVariable {
-  std::string name;
+  std::string name;  // a field's name inside a struct; empty inside a cell
   std::uint32_t arrayClass = 0;
   bool complex = false;
   std::vector<std::uint64_t> dims;
   std::uint32_t dataType = 0;           // the level-5 number type the data are stored in
   const unsigned char* data = nullptr;  // into the file's bytes, or into MatCheck::inflated
   std::uint64_t elements = 0;
+  // A struct's field names; a struct's contents (elements x fields children, element by
+  // element, each element's fields in order) or a cell's (one child per cell). Not listed
+  // past MatCheck::kMaxNodes in a file: then childrenCut is set.
+  std::vector<std::string> fields;
+  std::vector<MatVariable> children;
+  bool childrenCut = false;
+  // Why FlexArm does not read this array ("a MATLAB object of class SerialLink", "a sparse
+  // matrix"); empty for what it reads. Such an array is skipped, not refused.
+  std::string unreadable;
 };
 
 struct MatCheck {
@@ -40,9 +49,12 @@ struct MatCheck {
   bool swapBytes = false;  // the file was written in the other byte order
   std::vector<MatVariable> variables;
   std::vector<std::unique_ptr<unsigned char[]>> inflated;  // bodies of compressed variables
-  // v7.3: variables the walk found but FlexArm cannot read (structs, cells, objects), named
-  // with their MATLAB class, for the reader's note.
+  // The variables skipped as unreadable (structs, cells, objects a log cannot be), each
+  // "NAME (why)", in file order; the reader names them in its note.
   std::vector<std::string> skipped;
+  // Fields and cells described at most, over the whole file (a hostile file of a million
+  // tiny cells is checked whole but not listed whole).
+  static constexpr std::uint64_t kMaxNodes = 200000;
 };
 
 // Bytes per element of a level-5 data type; 0 when the type holds no numbers.

@@ -2,6 +2,7 @@
 // user's column mapping, as the DaISy files come.
 #include <algorithm>
 #include <filesystem>
+#include <tuple>
 
 #include "core/io/input_file.h"
 #include "core/io/log_io.h"
@@ -12,9 +13,40 @@ namespace flexarm {
 using io::failure;
 using io::FieldStatus;
 
+namespace {
+
+// A column a mapping names in a headerless table: "column 3", "3" (1-based); 0 for empty.
+bool columnOf(const std::string& text, int& column, std::string* why) {
+  std::string t = io::trim(text);
+  if (t.empty()) return true;
+  if (t.rfind("column", 0) == 0) t = io::trim(std::string_view(t).substr(6));
+  double v = 0.0;
+  if (io::parseNumber(t, v) != FieldStatus::Ok || v != static_cast<int>(v) || v < 1 ||
+      v > LogReadOptions::kMaxColumns) {
+    if (why) *why = "'" + text + "' is not a column of a headerless table (write column 3, or 3)";
+    return false;
+  }
+  column = static_cast<int>(v);
+  return true;
+}
+
+}  // namespace
+
 LogReadResult readTableText(std::string_view text, const std::string& path,
-                            const LogReadOptions& options) {
+                            const LogReadOptions& given) {
   std::string why;
+  // Columns the mapping names ("column 3") take the place of the column numbers.
+  LogReadOptions options = given;
+  int armColumn = 0, refColumn = 0;
+  const LogMapping& m = given.mapping;
+  if (!columnOf(m.input, options.inputColumn, &why) || !columnOf(m.output, options.outputColumn, &why) ||
+      !columnOf(m.time, options.timeColumn, &why) || !columnOf(m.arm, armColumn, &why) ||
+      !columnOf(m.reference, refColumn, &why))
+    return failure(path, 0, 0, {}, "bad column mapping: " + why);
+  for (const int extra : {armColumn, refColumn})
+    if (extra && (extra == options.inputColumn || extra == options.outputColumn || extra == options.timeColumn ||
+                  armColumn == refColumn))
+      return failure(path, 0, 0, {}, "bad column mapping: the arm angle's or the reference's column is already used");
   if (!options.isValid(&why)) return failure(path, 0, 0, {}, "bad column mapping: " + why);
   if (std::string enc = textEncodingProblem(text); !enc.empty()) return failure(path, 1, 0, {}, enc);
   if (text.find_first_not_of(" \t\r\n") == std::string_view::npos)
@@ -47,7 +79,8 @@ LogReadResult readTableText(std::string_view text, const std::string& path,
         return failure(path, cursor.number(), 0, {},
                        "the table has more than " + std::to_string(maxColumns) +
                            " columns, more than FlexArm reads");
-      const int needed = std::max({options.inputColumn, options.outputColumn, options.timeColumn});
+      const int needed =
+          std::max({options.inputColumn, options.outputColumn, options.timeColumn, armColumn, refColumn});
       if (static_cast<int>(fields.size()) < needed)
         return failure(path, cursor.number(), 0, {},
                        "the table has " + std::to_string(fields.size()) +
@@ -98,9 +131,20 @@ LogReadResult readTableText(std::string_view text, const std::string& path,
                        allLines, options.timeColumn, "time", options, data, fail))
       return fail;
   }
+  MappedChannels found;
   for (std::size_t i = 0; i < cols.size(); ++i) {
     const int col = static_cast<int>(i + 1);
     if (col == options.timeColumn) continue;
+    const int index = static_cast<int>(data.channels.size());
+    const std::string source = "column " + std::to_string(col);
+    for (auto [column, slot, named] : {std::tuple<int, int*, std::string*>{options.inputColumn, &found.input, &found.inputSource},
+                                      {options.outputColumn, &found.output, &found.outputSource},
+                                      {armColumn, &found.arm, &found.armSource},
+                                      {refColumn, &found.reference, &found.referenceSource}})
+      if (col == column) {
+        *slot = index;
+        *named = source;
+      }
     Channel c;
     if (col == options.inputColumn) {
       c.name = options.inputName;
@@ -118,6 +162,8 @@ LogReadResult readTableText(std::string_view text, const std::string& path,
   data.setMeta("source", std::filesystem::path(path).filename().string());
   data.setMeta("format", "headerless table");
   LogReadResult ok;
+  if (m != LogMapping{} && !applyMapping(data, found, m, true, ok.warnings, &why))
+    return failure(path, 0, 0, {}, why);
   ok.ok = true;
   ok.data = std::move(data);
   return ok;

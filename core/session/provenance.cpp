@@ -27,7 +27,7 @@ std::string shortSum(const std::string& sum) {
 }  // namespace
 
 bool Provenance::operator==(const Provenance& o) const {
-  return log == o.log && sha256 == o.sha256 && preprocessing == o.preprocessing &&
+  return log == o.log && sha256 == o.sha256 && reading == o.reading && preprocessing == o.preprocessing &&
          estimation == o.estimation && validation == o.validation && when == o.when;
 }
 
@@ -44,6 +44,7 @@ Provenance sessionDataProvenance(const Session& session, const std::string& path
   Provenance p;
   p.log = std::filesystem::path(path).filename().string();
   p.sha256 = sum;
+  if (!session.logs.empty()) p.reading = describeMapping(session.logs.front().read.mapping);
   if (session.preprocessed) p.preprocessing = describePreprocessing(session.preprocess);
   p.estimation = session.estimation;
   p.validation = session.validation;
@@ -52,7 +53,7 @@ Provenance sessionDataProvenance(const Session& session, const std::string& path
 }
 
 bool sameData(const Provenance& a, const Provenance& b) {
-  return a.sha256 == b.sha256 && a.preprocessing == b.preprocessing;
+  return a.sha256 == b.sha256 && a.reading == b.reading && a.preprocessing == b.preprocessing;
 }
 
 std::string shortDescription(const Provenance& p) {
@@ -61,6 +62,11 @@ std::string shortDescription(const Provenance& p) {
 
 std::string longDescription(const Provenance& p) {
   std::string text = p.log + " (SHA-256 " + shortSum(p.sha256) + ", ";
+  if (!p.reading.empty()) {
+    text += "read with ";
+    for (std::size_t i = 0; i < p.reading.size(); ++i) text += (i ? ", " : "") + p.reading[i];
+    text += "; ";
+  }
   if (p.preprocessing.empty()) {
     text += "as read";
   } else {
@@ -76,18 +82,20 @@ std::string dataMismatch(const Provenance& result, const Provenance& open) {
   if (sameData(result, open)) return {};
   const bool sameLog = result.sha256 == open.sha256;
   return "computed on " + longDescription(result) + (result.when.empty() ? "" : " at " + result.when) +
-         (sameLog ? "; the open data are the same log preprocessed differently: "
+         (sameLog ? "; the open data are the same log read or preprocessed differently: "
                   : "; the open log is ") +
          longDescription(open);
 }
 
 json provenanceToJson(const Provenance& p) {
-  return {{"log", p.log},
-          {"sha256", p.sha256},
-          {"preprocessing", p.preprocessing},
-          {"estimation_s", secondsRangeToJson(p.estimation)},
-          {"validation_s", secondsRangeToJson(p.validation)},
-          {"when", p.when}};
+  json j = {{"log", p.log},
+            {"sha256", p.sha256},
+            {"preprocessing", p.preprocessing},
+            {"estimation_s", secondsRangeToJson(p.estimation)},
+            {"validation_s", secondsRangeToJson(p.validation)},
+            {"when", p.when}};
+  if (!p.reading.empty()) j["reading"] = p.reading;
+  return j;
 }
 
 std::optional<Provenance> provenanceFromJson(const json& j, std::string* why) {
@@ -100,13 +108,15 @@ std::optional<Provenance> provenanceFromJson(const json& j, std::string* why) {
   if (!readText(j, "log", p.log, true, why, where) || !readText(j, "sha256", p.sha256, true, why, where) ||
       !readText(j, "when", p.when, false, why, where))
     return std::nullopt;
-  if (j.contains("preprocessing")) {
-    const json& steps = j["preprocessing"];
+  for (const auto& [key, list] : {std::pair<const char*, std::vector<std::string>*>{"preprocessing", &p.preprocessing},
+                                   {"reading", &p.reading}}) {
+    if (!j.contains(key)) continue;
+    const json& steps = j[key];
     if (!steps.is_array() || !std::all_of(steps.begin(), steps.end(), [](const json& s) { return s.is_string(); })) {
-      if (why) *why = where + "preprocessing must be a list of steps";
+      if (why) *why = where + key + " must be a list of steps";
       return std::nullopt;
     }
-    for (const auto& s : steps) p.preprocessing.push_back(s.get<std::string>());
+    for (const auto& s : steps) list->push_back(s.get<std::string>());
   }
   std::string rangeWhy;
   if (!readSecondsRange(j, "estimation_s", p.estimation, &rangeWhy) ||

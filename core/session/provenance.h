@@ -17,6 +17,9 @@ namespace flexarm {
 struct Provenance {
   std::string log;     // the log's file name, e.g. "chirp.csv"
   std::string sha256;  // of the log file's contents
+  // How the log was read when it is not a FlexArm log read as it is: which variables or
+  // columns, their units, sides, gear ratio and input scale (describeMapping).
+  std::vector<std::string> reading;
   // The preprocessing steps in words (describePreprocessing), empty: the log as read.
   std::vector<std::string> preprocessing;
   std::optional<SecondsRange> estimation, validation;
@@ -32,7 +35,8 @@ std::string utcNow();
 // checksum sum), its preprocessing and ranges; `when` is now.
 Provenance sessionDataProvenance(const Session& session, const std::string& path, const std::string& sum);
 
-// True when a and b are the same signal: the same log contents preprocessed the same way.
+// True when a and b are the same signal: the same log contents read and preprocessed the same
+// way.
 // Ranges are not compared: every result names the ranges it used and replays them itself.
 bool sameData(const Provenance& a, const Provenance& b);
 
@@ -46,7 +50,8 @@ std::string longDescription(const Provenance& p);
 // in full (file names, checksums, preprocessing).
 std::string dataMismatch(const Provenance& result, const Provenance& open);
 
-// {"log", "sha256", "preprocessing": [..], "estimation_s", "validation_s", "when"}.
+// {"log", "sha256", "reading": [..] (when mapped), "preprocessing": [..], "estimation_s",
+// "validation_s", "when"}.
 nlohmann::json provenanceToJson(const Provenance& p);
 // The provenance in j; nullopt with a sentence naming the problem.
 std::optional<Provenance> provenanceFromJson(const nlohmann::json& j, std::string* why);

@@ -108,6 +108,16 @@ ReportSection dataSection(const Session& session, const PreparedSession& prepare
                         {"rate_hz", l.raw.sampleRateHz()}, {"sha256", l.sha256}});
   }
   s.tables.push_back(logs);
+  // How each log was read when it is not a FlexArm log read as it is, and what was assumed.
+  for (std::size_t i = 0; i < session.logs.size() && i < prepared.logs.size(); ++i) {
+    const std::vector<std::string> reading = describeMapping(session.logs[i].read.mapping);
+    std::string text;
+    for (const auto& r : reading) text += (text.empty() ? "" : "; ") + r;
+    if (!text.empty()) s.paragraphs.push_back("Log '" + prepared.logs[i].name + "' read with " + text + ".");
+    if (const std::string assumed = prepared.logs[i].raw.meta("assumed"); !assumed.empty())
+      s.paragraphs.push_back("Log '" + prepared.logs[i].name + "', not said and so assumed: " + assumed + ".");
+    if (i == 0 && !reading.empty()) s.values["reading"] = reading;
+  }
   const IdData& d = prepared.logs.front().data;
   ReportTable channels{"Channels of '" + prepared.logs.front().name + "' as analysed",
                        {"Channel", "Unit", "Role"}, {}};

@@ -93,12 +93,24 @@ bool rangeFromJson(const json& v, const std::string& where, std::optional<Second
 }
 
 json readOptionsToJson(const LogReadOptions& o) {
-  return {{"format", toString(o.format)},       {"input_column", o.inputColumn},
-          {"output_column", o.outputColumn},    {"time_column", o.timeColumn},
-          {"sample_time_s", o.sampleTime},      {"input_name", o.inputName},
-          {"output_name", o.outputName},        {"input_variable", o.inputVariable},
-          {"output_variable", o.outputVariable}, {"max_sample_jitter", o.maxSampleJitter},
-          {"keep_irregular_time", o.keepIrregularTime}};
+  const LogMapping& m = o.mapping;
+  json j = {{"format", toString(o.format)},    {"input_column", o.inputColumn},
+            {"output_column", o.outputColumn}, {"time_column", o.timeColumn},
+            {"sample_time_s", o.sampleTime},   {"input_name", o.inputName},
+            {"output_name", o.outputName},     {"input_variable", m.input},
+            {"output_variable", m.output},     {"max_sample_jitter", o.maxSampleJitter},
+            {"keep_irregular_time", o.keepIrregularTime}};
+  // The mapping's units, sides and gear ratio: written only when said, so that a session of a
+  // FlexArm log reads as before.
+  if (!m.time.empty()) j["time_variable"] = m.time;
+  if (!m.arm.empty()) j["arm_variable"] = m.arm;
+  if (!m.reference.empty()) j["reference_variable"] = m.reference;
+  if (m.outputUnit) j["output_unit"] = toString(*m.outputUnit);
+  if (m.armUnit) j["arm_unit"] = toString(*m.armUnit);
+  if (m.outputSide) j["output_side"] = toString(*m.outputSide);
+  if (!m.gearRatio.empty()) j["gear_ratio"] = m.gearRatio;
+  if (m.inputScale != 1.0) j["input_scale"] = m.inputScale;
+  return j;
 }
 
 bool readOptionsFromJson(const json& j, const std::string& where, LogReadOptions& o,
@@ -118,8 +130,26 @@ bool readOptionsFromJson(const json& j, const std::string& where, LogReadOptions
   f.number(j, "sample_time_s", where, o.sampleTime, false);
   f.string(j, "input_name", where, o.inputName, false);
   f.string(j, "output_name", where, o.outputName, false);
-  f.string(j, "input_variable", where, o.inputVariable, false);
-  f.string(j, "output_variable", where, o.outputVariable, false);
+  LogMapping& m = o.mapping;
+  f.string(j, "input_variable", where, m.input, false);
+  f.string(j, "output_variable", where, m.output, false);
+  f.string(j, "time_variable", where, m.time, false);
+  f.string(j, "arm_variable", where, m.arm, false);
+  f.string(j, "reference_variable", where, m.reference, false);
+  for (const auto& [key, unit] : {std::pair<const char*, std::optional<SignalUnit>*>{"output_unit", &m.outputUnit},
+                                  {"arm_unit", &m.armUnit}}) {
+    std::string text;
+    f.string(j, key, where, text, false);
+    if (text.empty()) continue;
+    *unit = signalUnitFromString(text);
+    if (!*unit) return f.fail(where + "." + key, "unknown unit '" + text + "'");
+  }
+  std::string side;
+  f.string(j, "output_side", where, side, false);
+  if (!side.empty() && !(m.outputSide = encoderSideFromString(side)))
+    return f.fail(where + ".output_side", "must be motor or arm, not '" + side + "'");
+  f.string(j, "gear_ratio", where, m.gearRatio, false);
+  f.number(j, "input_scale", where, m.inputScale, false);
   f.number(j, "max_sample_jitter", where, o.maxSampleJitter, false);
   f.boolean(j, "keep_irregular_time", where, o.keepIrregularTime, false);
   if (f.failed()) return false;

@@ -25,8 +25,8 @@ struct Emps {
 // (gtau = 35.15 N/V, stored in the file).
 Emps readEmps(const std::string& file) {
   LogReadOptions o;
-  o.inputVariable = "vir";
-  o.outputVariable = "qm";
+  o.mapping.input = "vir";
+  o.mapping.output = "qm";
   o.sampleTime = 1e-3;
   const LogReadResult r = readLog(std::string(FLEXARM_TEST_DATA_DIR) + "/emps/" + file, o);
   EXPECT_TRUE(r.ok) << r.error.toString();

@@ -233,7 +233,7 @@ TEST(LogIo, MatFileWithFlexArmNames) {
   EXPECT_TRUE(r.data.isClosedLoop());
   // The same file with the user naming a variable that is not there.
   LogReadOptions o;
-  o.outputVariable = "arm_angle";
+  o.mapping.output = "arm_angle";
   LogReadResult m = readLog(p.string(), o);
   ASSERT_FALSE(m.ok);
   EXPECT_EQ(m.error.columnName, "arm_angle");
@@ -274,15 +274,15 @@ TEST(LogIo, MatFileWithoutTimeAsksForTheSampleTimeAndNamesItsVariables) {
   writeMat(p, {{"tau", u}, {"motor_speed", v}});
   LogReadOptions o;
   o.sampleTime = 0.0005;
-  o.inputVariable = "tau";
-  o.outputVariable = "velocity";  // not in the file
+  o.mapping.input = "tau";
+  o.mapping.output = "velocity";  // not in the file
   r = readLog(p.string(), o);
   ASSERT_FALSE(r.ok);
   EXPECT_FALSE(r.needsSampleTime);
   EXPECT_NE(r.error.problem.find("the file holds tau, motor_speed"), std::string::npos) << r.error.problem;
 
   // --output-name picks the variable of that name and names the channel; --input-name renames.
-  o.outputVariable.clear();
+  o.mapping.output.clear();
   o.outputName = "motor_speed";
   o.inputName = columns::kTorqueRef;
   r = readLog(p.string(), o);
@@ -294,7 +294,7 @@ TEST(LogIo, MatFileWithoutTimeAsksForTheSampleTimeAndNamesItsVariables) {
   EXPECT_EQ(r.data.input()->name, columns::kTorqueRef);
   EXPECT_EQ(r.data.channels.size(), 2u);
   // A variable and a channel name of the user's choice.
-  o.outputVariable = "motor_speed";
+  o.mapping.output = "motor_speed";
   o.outputName = columns::kMotorVelocity;
   r = readLog(p.string(), o);
   ASSERT_TRUE(r.ok) << r.error.toString();

@@ -167,17 +167,17 @@ TEST(MatRead, NonFiniteElementsMatricesAndTextAreRefusedByName) {
       << r.error.problem;
 
   LogReadOptions o;
-  o.outputVariable = "grid";
+  o.mapping.output = "grid";
   r = readLog(p.string(), o);
   ASSERT_FALSE(r.ok);
   EXPECT_EQ(r.error.columnName, "grid");
-  EXPECT_NE(r.error.problem.find("must be a real vector"), std::string::npos) << r.error.problem;
+  EXPECT_NE(r.error.problem.find("is a 100 x 2 array: name a row or a column, e.g. grid(1,:)"), std::string::npos) << r.error.problem;
 
-  o.outputVariable = "note";
+  o.mapping.output = "note";
   r = readLog(p.string(), o);
   ASSERT_FALSE(r.ok);
   EXPECT_EQ(r.error.columnName, "note");
-  EXPECT_NE(r.error.problem.find("not a numeric vector"), std::string::npos) << r.error.problem;
+  EXPECT_NE(r.error.problem.find("is a 1 x 5 char array, not numbers"), std::string::npos) << r.error.problem;
 
   // With a finite y the matrix and the text are not channels, and the rest reads.
   y[57] = 57.0;
