@@ -96,13 +96,20 @@ std::unique_ptr<FleetStore> FleetStore::open(const std::string& path, bool writa
   if (exists && !std::filesystem::is_regular_file(path, ec)) return fail("not a regular file");
   if (!exists && !writable) return fail("no such store");
   if (writable) {
+    // A store is written in place, so neither it nor its lock may be a link planted to send
+    // the writes elsewhere (SQLITE_OPEN_NOFOLLOW below, O_NOFOLLOW here).
+    if (std::filesystem::is_symlink(std::filesystem::symlink_status(path, ec)))
+      return fail("is a symbolic link; FlexArm writes only regular files and does not follow a link");
     const std::string lock = path + ".writer";
-    store->lockFd_ = ::open(lock.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+    store->lockFd_ = ::open(lock.c_str(), O_RDWR | O_CREAT | O_NOFOLLOW | O_CLOEXEC, 0644);
+    if (store->lockFd_ < 0 && errno == ELOOP)
+      return fail("the writer lock " + lock + " is a symbolic link; FlexArm does not follow it");
     if (store->lockFd_ < 0) return fail("cannot create the writer lock " + lock + ": " + std::strerror(errno));
     if (::flock(store->lockFd_, LOCK_EX | LOCK_NB) != 0)
       return fail("another flexarm fleet is writing to this store (it holds " + lock + "); one writer at a time");
   }
-  const int flags = writable ? (SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE) : SQLITE_OPEN_READONLY;
+  const int flags =
+      writable ? (SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE | SQLITE_OPEN_NOFOLLOW) : SQLITE_OPEN_READONLY;
   if (sqlite3_open_v2(path.c_str(), &store->db_, flags | SQLITE_OPEN_NOMUTEX, nullptr) != SQLITE_OK)
     return fail("cannot open the store: " + errorOf(store->db_));
   sqlite3_busy_timeout(store->db_, 10000);

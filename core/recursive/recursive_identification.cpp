@@ -84,6 +84,10 @@ InitialCovariance steadyStateCovariance(const ParametricModel& nominal, const Ei
     throw std::invalid_argument("recursive identification: input and output must have the same "
                                 "number of samples");
   InitialCovariance r;
+  if (std::string bad = sampleTimeProblem(design, T); !bad.empty()) {
+    r.message = bad + ".";
+    return r;
+  }
   // psi at the nominal theta: the estimator with theta held (P does not matter here).
   const RecursiveOptions options = perSample(design, T, resolveParameters(nominal, design));
   RecursiveOptions pre = options;
@@ -181,6 +185,10 @@ RecursiveStart startRecursive(const ParametricModel& nominal, const Eigen::Vecto
   start.failed.sampleTime = T;
   if (const std::string bad = nonFinite(u, y, T, startTime); !bad.empty()) {
     start.failed.message = bad;
+    return start;
+  }
+  if (const std::string bad = sampleTimeProblem(options, T); !bad.empty()) {
+    start.failed.message = bad + ".";
     return start;
   }
   RecursiveOptions o = options;

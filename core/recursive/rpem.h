@@ -153,6 +153,11 @@ struct RecursiveParameter {
 // values). Throws std::invalid_argument as kalmanR1 does.
 RecursiveOptions perSample(const RecursiveOptions& options, double sampleTime,
                            const std::vector<RecursiveParameter>& params);
+// Empty when the estimator can run on data sampled every sampleTime; otherwise a sentence: a
+// sample time longer than the memory 1 / (1 - lambda) of the forgetting factor (each sample
+// would forget every one before it), or one so long that lambda^(T / designSampleTime)
+// underflows (a log with a sample step of 1e6 s).
+std::string sampleTimeProblem(const RecursiveOptions& options, double sampleTime);
 // What lambda and R1 are given per, in words: "per 200 Hz sample" (or "per sample").
 std::string designRateText(const RecursiveOptions& options);
 

@@ -1,5 +1,6 @@
 // Names, option checks and the trajectory container of the recursive estimator.
 #include <cmath>
+#include <limits>
 
 #include "core/recursive/rpem.h"
 #include "core/recursive/theta.h"
@@ -103,6 +104,25 @@ RecursiveOptions perSample(const RecursiveOptions& options, double sampleTime,
   }
   o.designSampleTime = 0.0;
   return o;
+}
+
+std::string sampleTimeProblem(const RecursiveOptions& options, double sampleTime) {
+  if (!(options.designSampleTime > 0.0) || !(sampleTime > options.designSampleTime)) return {};
+  const std::string at = "The sample time of " + formatNumber(sampleTime) + " s";
+  if (options.algorithm == RecursiveAlgorithm::ForgettingFactor && options.lambda < 1.0) {
+    const double memory = options.designSampleTime / (1.0 - options.lambda);  // s, of (6.13)
+    if (sampleTime > memory)
+      return at + " is longer than the recursive estimator's memory of " + formatNumber(memory) +
+             " s (lambda " + formatNumber(options.lambda) + " " + designRateText(options) +
+             "): each sample would forget every sample before it; the log needs a sample at least every " +
+             formatNumber(memory) + " s";
+  }
+  const double ratio = sampleTime / options.designSampleTime;
+  for (double lambda : {options.lambda, options.lambdaMin})
+    if (!(std::pow(lambda, ratio) >= std::numeric_limits<double>::min()))
+      return at + " makes the forgetting factor " + formatNumber(lambda) + " " + designRateText(options) +
+             " vanish (" + formatNumber(lambda) + "^" + formatNumber(ratio) + " is zero in double precision)";
+  return {};
 }
 
 std::string designRateText(const RecursiveOptions& options) {

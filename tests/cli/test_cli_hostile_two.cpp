@@ -91,6 +91,17 @@ TEST(HostileTwo, DiagnosisOnADeadReferenceLogIsRefusedNotCrashed) {
                  3, "too small for its squares to be told from zero", 300);
 }
 
+TEST(HostileTwo, SessionDiagnosisOnADeadLogWarnsInsteadOfCrashing) {
+  // `flexarm run` of a session holding such a diagnosis died the same way.
+  const fs::path session = flexarm::test::scratchDir() / "dead_reference.json";
+  writeSession(session, "stuck", hostile("dead_stuck_encoder.csv"),
+               R"({"diagnosis": {"request": {"log": "stuck", "reference_log": "stuck", "structure": "three-mass",
+                                             "seed_fault": null, "calibrate": false}}})");
+  const MeasuredRun r = confined({"run", session.string(), "--json"});
+  expectConfined(r, 0, "flexarm run: warning: diagnosis: could not run: ", 300);
+  EXPECT_NE(r.err.find("the channel motor_angle_rad carries no signal"), std::string::npos) << r.err;
+}
+
 TEST(HostileTwo, SingularReferenceFitEndsAsASentence) {
   // A time step of 1e6 s leaves the parameters unidentifiable: the fit's Hessian is singular
   // and gives no covariance, which the thresholds need.
@@ -231,13 +242,20 @@ TEST(HostileTwo, ResampleRateBeyondTheBudgetIsRefusedBeforeAllocating) {
 
 TEST(HostileTwo, HugeTimeStepEndsInsteadOfLooping) {
   // A time step of 1e6 s made ExtendedZoh::advance take billions of sub-steps a sample.
-  // The recursive estimator's pre-run for P(0) finds nothing to tell apart at that step
-  // (ExtendedZoh's own refusal is tested in tests/core/recursive/test_extended_zoh.cpp).
+  // The recursive estimator forgets with a memory of one second, so a step of 1e6 s is refused
+  // before its pre-run for P(0) (ExtendedZoh's own refusal is tested in
+  // tests/core/recursive/test_extended_zoh.cpp).
   expectConfined(confined({"recursive", hostile("time_step_1e6.csv"), "--model", "two-mass"}), 3,
+                 "time_step_1e6.csv: The sample time of 1e+06 s is longer than the recursive estimator's memory of 1 s",
+                 200);
+  // Given per sample, the forgetting factor keeps its memory of 200 samples; the pre-run then
+  // finds nothing to tell apart at that step.
+  expectConfined(confined({"recursive", hostile("time_step_1e6.csv"), "--model", "two-mass", "--per-sample"}), 3,
                  "time_step_1e6.csv: The data cannot tell the estimated parameters apart", 200);
   const MeasuredRun d = confined({"diagnose", hostile("time_step_1e6.csv"), "--model", "three-mass"});
   EXPECT_FALSE(d.timedOut);
   EXPECT_TRUE(d.code == 3 || d.code == 4) << d.err;
+  EXPECT_EQ(d.err.find("forgetting factor must lie"), std::string::npos) << d.err;  // no option was wrong
   EXPECT_TRUE(d.outsideAccess.empty()) << joined(d.outsideAccess);
 }
 
@@ -287,6 +305,25 @@ TEST(HostileTwo, WritersDoNotFollowPlantedLinks) {
   }
   EXPECT_EQ(ok.creations[0].find((dir / ".log.csv.tmp-").string()), 0u) << ok.creations[0];
   EXPECT_EQ(ok.creations[0].find(' '), (dir / ".log.csv.tmp-").string().size() + 16) << ok.creations[0];
+}
+
+TEST(HostileTwo, FleetStoreDoesNotFollowPlantedLinks) {
+  // The fleet's SQLite store is written in place, not replaced: a link at its name or at its
+  // writer lock would send those writes to the link's target.
+  const fs::path dir = flexarm::test::scratchDir() / "store_links";
+  fs::create_directories(dir);
+  const fs::path victim = dir / "victim.txt";
+  { std::ofstream(victim) << "keep me\n"; }
+  const fs::path manifest = dir / "fleet.csv";
+  { std::ofstream(manifest) << "# flexarm-fleet: 1\nrobot,axis,time,log\nR01,1,2026-03-01T06:00:00Z," << kHealthy << "\n"; }
+  fs::create_symlink(victim, dir / "linked.sqlite");
+  expectConfined(confined({"fleet", manifest.string(), "--db", (dir / "linked.sqlite").string()}), 3,
+                 "linked.sqlite: is a symbolic link; FlexArm writes only regular files", 100);
+  fs::create_symlink(victim, dir / "locked.sqlite.writer");
+  expectConfined(confined({"fleet", manifest.string(), "--db", (dir / "locked.sqlite").string()}), 3,
+                 "the writer lock " + (dir / "locked.sqlite.writer").string() + " is a symbolic link", 100);
+  EXPECT_FALSE(fs::exists(dir / "locked.sqlite"));
+  EXPECT_EQ(flexarm::test::readAll(victim.string()), "keep me\n");
 }
 
 #if FLEXARM_GUI_BUILD

@@ -6,6 +6,7 @@
 
 #include "core/ident/pem.h"
 #include "core/recursive/extended_zoh.h"
+#include "core/recursive/rpem.h"
 #include "recursive_helpers.h"
 
 namespace flexarm {
@@ -116,6 +117,29 @@ TEST(ExtendedZoh, ASampleFarLongerThanTheModelsTimeScaleIsRefusedNotIntegrated) 
   zoh.advance(ss.A, ss.B.col(0), {}, {}, 0.005, 1.0, x, none);
   EXPECT_EQ(zoh.tooLongSubsteps(), 0.0);
   EXPECT_TRUE(x.allFinite());
+}
+
+TEST(ExtendedZoh, ASampleLongerThanTheEstimatorsMemoryIsRefusedWithASentence) {
+  // lambda = 0.995 per 200 Hz sample (6.13) remembers 1 s: a coarser log is refused before the
+  // forgetting factor is carried to its rate (at 1e6 s it underflowed to 0 and was reported as a
+  // wrong option the user never gave).
+  RecursiveOptions o;
+  EXPECT_EQ(sampleTimeProblem(o, 0.005), "");
+  EXPECT_EQ(sampleTimeProblem(o, 0.5), "");
+  EXPECT_EQ(sampleTimeProblem(o, 1.0), "");
+  const std::string coarse = sampleTimeProblem(o, 2.0);
+  EXPECT_NE(coarse.find("The sample time of 2 s is longer than the recursive estimator's memory of 1 s"),
+            std::string::npos)
+      << coarse;
+  // Per sample, the memory is 200 samples whatever the step.
+  o.designSampleTime = 0.0;
+  EXPECT_EQ(sampleTimeProblem(o, 1e6), "");
+  // The Kalman gain has no memory to outlast, but a lowest forgetting factor carried to 1e6 s
+  // still vanishes.
+  o.designSampleTime = 0.005;
+  o.algorithm = RecursiveAlgorithm::Kalman;
+  EXPECT_EQ(sampleTimeProblem(o, 2.0), "");
+  EXPECT_NE(sampleTimeProblem(o, 1e6).find("is zero in double precision"), std::string::npos);
 }
 
 }  // namespace
