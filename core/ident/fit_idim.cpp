@@ -103,8 +103,11 @@ void idimStart(FitOptions& o, FitResult& r) {
         v.name.rfind("theta", 0) == 0)
       return;  // the user chose start values of the dynamics
   if (model.structureName() == "two-mass-theta") return;
+  // Only a logged motor angle: an output of another kind (an acceleration, a velocity) is no
+  // position to differentiate.
+  const bool angle = r.data.angle.size() == r.data.u.size() || r.data.outputName == columns::kMotorAngle;
   Eigen::VectorXd q, tau, ref;
-  if (!positionAndTorque(r.data, q, tau, ref)) return;
+  if (!angle || !positionAndTorque(r.data, q, tau, ref)) return;
   std::shared_ptr<PhysicalModel> start;
   try {
     start = fitStartModel(o);
