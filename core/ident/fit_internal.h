@@ -29,9 +29,10 @@ void fitNonlinear(const FitOptions& options, FitResult& result, const ProgressCa
 void keepNonlinear(NonlinearPemResult&& estimate, const FitOptions& options, const PhysicalModel& start,
                    FitResult& result);
 
-// One experiment of prepared data over range as the nonlinear estimator sees it: the output
-// the model gives (velocity or angle), the logged angle when there is one, and a start in
-// rigid-body motion at the speed of the range's first sample.
+// One experiment of prepared data over range as the nonlinear estimator sees it
+// (nonlinearSeries of nonlinear_pem.h, the output the model gives: velocity or angle), and the
+// estimator's options: on closed-loop data the predictor discovery uses (a load observer,
+// the predicted angle differentiated as the logged one was).
 NonlinearSeries nonlinearSeries(const FitResult& result, const PreparedData& data, SampleRange range);
 NonlinearPemOptions nonlinearOptions(const FitOptions& options, const FitResult& result);
 

@@ -8,30 +8,38 @@
 
 namespace flexarm::fit_detail {
 
+namespace {
+bool angleOutput(const FitResult& r) {
+  return r.model.start && r.model.start->options().output == ModelOutput::MotorAngle;
+}
+}  // namespace
+
 NonlinearPemOptions nonlinearOptions(const FitOptions& o, const FitResult& r) {
   NonlinearPemOptions no;
   no.smoothingSpeed = r.smoothingSpeed;
   no.maxIterations = o.maxIterations;
   no.level = o.level;
-  no.output = o.model.start && o.model.start->options().output == ModelOutput::MotorAngle
-                  ? PredictedOutput::MotorAngle
+  // A velocity differentiated from the angle at the fit's rate is compared with the predicted
+  // angle through the same central differences; a logged velocity, or one decimated behind
+  // the anti-alias filter, with the velocity state.
+  no.output = angleOutput(r) ? PredictedOutput::MotorAngle
+              : r.data.differentiated && r.data.decimation == 1 && r.data.angle.size() > 0
+                  ? PredictedOutput::DifferentiatedAngle
                   : PredictedOutput::MotorVelocity;
+  // A closed-loop log carries a load torque on the arm that the controller answers: the
+  // observer keeps the simulation on the measured operating point, as in discovery.
+  // Not with the arm as an output: the deflection the arm encoder measures is to be predicted
+  // from the logged torque alone, and an observer's torque would pass through the spring.
+  no.observerBandwidthHz = r.data.closedLoop && !o.model.armOutput ? kClosedLoopObserverHz : 0.0;
   return no;
 }
 
 NonlinearSeries nonlinearSeries(const FitResult& r, const PreparedData& d, SampleRange range) {
-  NonlinearSeries s;
-  const auto b = static_cast<Eigen::Index>(range.begin), n = static_cast<Eigen::Index>(range.size());
-  s.Ts = d.sampleTime;
-  s.startTime = d.timeAt(range.begin);
-  s.u.assign(d.u.data() + b, d.u.data() + b + n);
-  s.y.assign(d.y.data() + b, d.y.data() + b + n);
-  const bool angleOut = r.model.start && r.model.start->options().output == ModelOutput::MotorAngle;
-  if (angleOut) s.phi = s.y;
-  else if (d.angle.size() == d.u.size()) s.phi.assign(d.angle.data() + b, d.angle.data() + b + n);
-  // The start in rigid-body motion at the first sample's speed.
-  if (angleOut) s.initialSpeed = n > 1 ? (s.y[1] - s.y[0]) / s.Ts : 0.0;
-  else s.initialSpeed = n > 0 ? s.y[0] : 0.0;
+  NonlinearSeries s = flexarm::nonlinearSeries(d, range, angleOutput(r));
+  // With the arm as an output the whole motion comes from the torque: a motor angle reset to
+  // the measured one each sample would hand the measurement to the gravity torque
+  // m g l sin(phi_a + phi_0) (and on KUKA axes 2 and 3 it takes the fit to a skew of 12 ms).
+  if (r.model.armOutput) s.resetAngle = false;
   return s;
 }
 
@@ -67,7 +75,8 @@ bool outputNoise(const PhysicalModel& model, const std::vector<Effect>& effects,
     for (const auto& s : ex) {
       std::vector<double> yhat, d;
       const int substeps = no.substeps > 0 ? no.substeps : defaultSubsteps(s.Ts);
-      if (!predictOutput(plant, s, substeps, {}, no.output, yhat, nullptr, &d)) return false;
+      if (!predictOutput(plant, s, substeps, loadObserver(model, no.observerBandwidthHz), no.output, yhat, nullptr, &d))
+        return false;
       double md = 0.0, mp = 0.0;
       for (std::size_t k = 0; k < d.size(); ++k) md += s.deflection[k], mp += d[k];
       md /= static_cast<double>(d.size());
@@ -157,7 +166,12 @@ void keepNonlinear(NonlinearPemResult&& e, const FitOptions& o, const PhysicalMo
   if (r.data.closedLoop) {
     r.method = ClosedLoopMethod::Direct;
     r.methodDescription = "direct fit of closed-loop data";
-    r.methodReason = "a fit with effects simulates the plant from the measured torque";
+    char reason[160];
+    std::snprintf(reason, sizeof reason,
+                  "a fit with effects simulates the plant from the measured torque, through a %g Hz load "
+                  "observer as discovery does",
+                  nonlinearOptions(o, r).observerBandwidthHz);
+    r.methodReason = reason;
   }
   std::size_t row = 0;
   for (; row < e.model->parameters().size(); ++row) {
