@@ -166,11 +166,17 @@ void keepNonlinear(NonlinearPemResult&& e, const FitOptions& o, const PhysicalMo
   if (r.data.closedLoop) {
     r.method = ClosedLoopMethod::Direct;
     r.methodDescription = "direct fit of closed-loop data";
-    char reason[160];
-    std::snprintf(reason, sizeof reason,
-                  "a fit with effects simulates the plant from the measured torque, through a %g Hz load "
-                  "observer as discovery does",
-                  nonlinearOptions(o, r).observerBandwidthHz);
+    const double observer = nonlinearOptions(o, r).observerBandwidthHz;
+    char reason[200];
+    if (observer > 0.0)
+      std::snprintf(reason, sizeof reason,
+                    "a fit with effects simulates the plant from the measured torque, through a %g Hz load "
+                    "observer as discovery does",
+                    observer);
+    else
+      std::snprintf(reason, sizeof reason,
+                    "a fit with effects simulates the plant from the measured torque alone (no load observer: "
+                    "the arm encoder's deflection is fitted too)");
     r.methodReason = reason;
   }
   std::size_t row = 0;
