@@ -742,6 +742,7 @@ void FitPanel::onFinished() {
                  .arg(r.deflection->fitPercentNrmse.value_or(NAN), 0, 'f', 1)
                  .arg(1e3 * r.deflection->skewSeconds, 0, 'g', 3);
   for (const auto& w : r.plausibility) lines << tr("Implausible: %1.").arg(QString::fromStdString(w));
+  if (!r.idimNote.empty()) lines << tr("Start: %1.").arg(QString::fromStdString(r.idimNote));
   for (const auto& w : r.warnings) lines << tr("Note: %1.").arg(QString::fromStdString(w));
   // The estimate joins the shared list under a name no other entry has, naming its data:
   // "three-mass estimate 2 (chirp.csv 0.5-12 s)".

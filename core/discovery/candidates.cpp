@@ -201,7 +201,7 @@ int addEffectCoordinates(NonlinearProblem& pr, int index, const EffectBounds& bo
       pr.coords.push_back(effectCoordinate(index, 1, CoordinateMap::Fraction, e.kind));
       return 0;
     }
-    default: break;  // not a discovery candidate (DiscoveryOptions::isValid)
+    default: break;  // not a candidate (DiscoveryOptions::isValid)
   }
   return 0;
 }
@@ -278,7 +278,7 @@ void fitCandidate(const Context& ctx, EffectKind kind, const ModelFit& current, 
         }
         break;
       }
-      default:  // not a discovery candidate (DiscoveryOptions::isValid): one start, the default
+      default:  // not a candidate (DiscoveryOptions::isValid)
         starts.push_back(e0);
         break;
     }

@@ -37,7 +37,7 @@ std::string signatureText(EffectKind k) {
       return "the residual lines at n times the motor angle (the response to A sin(n phi_m))";
     case EffectKind::ExtraMass:
       return "the residual against the resonance shift of an added mass at omega";
-    default: break;  // not a discovery candidate (DiscoveryOptions::isValid)
+    default: break;  // not a candidate (DiscoveryOptions::isValid)
   }
   return toString(k);
 }
@@ -114,7 +114,7 @@ Confirmation confirmEffect(const Context& ctx, const ModelFit& current, const Mo
   if (!signature(*fitted, size)) return C;
   // Rivals: every other effect the current model lacks, at the values its own candidate fit
   // found this round (ripple and a mass need those: a period count, a frequency).
-  for (EffectKind k : allEffectKinds()) {
+  for (EffectKind k : seedEffectKinds()) {
     if (k == kind || hasEffect(current.effects, k)) continue;
     if (gearEffect(k) && !hasGearSpring(*current.model)) continue;
     if (k == EffectKind::ExtraMass && structureWith(*current.model, current.effects) == "four-mass") continue;

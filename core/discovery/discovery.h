@@ -38,9 +38,7 @@
 namespace flexarm {
 
 struct DiscoveryOptions {
-  // Effects to test: the seed's Section 3.2 assumptions (the arm-side effects are fitted with
-  // fit --effect, not searched).
-  std::vector<EffectKind> candidates = seedEffectKinds();
+  std::vector<EffectKind> candidates = seedEffectKinds();  // effects to test
   // Effects the base model already has (their values the start): refitted with it, and not
   // tested again. extra_mass among them enlarges the structure.
   std::vector<Effect> startEffects;

@@ -16,10 +16,17 @@ bool DiscoveryOptions::isValid(std::string* why) const {
     return false;
   };
   if (candidates.empty()) return fail("at least one candidate effect is needed");
+  auto seed = [](EffectKind k) {
+    return std::find(seedEffectKinds().begin(), seedEffectKinds().end(), k) != seedEffectKinds().end();
+  };
   for (EffectKind k : candidates)
-    if (std::find(seedEffectKinds().begin(), seedEffectKinds().end(), k) == seedEffectKinds().end())
-      return fail(std::string("discovery looks for the effects of the seed's Section 3.2 assumptions; ") +
-                  toString(k) + " is fitted with fit --effect");
+    if (!seed(k))
+      return fail(std::string("discovery looks for the effects of the seed's Section 3.2 assumptions; ") + toString(k) +
+                  " is fitted with fit --effect");
+  for (const Effect& e : startEffects)
+    if (!seed(e.kind))
+      return fail(std::string("discovery refits the effects of the seed's Section 3.2 assumptions; the start effect ") +
+                  toString(e.kind) + " is fitted with fit --effect");
   for (std::size_t i = 0; i < startEffects.size(); ++i) {
     std::string reason;
     if (!startEffects[i].isValid(&reason)) return fail("start effect: " + reason);

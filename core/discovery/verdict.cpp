@@ -156,7 +156,7 @@ std::string describeEffect(EffectKind kind, const std::vector<EffectParameterEst
     case EffectKind::ExtraMass:
       return "an extra mass: " + plusMinus(p[1], 100.0) + " % of the outermost inertia on a spring resonating at " +
              number(p[0].value) + " +- " + number(p[0].std, 2) + " rad/s";
-    default: break;  // not a discovery candidate (DiscoveryOptions::isValid)
+    default: break;  // not a candidate (DiscoveryOptions::isValid)
   }
   return toString(kind);
 }

@@ -19,7 +19,8 @@ Eigen::VectorXd predictedDeflection(const FitOptions& o, const FitResult& r, con
   const auto n = static_cast<Eigen::Index>(range.size());
   if (o.model.nonlinear()) {
     NonlinearPlant plant(*model, r.effects);
-    const NonlinearSeries s = nonlinearSeries(r, d, range);
+    NonlinearSeries s = nonlinearSeries(r, d, range);
+    s.resetAngle = false;  // from the torque alone: no measured angle in the arm's gravity torque
     const NonlinearPemOptions no = nonlinearOptions(o, r);
     if (no.smoothingSpeed > 0.0) plant.setSmoothingSpeed(no.smoothingSpeed);
     std::vector<double> yhat, arm;

@@ -37,8 +37,12 @@ std::string number(double v) {
 // and of the torque, their means kept. False when the data hold no position.
 bool positionAndTorque(const PreparedData& d, Eigen::VectorXd& q, Eigen::VectorXd& tau, Eigen::VectorXd& ref) {
   const auto b = static_cast<Eigen::Index>(d.estimation.begin), n = static_cast<Eigen::Index>(d.estimation.size());
+  // An output named for a speed or an acceleration (motor_velocity_rad_s, arm_accel_rad_s2, a
+  // prismatic axis's motor_velocity_m_s) is no position to differentiate.
+  const bool position = !d.differentiated && d.outputName.find("velocity") == std::string::npos &&
+                        d.outputName.find("accel") == std::string::npos;
   if (d.angle.size() == d.u.size()) q = d.angle.segment(b, n);
-  else if (!d.differentiated && d.outputName != columns::kMotorVelocity) q = d.y.segment(b, n).array() + d.outputMean;
+  else if (position) q = d.y.segment(b, n).array() + d.outputMean;
   else return false;
   tau = d.u.segment(b, n).array() + d.inputMean;
   if (d.r.size() == d.u.size()) ref = d.r.segment(b, n).array() + d.referenceMean;
@@ -64,7 +68,7 @@ bool fitIdim(const FitOptions& o, FitResult& r) {
   };
   Eigen::VectorXd q, tau, ref;
   if (!positionAndTorque(r.data, q, tau, ref))
-    return fail("inverse dynamics needs a position: the log's output is a velocity and it has no " +
+    return fail("inverse dynamics needs a position: the log's output " + r.data.outputName + " is not one and it has no " +
                 std::string(columns::kMotorAngle) + " channel");
   IdimOptions io = o.idim;
   io.instrumentalVariables = o.method == FitMethod::IdimIv;

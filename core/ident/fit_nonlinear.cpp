@@ -28,12 +28,19 @@ NonlinearPemOptions nonlinearOptions(const FitOptions& o, const FitResult& r) {
                   : PredictedOutput::MotorVelocity;
   // A closed-loop log carries a load torque on the arm that the controller answers: the
   // observer keeps the simulation on the measured operating point, as in discovery.
-  no.observerBandwidthHz = r.data.closedLoop ? kClosedLoopObserverHz : 0.0;
+  // Not with the arm as an output: the deflection the arm encoder measures is to be predicted
+  // from the logged torque alone, and an observer's torque would pass through the spring.
+  no.observerBandwidthHz = r.data.closedLoop && !o.model.armOutput ? kClosedLoopObserverHz : 0.0;
   return no;
 }
 
 NonlinearSeries nonlinearSeries(const FitResult& r, const PreparedData& d, SampleRange range) {
-  return flexarm::nonlinearSeries(d, range, angleOutput(r));
+  NonlinearSeries s = flexarm::nonlinearSeries(d, range, angleOutput(r));
+  // With the arm as an output the whole motion comes from the torque: a motor angle reset to
+  // the measured one each sample would hand the measurement to the gravity torque
+  // m g l sin(phi_a + phi_0) (and on KUKA axes 2 and 3 it takes the fit to a skew of 12 ms).
+  if (r.model.armOutput) s.resetAngle = false;
+  return s;
 }
 
 namespace {
@@ -159,11 +166,17 @@ void keepNonlinear(NonlinearPemResult&& e, const FitOptions& o, const PhysicalMo
   if (r.data.closedLoop) {
     r.method = ClosedLoopMethod::Direct;
     r.methodDescription = "direct fit of closed-loop data";
-    char reason[160];
-    std::snprintf(reason, sizeof reason,
-                  "a fit with effects simulates the plant from the measured torque, through a %g Hz load "
-                  "observer as discovery does",
-                  nonlinearOptions(o, r).observerBandwidthHz);
+    const double observer = nonlinearOptions(o, r).observerBandwidthHz;
+    char reason[200];
+    if (observer > 0.0)
+      std::snprintf(reason, sizeof reason,
+                    "a fit with effects simulates the plant from the measured torque, through a %g Hz load "
+                    "observer as discovery does",
+                    observer);
+    else
+      std::snprintf(reason, sizeof reason,
+                    "a fit with effects simulates the plant from the measured torque alone (no load observer: "
+                    "the arm encoder's deflection is fitted too)");
     r.methodReason = reason;
   }
   std::size_t row = 0;

@@ -192,13 +192,12 @@ bool NonlinearProblem::evaluate(const Eigen::VectorXd& phi, Eigen::VectorXd& eps
   Eigen::Index N = 0;
   for (std::size_t s = 0; s < series.size(); ++s) {
     if (!simulate(phi, *series[s], yhat[s])) return false;
-    // With a deflection the prediction stacks the output and the deflection, each one value a
-    // sample: fitSamples then pick the same samples of both.
     const std::size_t outputs = series[s]->deflection.empty() ? 1 : 2;
     N += static_cast<Eigen::Index>(series[s]->fitSamples.empty() ? yhat[s].size()
-                                                                  : outputs * series[s]->fitSamples.size());
+                                                                 : outputs * series[s]->fitSamples.size());
   }
-  // The errors that enter the loss: every sample, or the series' fitSamples (of each output).
+  // The errors that enter the loss: every sample, or the series' fitSamples (of each output
+  // when the deflection is stacked after the first).
   auto stack = [this](std::size_t s, const std::vector<double>& y, auto&& put) {
     const auto& pick = series[s]->fitSamples;
     if (pick.empty()) {
@@ -206,8 +205,8 @@ bool NonlinearProblem::evaluate(const Eigen::VectorXd& phi, Eigen::VectorXd& eps
       return;
     }
     const std::size_t n = series[s]->y.size();
-    for (std::size_t offset = 0; offset < y.size(); offset += n)
-      for (std::size_t k : pick) put(offset + k);
+    for (std::size_t at = 0; at < y.size(); at += n)
+      for (std::size_t k : pick) put(at + k);
   };
   eps.resize(N);
   for (std::size_t s = 0, at = 0; s < series.size(); ++s) {
@@ -320,9 +319,9 @@ bool NonlinearPemOptions::isValid(std::string* why) const {
   if (!(level > 0.0 && level < 1.0)) return fail("the level must lie strictly between 0 and 1");
   if (substeps < 0 || substeps > 200) return fail("substeps must be in 0..200");
   if (threads < 1 || threads > 64) return fail("threads must be in 1..64");
+  if (!(smoothingSpeed >= 0.0) || !std::isfinite(smoothingSpeed)) return fail("the smoothing speed must be >= 0");
   if (!(observerBandwidthHz >= 0.0) || !std::isfinite(observerBandwidthHz))
     return fail("the observer bandwidth must be >= 0 Hz");
-  if (!(smoothingSpeed >= 0.0) || !std::isfinite(smoothingSpeed)) return fail("the smoothing speed must be >= 0");
   if (why) why->clear();
   return true;
 }

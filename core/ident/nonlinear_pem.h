@@ -51,9 +51,6 @@ struct NonlinearSeries {
   // the stage point, which moves smoothly with a delay (a held value jumps only when a sample
   // edge crosses a stage point, giving a zero gradient). An input delay always averages.
   bool averageTorque = false;
-  // The samples whose errors enter the loss, ascending (empty: every sample): a log split
-  // into fitted and held-out samples is still simulated whole.
-  std::vector<std::size_t> fitSamples;
   // The arm as a second output: the measured deflection r phi_m - phi_a (motor and arm-side
   // encoders; empty: the motor output alone) and the weight of its errors against the first
   // output's (the ratio of their noise levels). Both are compared about their own means over
@@ -64,6 +61,9 @@ struct NonlinearSeries {
   // The output, then (with a deflection) the weighted deflection about its mean: what the
   // predictor's stacked output is compared with.
   std::vector<double> targets() const;
+  // The samples whose errors enter the loss, ascending (empty: every sample): a log split
+  // into fitted and held-out samples is still simulated whole.
+  std::vector<std::size_t> fitSamples;
 };
 
 // A slow observer of an unmeasured arm-side load: a PI torque on the motor (in units of u)
@@ -176,11 +176,11 @@ struct NonlinearPemOptions {
   // MotorVelocity or DifferentiatedAngle for a velocity output (the latter where the series
   // holds the measured angle: the predicted angle through the same central differences).
   PredictedOutput output = PredictedOutput::MotorVelocity;
-  // Load observer (loadObserver) for closed-loop data: kClosedLoopObserverHz; 0: output error.
-  double observerBandwidthHz = 0.0;
   // The motor speed of the smooth signs of asymmetric_coulomb and arm_friction
   // (NonlinearPlant::setSmoothingSpeed); 0: the default 0.1 rad/s.
   double smoothingSpeed = 0.0;
+  // Load observer (loadObserver) for closed-loop data: kClosedLoopObserverHz; 0: output error.
+  double observerBandwidthHz = 0.0;
   bool isValid(std::string* why) const;
 };
 

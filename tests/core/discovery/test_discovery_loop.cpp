@@ -20,7 +20,7 @@ struct LoopCase {
   std::vector<Effect> hidden;
   int seed = 1;
   const char* truth = "two-mass";
-  std::vector<EffectKind> candidates = allEffectKinds();
+  std::vector<EffectKind> candidates = seedEffectKinds();
 };
 
 struct LoopOutcome {

@@ -3,6 +3,7 @@
 // whose truth is known.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <string>
@@ -212,6 +213,34 @@ TEST(Idim, RefusesAnAxisThatDoesNotMove) {
   IdimOptions bad;
   bad.filterOrder = 3;
   EXPECT_THROW(idim(q, tau, 1e-3, bad), std::invalid_argument);
+}
+
+// A log whose output is a speed or an acceleration holds no position: inverse dynamics refuses
+// it naming the channel, and a prediction-error fit takes no start values from it.
+TEST(Idim, AnOutputThatIsNoPositionIsRefusedByName) {
+  SimulationOptions so;
+  so.durationS = 2.0;
+  so.seed = 5;
+  so.logMotorVelocity = true;
+  so.logArmAcceleration = true;
+  const SimulationResult sim = simulateClosedLoop(*makeModel("rigid"), {}, so);
+  ASSERT_EQ(sim.termination, Termination::Converged) << sim.message;
+  auto data = std::make_shared<IdData>(sim.data);
+  auto& ch = data->channels;
+  ch.erase(std::remove_if(ch.begin(), ch.end(), [](const Channel& c) { return c.name == columns::kMotorAngle; }),
+           ch.end());
+  for (const char* output : {columns::kArmAccel, columns::kMotorVelocity}) {
+    FitOptions o;
+    o.model.kind = FitModelKind::Physical;
+    o.model.start = std::shared_ptr<const PhysicalModel>(makeModel("rigid"));
+    o.method = FitMethod::Idim;
+    o.output = output;
+    o.estimation = {{data, std::nullopt}};
+    const FitResult r = fitModel(o);
+    EXPECT_EQ(r.summary.termination, Termination::Failed) << output;
+    EXPECT_NE(r.message.find(output), std::string::npos) << r.message;
+    EXPECT_NE(r.message.find("needs a position"), std::string::npos) << r.message;
+  }
 }
 
 }  // namespace
