@@ -288,11 +288,10 @@ void FleetPanel::plotTrend() {
     if (s.name == "estimate") {
       g->setLineStyle(QCPGraph::lsNone);
       g->setScatterStyle(QCPScatterStyle(QCPScatterStyle::ssDisc, blue, 6));
-    } else if (s.name == "+2 std") {
+    } else if (s.name == "+-2 std") {
       g->setPen(QPen(QColor(31, 119, 180, 60)));
-      g->setName(tr("+-2 std"));
       upper = g;
-    } else if (s.name == "-2 std") {
+    } else if (s.name.empty()) {  // the band's lower bound
       g->setPen(QPen(QColor(31, 119, 180, 60)));
       g->setBrush(QColor(31, 119, 180, 40));
       if (upper) g->setChannelFillGraph(upper);
