@@ -230,7 +230,7 @@ void FleetPanel::fillGrid() {
       grid_->setItem(row, kKT + c, cell);
     }
     grid_->setItem(row, kSince, new NumberItem(t.since ? dateOf(*t.since) : "-", t.since.value_or(0)));
-    grid_->setItem(row, kDays, new NumberItem(t.daysToThreshold ? QString::asprintf("%.1f", *t.daysToThreshold) : "-",
+    grid_->setItem(row, kDays, new NumberItem(QString::fromStdString(daysToThresholdText(t)),
                                              t.daysToThreshold.value_or(1e9)));
     grid_->setItem(row, kLogs, new NumberItem(QString::number(a.logs), a.logs));
   }

@@ -115,7 +115,7 @@ Report fleetReport(const FleetRunResult& run, const std::string& manifest, const
   });
   for (const auto* a : urgent)
     due.rows.push_back({a->robot, std::to_string(a->axis), a->trend.status, a->trend.parameter,
-                        a->trend.daysToThreshold ? formatFixed(*a->trend.daysToThreshold, 1) : "-", a->trend.suggestion});
+                        daysToThresholdText(a->trend), a->trend.suggestion});
   if (urgent.empty()) maintenance.paragraphs.push_back("No axis needs service at the next stop.");
   else maintenance.tables.push_back(due);
   r.sections.push_back(maintenance);
@@ -130,7 +130,7 @@ Report fleetReport(const FleetRunResult& run, const std::string& manifest, const
     if (tr.slopePerDay) change = formatSignificant(100.0 * *tr.slopePerDay, 3) + " %/day";
     t.rows.push_back({a.robot, std::to_string(a.axis), std::to_string(a.logs), tr.status,
                       tr.parameter.empty() ? "-" : tr.parameter, tr.since ? dateOf(*tr.since) : "-", change,
-                      tr.daysToThreshold ? formatFixed(*tr.daysToThreshold, 1) : "-"});
+                      daysToThresholdText(tr)});
   }
   status.tables.push_back(t);
   r.sections.push_back(status);
