@@ -230,7 +230,7 @@ void FleetPanel::fillGrid() {
       grid_->setItem(row, kKT + c, cell);
     }
     grid_->setItem(row, kSince, new NumberItem(t.since ? dateOf(*t.since) : "-", t.since.value_or(0)));
-    grid_->setItem(row, kDays, new NumberItem(t.daysToThreshold ? QString::asprintf("%.1f", *t.daysToThreshold) : "-",
+    grid_->setItem(row, kDays, new NumberItem(QString::fromStdString(daysToThresholdText(t)),
                                              t.daysToThreshold.value_or(1e9)));
     grid_->setItem(row, kLogs, new NumberItem(QString::number(a.logs), a.logs));
   }
@@ -288,11 +288,10 @@ void FleetPanel::plotTrend() {
     if (s.name == "estimate") {
       g->setLineStyle(QCPGraph::lsNone);
       g->setScatterStyle(QCPScatterStyle(QCPScatterStyle::ssDisc, blue, 6));
-    } else if (s.name == "+2 std") {
+    } else if (s.name == "+-2 std") {
       g->setPen(QPen(QColor(31, 119, 180, 60)));
-      g->setName(tr("+-2 std"));
       upper = g;
-    } else if (s.name == "-2 std") {
+    } else if (s.name.empty()) {  // the band's lower bound
       g->setPen(QPen(QColor(31, 119, 180, 60)));
       g->setBrush(QColor(31, 119, 180, 40));
       if (upper) g->setChannelFillGraph(upper);

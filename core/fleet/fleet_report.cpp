@@ -23,7 +23,7 @@ ReportPlot fleetTrendPlot(const FleetAxisReport& a, const ParameterSeries& s, do
   p.title = a.robot + " axis " + std::to_string(a.axis) + ": " + s.name + " over days";
   p.xLabel = "time [days since " + dateOf(d0) + "]";
   p.yLabel = s.name + " - theta_0 [%]";
-  ReportSeries est{"estimate", {}, {}}, hi{"+2 std", {}, {}, true, 0}, lo{"-2 std", {}, {}, true, 0},
+  ReportSeries est{"estimate", {}, {}}, hi{"+-2 std", {}, {}, true, 0}, lo{"", {}, {}, true, 0},
       fit{s.kind == "none" ? "mean" : s.kind == "step" ? "fitted step" : "fitted drift", {}, {}, false, 1};
   for (std::size_t i = 0; i < s.day.size(); ++i) {
     const double x = s.day[i] - d0;
@@ -51,7 +51,7 @@ ReportPlot fleetTrendPlot(const FleetAxisReport& a, const ParameterSeries& s, do
     }
     p.series.push_back({"threshold " + percentText(threshold, 0), {0.0, end}, {100.0 * threshold, 100.0 * threshold}, true, 2});
   }
-  // Every point in view, with room below them for the legend (changes mostly rise).
+  // Every point in view.
   double bottom = 0.0, top = 0.0;
   for (const auto& x : p.series)
     for (double y : x.y) {
@@ -59,7 +59,7 @@ ReportPlot fleetTrendPlot(const FleetAxisReport& a, const ParameterSeries& s, do
       top = std::max(top, y);
     }
   const double span = std::max(top - bottom, 1.0);
-  p.yRange = std::make_pair(bottom - 0.9 * span, top + 0.05 * span);
+  p.yRange = std::make_pair(bottom - 0.05 * span, top + 0.05 * span);
   return p;
 }
 
@@ -115,7 +115,7 @@ Report fleetReport(const FleetRunResult& run, const std::string& manifest, const
   });
   for (const auto* a : urgent)
     due.rows.push_back({a->robot, std::to_string(a->axis), a->trend.status, a->trend.parameter,
-                        a->trend.daysToThreshold ? formatFixed(*a->trend.daysToThreshold, 1) : "-", a->trend.suggestion});
+                        daysToThresholdText(a->trend), a->trend.suggestion});
   if (urgent.empty()) maintenance.paragraphs.push_back("No axis needs service at the next stop.");
   else maintenance.tables.push_back(due);
   r.sections.push_back(maintenance);
@@ -130,7 +130,7 @@ Report fleetReport(const FleetRunResult& run, const std::string& manifest, const
     if (tr.slopePerDay) change = formatSignificant(100.0 * *tr.slopePerDay, 3) + " %/day";
     t.rows.push_back({a.robot, std::to_string(a.axis), std::to_string(a.logs), tr.status,
                       tr.parameter.empty() ? "-" : tr.parameter, tr.since ? dateOf(*tr.since) : "-", change,
-                      tr.daysToThreshold ? formatFixed(*tr.daysToThreshold, 1) : "-"});
+                      daysToThresholdText(tr)});
   }
   status.tables.push_back(t);
   r.sections.push_back(status);

@@ -406,4 +406,9 @@ AxisTrend analyseAxisTrend(const std::vector<TrendPoint>& input, std::optional<d
   return t;
 }
 
+std::string daysToThresholdText(const AxisTrend& t) {
+  if (!t.daysToThreshold) return "-";
+  return *t.daysToThreshold <= 0.0 ? "passed" : number(*t.daysToThreshold, "%.1f");
+}
+
 }  // namespace flexarm

@@ -93,4 +93,8 @@ struct AxisTrend {
 AxisTrend analyseAxisTrend(const std::vector<TrendPoint>& points,
                            std::optional<double> referenceTemperatureC, const TrendOptions& options);
 
+// The days to the threshold as tables show them: "-" (none foreseen), "passed" (a fault, or a drift
+// beyond it) or the days from the last log.
+std::string daysToThresholdText(const AxisTrend& t);
+
 }  // namespace flexarm

@@ -115,6 +115,9 @@ class FleetPanelTest : public QObject {
     QCOMPARE(g->item(fault, 3)->background().color(), QColor(239, 154, 154));
     QCOMPARE(g->item(fault, 5)->background().color(), QColor(200, 230, 201));
     QVERIFY2(g->item(fault, 3)->text().startsWith("+20"), qPrintable(g->item(fault, 3)->text()));
+    // A fault has passed the threshold already; a healthy axis foresees no crossing.
+    QCOMPARE(g->item(fault, 7)->text(), QString("passed"));
+    QCOMPARE(g->item(healthy, 7)->text(), QString("-"));
     // Sorted by status, the fault comes first, then the drift.
     g->sortByColumn(2, Qt::DescendingOrder);
     QCOMPARE(g->item(0, 2)->text(), QString("fault k_T"));
