@@ -246,5 +246,6 @@ void DiagnosisPanel::showAt(double t) {
 
 QString DiagnosisPanel::verdictText() const { return verdict_->text(); }
 QString DiagnosisPanel::statementText() const { return statement_->text(); }
+QString DiagnosisPanel::thresholdsText() const { return thresholds_->text(); }
 
 }  // namespace flexarm

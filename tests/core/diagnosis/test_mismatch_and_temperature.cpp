@@ -96,6 +96,9 @@ TEST(DiagnosisTemperature, AWarmHealthyAxisRaisesNoFrictionAlarmAFaultStillDoes)
   friction.alpha = 0.2 / 15.0;
   friction.referenceC = 25.0;
   const double warmFm = friction.atTemperature(kFm, 40.0);
+  // A given alpha is relative to the reference log's friction whatever T_ref it carries: the
+  // diagnosis takes the reference's 25 degC (with T_ref 20 the shift would be 18.75 %).
+  friction.referenceC = 20.0;
   ASSERT_NEAR(warmFm / kFm, 1.2, 1e-12);
   const IdData warm = simulated(*arm(warmFm), 4, {}, {}, 40.0);
 
