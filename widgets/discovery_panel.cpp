@@ -73,6 +73,7 @@ DiscoveryPanel::DiscoveryPanel(Workspace* workspace, QWidget* parent)
       workspace_(workspace),
       base_(new QComboBox(this)),
       find_(new QPushButton(tr("Find missing effect"), this)),
+      findAll_(new QPushButton(tr("Find all"), this)),
       cancel_(new QPushButton(tr("Cancel"), this)),
       add_(new QPushButton(tr("Add to model"), this)),
       progress_(new QProgressBar(this)),
@@ -82,18 +83,25 @@ DiscoveryPanel::DiscoveryPanel(Workspace* workspace, QWidget* parent)
       where_(new QLabel(this)),
       comparison_(new QLabel(this)),
       table_(new QTableWidget(0, 7, this)),
+      step_(new QComboBox(this)),
+      ladder_(new QCustomPlot(this)),
       residualTime_(new QCustomPlot(this)),
       residualSpectrum_(new QCustomPlot(this)),
       overlay_(new QCustomPlot(this)),
       residualCursor_(new PlayheadCursor(residualTime_, this)),
       overlayCursor_(new PlayheadCursor(overlay_, this)) {
   find_->setObjectName("findMissingEffect");
+  findAll_->setObjectName("findAllEffects");
+  findAll_->setToolTip(tr("Find, add, refit the base and every effect found so far, and look again, until no "
+                          "effect is missing (at most four)"));
+  step_->setToolTip(tr("The step whose candidates, evidence and overlay are shown"));
   add_->setObjectName("addToModel");
-  base_->setToolTip(tr("The model to extend: the effect missing from it is looked for"));
+  base_->setToolTip(tr("The model to extend (with any effects it has): the effects missing from it are "
+                       "looked for"));
   cancel_->setToolTip(tr("Stop the search; no effect is named from a part of it"));
   find_->setToolTip(tr("Fit the base model, map where it disagrees with the log, fit each "
                        "candidate effect and name the one that is significant"));
-  add_->setToolTip(tr("Add the base model with the found effect to the model list (undoable)"));
+  add_->setToolTip(tr("Add the base model with every effect found to the model list (undoable)"));
   progress_->setRange(0, 1000);
   progress_->setVisible(false);
   cancel_->setVisible(false);
@@ -117,12 +125,11 @@ DiscoveryPanel::DiscoveryPanel(Workspace* workspace, QWidget* parent)
   table_->verticalHeader()->setVisible(false);
   table_->setEditTriggers(QAbstractItemView::NoEditTriggers);
   table_->setSelectionBehavior(QAbstractItemView::SelectRows);
-  table_->setMinimumHeight(150);
 
   setupPlot(residualTime_, tr("time (s)"), tr("residual (rad/s)"));
   addCurve(residualTime_, tr("base"), QColor(200, 40, 40));
   addCurve(residualTime_, tr("augmented"), QColor(30, 90, 200));
-  setupPlot(residualSpectrum_, tr("frequency (rad/s)"), tr("residual amplitude (rad/s)"));
+  setupPlot(residualSpectrum_, tr("frequency (rad/s)"), tr("amplitude (rad/s)"));
   residualSpectrum_->xAxis->setScaleType(QCPAxis::stLogarithmic);
   residualSpectrum_->yAxis->setScaleType(QCPAxis::stLogarithmic);
   residualSpectrum_->xAxis->setTicker(QSharedPointer<QCPAxisTickerLog>(new QCPAxisTickerLog));
@@ -133,24 +140,63 @@ DiscoveryPanel::DiscoveryPanel(Workspace* workspace, QWidget* parent)
   addCurve(overlay_, tr("measured"), Qt::black);
   addCurve(overlay_, tr("base"), QColor(200, 40, 40));
   addCurve(overlay_, tr("augmented"), QColor(30, 90, 200));
+  // The ladder: held-out residual RMS (bars, left) and fit % (line, right) per step.
+  ladder_->xAxis->setLabel(tr("step"));
+  ladder_->yAxis->setLabel(tr("RMS (rad/s)"));
+  ladder_->yAxis2->setVisible(true);
+  ladder_->yAxis2->setLabel(tr("fit (5.2) %"));
+  ladder_->setMinimumHeight(140);
+  ladder_->setMinimumWidth(260);
+  ladder_->setToolTip(tr("The gap step by step: the held-out residual RMS and fit % of the base and after each "
+                         "effect found; click a step to show it"));
+  {
+    auto* bars = new QCPBars(ladder_->xAxis, ladder_->yAxis);
+    bars->setName(tr("held-out residual RMS"));
+    bars->setBrush(QColor(200, 40, 40, 120));
+    bars->setPen(QPen(QColor(200, 40, 40)));
+    bars->setWidth(0.5);
+    QCPGraph* fit = ladder_->addGraph(ladder_->xAxis, ladder_->yAxis2);
+    fit->setName(tr("held-out fit %"));
+    fit->setPen(QPen(QColor(30, 90, 200), 1.6));
+    fit->setScatterStyle(QCPScatterStyle(QCPScatterStyle::ssCircle, 6));
+    ladder_->legend->setVisible(true);
+    ladder_->legend->setFont(QFont(ladder_->font().family(), 8));
+    placeLegendAbove(ladder_);
+    ladder_->setInteractions(QCP::iSelectPlottables);
+    connect(ladder_, &QCustomPlot::plottableClick, this,
+            [this](QCPAbstractPlottable*, int index, QMouseEvent*) { selectStep(index); });
+  }
 
   auto* top = new QHBoxLayout;
   top->addWidget(new QLabel(tr("Base model:"), this));
   top->addWidget(base_, 1);
   top->addWidget(find_);
+  top->addWidget(findAll_);
   top->addWidget(cancel_);
   top->addWidget(add_);
   auto* status = new QHBoxLayout;
   status->addWidget(progress_, 1);
   status->addWidget(stage_, 2);
 
+  auto* stepRow = new QHBoxLayout;
+  stepRow->addWidget(new QLabel(tr("Step:"), this));
+  stepRow->addWidget(step_, 1);
+  // The ladder beside the chosen step's candidates, the plots over time and frequency below:
+  // the whole panel fits a 1366x768 window.
+  auto* rung = new QSplitter(Qt::Horizontal, this);
+  rung->addWidget(ladder_);
+  rung->addWidget(table_);
+  rung->setStretchFactor(0, 2);
+  rung->setStretchFactor(1, 3);
+  for (QCustomPlot* p : {residualTime_, residualSpectrum_, overlay_}) p->setMinimumHeight(130);
   auto* plots = new QSplitter(Qt::Vertical, this);
-  plots->addWidget(table_);
+  plots->addWidget(rung);
   plots->addWidget(residualTime_);
   plots->addWidget(residualSpectrum_);
   plots->addWidget(overlay_);
   table_->setMaximumHeight(240);
-  plots->setStretchFactor(0, 1);
+  table_->setMinimumHeight(140);
+  plots->setStretchFactor(0, 2);
   for (int i = 1; i < 4; ++i) plots->setStretchFactor(i, 2);
   auto* layout = new QVBoxLayout(this);
   layout->addLayout(top);
@@ -158,10 +204,13 @@ DiscoveryPanel::DiscoveryPanel(Workspace* workspace, QWidget* parent)
   layout->addWidget(verdict_);
   layout->addWidget(evidence_);
   layout->addWidget(comparison_);
+  layout->addLayout(stepRow);
   layout->addWidget(plots, 1);
   layout->addWidget(where_);
 
   connect(find_, &QPushButton::clicked, this, &DiscoveryPanel::findMissingEffect);
+  connect(findAll_, &QPushButton::clicked, this, &DiscoveryPanel::findAllEffects);
+  connect(step_, qOverload<int>(&QComboBox::currentIndexChanged), this, [this](int) { showStep(); });
   connect(cancel_, &QPushButton::clicked, this, &DiscoveryPanel::cancel);
   connect(add_, &QPushButton::clicked, this, &DiscoveryPanel::addToModel);
   connect(&watcher_, &QFutureWatcher<Outcome>::finished, this, &DiscoveryPanel::onFinished);
@@ -217,21 +266,28 @@ void DiscoveryPanel::clearResult() {
   result_.reset();
   added_ = false;
   find_->setEnabled(true);
+  findAll_->setEnabled(true);
   add_->setEnabled(false);
   cancel_->setVisible(false);
   progress_->setVisible(false);
   verdict_->setText(tr("Choose a base model and press \"Find missing effect\"."));
   for (QLabel* l : {evidence_, where_, comparison_, stage_}) l->clear();
   table_->setRowCount(0);
+  {
+    const QSignalBlocker block(step_);
+    step_->clear();
+  }
   clearPlots();
 }
 
 void DiscoveryPanel::clearPlots() {
-  for (QCustomPlot* p : {residualTime_, residualSpectrum_, overlay_}) {
+  for (QCustomPlot* p : {residualTime_, residualSpectrum_, overlay_, ladder_}) {
     for (int g = 0; g < p->graphCount(); ++g) p->graph(g)->data()->clear();
     p->clearItems();
     p->replot();
   }
+  if (auto* bars = qobject_cast<QCPBars*>(ladder_->plottable(0))) bars->data()->clear();
+  ladder_->replot();
   residualCursor_->attach();
   overlayCursor_->attach();
 }
@@ -244,8 +300,13 @@ void DiscoveryPanel::setPlayhead(Playhead* playhead) {
 QString DiscoveryPanel::verdictText() const { return verdict_->text(); }
 QString DiscoveryPanel::evidenceText() const { return evidence_->text(); }
 QString DiscoveryPanel::comparisonText() const { return comparison_->text(); }
+QString DiscoveryPanel::stageText() const { return stage_->text(); }
 
-void DiscoveryPanel::findMissingEffect() {
+void DiscoveryPanel::findMissingEffect() { run(1); }
+
+void DiscoveryPanel::findAllEffects() { run(4); }
+
+void DiscoveryPanel::run(int maxEffects) {
   if (watcher_.isRunning()) return;
   if (!workspace_->current()) {
     verdict_->setText(workspace_->needsResampling()
@@ -259,11 +320,6 @@ void DiscoveryPanel::findMissingEffect() {
     verdict_->setText(tr("Choose a base model."));
     return;
   }
-  if (!existing.empty()) {
-    verdict_->setText(tr("The chosen model already has effects; choose a model without effects "
-                         "as the base."));
-    return;
-  }
   // Estimation and validation data from the workspace ranges (whole log if none is set).
   const IdData all = workspace_->currentWithRanges();
   pendingData_ = workspace_->dataProvenance();
@@ -274,7 +330,8 @@ void DiscoveryPanel::findMissingEffect() {
   if (all.validationRange && !all.validationRange->empty())
     val = std::make_shared<IdData>(all.select(*all.validationRange));
   baseName_ = base_->currentText();
-  // The request as a session stores it: the workspace's log as preprocessed, its ranges.
+  // The request as a session stores it: the workspace's log as preprocessed, its ranges, the
+  // base's effects as the start effects.
   DiscoveryRequest request;
   if (base_->currentData().typeId() == QMetaType::Int) request.baseModel = base_->currentText().toStdString();
   else request.baseStructure = base_->currentData().toString().toStdString();
@@ -286,14 +343,17 @@ void DiscoveryPanel::findMissingEffect() {
   if (all.estimationRange && !all.estimationRange->empty()) request.estimation.range = seconds(RangeKind::Estimation);
   if (val) request.validation = DiscoveryDataRef{"", seconds(RangeKind::Validation)};
   request.options = options_;
+  request.options.maxEffects = maxEffects;
+  request.options.startEffects = existing;
   pendingRequest_ = request;
   const int run = ++run_;
   std::shared_ptr<const PhysicalModel> baseModel(std::move(base));
   cancelFlag_ = std::make_shared<std::atomic<bool>>(false);
   auto flag = cancelFlag_;
-  const DiscoveryOptions o = options_;
+  const DiscoveryOptions o = request.options;
   QPointer<DiscoveryPanel> self(this);
   find_->setEnabled(false);
+  findAll_->setEnabled(false);
   add_->setEnabled(false);
   cancel_->setVisible(true);
   progress_->setVisible(true);
@@ -319,8 +379,7 @@ void DiscoveryPanel::findMissingEffect() {
             Qt::QueuedConnection);
         return flag->load() ? ProgressAction::Abort : ProgressAction::Continue;
       };
-      out.result = std::make_shared<DiscoveryResult>(
-          discoverMissingEffect(*baseModel, *est, val.get(), o, progress));
+      out.result = std::make_shared<DiscoveryResult>(discoverMissingEffect(*baseModel, *est, val.get(), o, progress));
     } catch (const std::exception& e) {
       out.error = QString::fromStdString(e.what());
     }
@@ -336,6 +395,7 @@ void DiscoveryPanel::cancel() {
 void DiscoveryPanel::onFinished() {
   Outcome out = watcher_.result();
   find_->setEnabled(true);
+  findAll_->setEnabled(true);
   cancel_->setVisible(false);
   progress_->setVisible(false);
   if (out.run != run_) {  // a stored result replaced this run while it ran
@@ -347,7 +407,9 @@ void DiscoveryPanel::onFinished() {
     emit finished();
     return;
   }
-  if (out.result->termination == Termination::Cancelled) {
+  // A loop cancelled between steps keeps the steps it finished.
+  const bool partial = out.result->termination == Termination::Cancelled && !out.result->found.empty();
+  if (out.result->termination == Termination::Cancelled && !partial) {
     verdict_->setText(tr("Cancelled."));
     stage_->clear();
     emit finished();
@@ -367,6 +429,11 @@ void DiscoveryPanel::onFinished() {
   result_ = out.result;
   request_ = pendingRequest_;
   showResult();
+  if (partial) {
+    verdict_->setText(tr("Cancelled after %n step(s): ", "", static_cast<int>(result_->found.size())) +
+                      verdict_->text());
+    stage_->setText(QString::fromStdString(result_->message));
+  }
   emit finished();
 }
 
@@ -382,6 +449,7 @@ void DiscoveryPanel::showStored(const DiscoveryRequest& request, const Discovery
   baseName_ = base_->currentText();
   added_ = false;
   find_->setEnabled(true);
+  findAll_->setEnabled(true);
   cancel_->setVisible(false);
   progress_->setVisible(false);
   showResult();
@@ -392,35 +460,112 @@ void DiscoveryPanel::showStored(const DiscoveryRequest& request, const Discovery
 
 void DiscoveryPanel::showResult() {
   const DiscoveryResult& r = *result_;
-  QString verdict = r.effect ? tr("Missing effect: %1").arg(toString(*r.effect))
-                             : tr("Missing effect: none");
+  QString verdict;
+  if (r.found.size() > 1 || (request_ && request_->options.maxEffects > 1)) {
+    QStringList names;
+    for (const auto& f : r.found)
+      names << QString("%1 (%2)").arg(toString(f.kind), f.confirmation.confirmed ? tr("confirmed") : tr("not confirmed"));
+    verdict = tr("Missing effects: %1").arg(names.isEmpty() ? tr("none") : names.join(", "));
+  } else {
+    verdict = r.effect ? tr("Missing effect: %1").arg(toString(*r.effect)) : tr("Missing effect: none");
+    if (!r.found.empty()) verdict += r.found[0].confirmation.confirmed ? tr(" (confirmed)") : tr(" (not confirmed)");
+  }
   if (!r.tied.empty()) {
     QStringList t;
     for (EffectKind k : r.tied) t << toString(k);
     verdict += tr("  (tie with %1)").arg(t.join(", "));
   }
   verdict_->setText(verdict);
-  evidence_->setText(QString::fromStdString(r.evidence));
-  where_->setText(QString::fromStdString(r.disagreement.summary));
-  stage_->setText(tr("%1 candidates in %2 s").arg(r.candidates.size()).arg(r.seconds, 0, 'f', 1));
-  add_->setEnabled(r.effect.has_value());
+  stage_->setText(tr("%1 step(s) in %2 s").arg(std::max<std::size_t>(1, r.rounds.size())).arg(r.seconds, 0, 'f', 1));
+  add_->setEnabled(!r.found.empty() && r.augmentedModel != nullptr);
+  // The steps: every round of a live result; the effects found of a stored summary.
+  {
+    const QSignalBlocker block(step_);
+    step_->clear();
+    const std::size_t n = r.rounds.empty() ? std::max<std::size_t>(1, r.found.size()) : r.rounds.size();
+    QString model = tr("base");
+    for (std::size_t i = 0; i < n; ++i) {
+      const std::optional<EffectKind> k =
+          r.rounds.empty() ? (i < r.found.size() ? std::optional<EffectKind>(r.found[i].kind) : std::nullopt)
+                           : r.rounds[i].effect;
+      step_->addItem(k ? tr("Step %1: %2 + %3").arg(i + 1).arg(model, toString(*k))
+                       : tr("Step %1: %2, nothing more missing").arg(i + 1).arg(model));
+      if (k) model += QString(" + ") + toString(*k);
+    }
+    step_->setCurrentIndex(0);
+  }
+  showLadder();
+  showStep();
+}
 
-  table_->setRowCount(static_cast<int>(r.candidates.size()));
-  for (std::size_t i = 0; i < r.candidates.size(); ++i) {
-    const CandidateFit& c = r.candidates[i];
+void DiscoveryPanel::showLadder() {
+  const DiscoveryResult& r = *result_;
+  auto* bars = qobject_cast<QCPBars*>(ladder_->plottable(0));
+  QVector<double> x, rmsV, fit;
+  QSharedPointer<QCPAxisTickerText> ticks(new QCPAxisTickerText);
+  const DiscoveryScore& base = r.found.empty() ? r.base : r.found.front().before;
+  x << 0;
+  rmsV << base.rmsValidation;
+  fit << base.fitPercentValidation;
+  ticks->addTick(0, tr("base"));
+  for (std::size_t i = 0; i < r.found.size(); ++i) {
+    x << static_cast<double>(i + 1);
+    rmsV << r.found[i].after.rmsValidation;
+    fit << r.found[i].after.fitPercentValidation;
+    ticks->addTick(static_cast<double>(i + 1), QString("+ ") + toString(r.found[i].kind));
+  }
+  bars->setData(x, rmsV);
+  ladder_->graph(0)->setData(x, fit);
+  ladder_->xAxis->setTicker(ticks);
+  ladder_->xAxis->setRange(-0.6, static_cast<double>(r.found.size()) + 0.6);
+  double top = 0.0;
+  for (double v : rmsV) top = std::max(top, std::isfinite(v) ? v : 0.0);
+  ladder_->yAxis->setRange(0.0, top > 0.0 ? 1.15 * top : 1.0);
+  double lo = 100.0, hi = 0.0;
+  for (double v : fit)
+    if (std::isfinite(v)) lo = std::min(lo, v), hi = std::max(hi, v);
+  if (hi < lo) lo = 0.0, hi = 100.0;
+  const double pad = std::max(1.0, 0.1 * (hi - lo));
+  ladder_->yAxis2->setRange(lo - pad, std::min(100.0 + pad, hi + pad));
+  ladder_->replot();
+}
+
+void DiscoveryPanel::selectStep(int step) {
+  if (step >= 0 && step < step_->count()) step_->setCurrentIndex(step);
+}
+
+void DiscoveryPanel::showStep() {
+  if (!result_) return;
+  const DiscoveryResult& r = *result_;
+  const int at = std::max(0, step_->currentIndex());
+  const DiscoveryRound* round = at < static_cast<int>(r.rounds.size()) ? &r.rounds[static_cast<std::size_t>(at)] : nullptr;
+  const std::vector<CandidateFit>& candidates = round ? round->candidates : r.candidates;
+  const int best = round ? round->best : r.best;
+  const double aic = round ? round->aic : r.baseAic;
+  const bool storedStep = !round && at < static_cast<int>(r.found.size());
+  evidence_->setText(QString::fromStdString(round ? round->evidence : storedStep ? r.found[static_cast<std::size_t>(at)].evidence : r.evidence));
+  where_->setText(QString::fromStdString(round ? round->disagreement.summary : r.disagreement.summary));
+
+  table_->setRowCount(static_cast<int>(candidates.size()));
+  for (std::size_t i = 0; i < candidates.size(); ++i) {
+    const CandidateFit& c = candidates[i];
     const int row = static_cast<int>(i);
+    QString why = QString::fromStdString(c.reason);
+    if (c.confirmation.ran) why += " — " + QString::fromStdString(c.confirmation.text);
     const QStringList cells = {
         toString(c.kind),
         num(c.lossEst, 4),
         r.hasValidation ? num(c.score.rmsValidation, 4) : tr("no validation range"),
-        std::isfinite(c.aic) ? QString::number(c.aic - r.baseAic, 'f', 1) : tr("-"),
+        std::isfinite(c.aic) ? QString::number(c.aic - aic, 'f', 1) : tr("-"),
         num(c.fStatistic, 3) + " / " + num(c.fThreshold, 3),
-        c.significant ? tr("yes") : tr("no"),
-        QString::fromStdString(c.reason)};
+        c.significant ? (c.confirmation.ran ? (c.confirmation.confirmed ? tr("yes, confirmed") : tr("yes, not confirmed"))
+                                            : tr("yes"))
+                      : tr("no"),
+        why};
     for (int col = 0; col < cells.size(); ++col) {
       auto* item = new QTableWidgetItem(cells[col]);
       item->setToolTip(cells[col]);  // the whole text, also when the column wraps it
-      if (static_cast<int>(i) == r.best) {
+      if (row == best) {
         QFont f = item->font();
         f.setBold(true);
         item->setFont(f);
@@ -432,30 +577,35 @@ void DiscoveryPanel::showResult() {
   // Every column as wide as its text except "Why", which wraps within what is left, so the
   // reason reads whole in the row (and in its tooltip).
   table_->resizeColumnsToContents();
-  const int why = table_->columnCount() - 1;
+  const int whyCol = table_->columnCount() - 1;
   int others = 0;
-  for (int col = 0; col < why; ++col) others += table_->columnWidth(col);
-  table_->setColumnWidth(why, std::max(220, table_->viewport()->width() - others));
+  for (int col = 0; col < whyCol; ++col) others += table_->columnWidth(col);
+  table_->setColumnWidth(whyCol, std::max(220, table_->viewport()->width() - others));
   table_->resizeRowsToContents();
+  if (best >= 0 && best < table_->rowCount()) table_->scrollToItem(table_->item(best, 0));
 
-  // Base residual in time and frequency, the model's resonances marked (a stored summary
-  // has no traces).
-  const auto& e = r.estimation;
+  // The step's residual before it in time and frequency, the model's resonances marked (a
+  // stored summary has no traces).
+  const DiscoveryTrace& e = round ? round->estimation : r.estimation;
   if (e.time.size() < 8) {
-    clearPlots();
+    for (QCustomPlot* p : {residualTime_, residualSpectrum_, overlay_}) {
+      for (int g = 0; g < p->graphCount(); ++g) p->graph(g)->data()->clear();
+      p->clearItems();
+      p->replot();
+    }
     showComparison();
     return;
   }
-  const auto baseRes = difference(e.measured, e.base);
-  residualTime_->graph(0)->setData(toQ(e.time), toQ(baseRes), true);
+  const auto before = difference(e.measured, e.base);
+  residualTime_->graph(0)->setData(toQ(e.time), toQ(before), true);
   residualTime_->graph(1)->data()->clear();
   residualTime_->rescaleAxes();
   residualTime_->replot();
   residualSpectrum_->clearItems();
-  setSpectrum(residualSpectrum_->graph(0), baseRes, r.sampleTime);
+  setSpectrum(residualSpectrum_->graph(0), before, r.sampleTime);
   residualSpectrum_->graph(1)->data()->clear();
   residualSpectrum_->rescaleAxes();
-  for (double w : r.disagreement.resonancesRadS) {
+  for (double w : (round ? round->disagreement : r.disagreement).resonancesRadS) {
     auto* line = new QCPItemStraightLine(residualSpectrum_);
     line->point1->setCoords(w, 1e-9);
     line->point2->setCoords(w, 1.0);
@@ -467,22 +617,33 @@ void DiscoveryPanel::showResult() {
 
 void DiscoveryPanel::showOverlay() {
   const DiscoveryResult& r = *result_;
-  const DiscoveryTrace& t = r.hasValidation ? r.validation : r.estimation;
+  const int at = std::max(0, step_->currentIndex());
+  const DiscoveryRound* round = at < static_cast<int>(r.rounds.size()) ? &r.rounds[static_cast<std::size_t>(at)] : nullptr;
+  const DiscoveryTrace& t = round ? round->validation : (r.hasValidation ? r.validation : r.estimation);
+  const bool named = round ? round->effect.has_value() : !r.found.empty();
+  const QString stepName = round && round->effect ? QString("+ ") + toString(*round->effect) : tr("augmented");
   overlay_->graph(0)->setData(toQ(t.time), toQ(t.measured), true);
+  overlay_->graph(1)->setName(at == 0 ? tr("base") : tr("before step %1").arg(at + 1));
   overlay_->graph(1)->setData(toQ(t.time), toQ(t.base), true);
-  if (added_) {
+  overlay_->graph(2)->setName(stepName);
+  // A step that named an effect shows the model with it at once; the one-search result waits
+  // for "Add to model" as before.
+  const bool showAfter = named && (added_ || r.found.size() > 1 || (request_ && request_->options.maxEffects > 1));
+  if (showAfter) {
     overlay_->graph(2)->setData(toQ(t.time), toQ(t.augmented), true);
-    const auto& e = r.estimation;
-    const auto augRes = difference(e.measured, e.augmented);
-    residualTime_->graph(1)->setData(toQ(e.time), toQ(augRes), true);
-    setSpectrum(residualSpectrum_->graph(1), augRes, r.sampleTime);
+    const DiscoveryTrace& e = round ? round->estimation : r.estimation;
+    const auto after = difference(e.measured, e.augmented);
+    residualTime_->graph(1)->setName(stepName);
+    residualSpectrum_->graph(1)->setName(stepName);
+    residualTime_->graph(1)->setData(toQ(e.time), toQ(after), true);
+    setSpectrum(residualSpectrum_->graph(1), after, r.sampleTime);
     residualTime_->replot();
     residualSpectrum_->replot();
   } else {
     overlay_->graph(2)->data()->clear();
   }
-  overlay_->xAxis->setLabel(r.hasValidation ? tr("time (s), validation data")
-                                            : tr("time (s), estimation data"));
+  overlay_->xAxis->setLabel(r.heldOutSplit ? tr("time (s), estimation log (held-out blocks inside)")
+                                           : tr("time (s), validation data"));
   overlay_->rescaleAxes();
   overlay_->replot();
   showComparison();
@@ -490,32 +651,33 @@ void DiscoveryPanel::showOverlay() {
 
 void DiscoveryPanel::showComparison() {
   const DiscoveryResult& r = *result_;
-  // A stored summary shows the augmented scores at once: its model is not in the list.
-  const bool after = added_ || (r.effect && r.estimation.time.empty());
+  // A stored summary shows the final scores at once: its model is not in the list.
+  const bool after = added_ || (!r.found.empty() && (r.estimation.time.empty() || r.found.size() > 1));
   QString text = tr("Base: fit (5.2) %1 % (estimation)").arg(r.base.fitPercent, 0, 'f', 1);
-  if (r.hasValidation)
-    text += tr(", %1 % (validation), residual RMS %2 rad/s")
-                .arg(r.base.fitPercentValidation, 0, 'f', 1)
-                .arg(num(r.base.rmsValidation));
+  text += tr(", %1 % (held out), residual RMS %2 rad/s").arg(r.base.fitPercentValidation, 0, 'f', 1).arg(num(r.base.rmsValidation));
   if (after) {
-    text += tr(".   Augmented: fit (5.2) %1 % (estimation)").arg(r.augmented.fitPercent, 0, 'f', 1);
-    if (r.hasValidation)
-      text += tr(", %1 % (validation), residual RMS %2 rad/s (%3 % lower)")
-                  .arg(r.augmented.fitPercentValidation, 0, 'f', 1)
-                  .arg(num(r.augmented.rmsValidation))
-                  .arg(100.0 * (1.0 - r.augmented.rmsValidation / r.base.rmsValidation), 0, 'f', 0);
+    text += tr(".   With %n effect(s): fit (5.2) %1 % (estimation)", "", static_cast<int>(r.found.size()))
+                .arg(r.augmented.fitPercent, 0, 'f', 1);
+    text += tr(", %1 % (held out), residual RMS %2 rad/s (%3 % lower)")
+                .arg(r.augmented.fitPercentValidation, 0, 'f', 1)
+                .arg(num(r.augmented.rmsValidation))
+                .arg(100.0 * (1.0 - r.augmented.rmsValidation / r.base.rmsValidation), 0, 'f', 0);
   }
+  if (!r.validationData.empty()) text += tr(".  Held-out data: %1").arg(QString::fromStdString(r.validationData));
   comparison_->setText(text + ".");
 }
 
 void DiscoveryPanel::addToModel() {
-  if (!result_ || !result_->effect || !result_->augmentedModel) return;
+  if (!result_ || result_->found.empty() || !result_->augmentedModel) return;
   ModelEntry entry;
-  QString baseLabel = baseName_;
-  baseLabel.remove(tr(" (nominal)"));
-  entry.name = tr("%1 + %2").arg(baseLabel, toString(*result_->effect));
-  entry.model = result_->augmentedModel;
-  entry.effects = result_->augmentedEffects;
+  QString label = baseName_;
+  label.remove(tr(" (nominal)"));
+  for (const auto& f : result_->found) label += QString(" + ") + toString(f.kind);
+  entry.name = label;
+  // An extra mass becomes the larger structure: the model list and the fit take it so.
+  auto merged = mergedModel(*result_->augmentedModel, result_->augmentedEffects);
+  entry.model = std::shared_ptr<const PhysicalModel>(std::move(merged.first));
+  entry.effects = merged.second;
   const int index = workspace_->addModel(entry);
   added_ = true;
   add_->setEnabled(false);

@@ -1,10 +1,12 @@
 #pragma once
-// Discovery panel: finds the effect the chosen base model misses (core/discovery). One button
-// runs the base fit, the map of the disagreement and every candidate off the GUI thread, with
-// progress and Cancel; the panel then shows the candidates table, the verdict with its
-// evidence, the base residual in time and frequency (with the model's resonances), and, after
-// "Add to model" (undoable, a new entry in the model list), the measured, base and augmented
-// simulations overlaid with fit % and residual RMS before and after.
+// Discovery panel: finds the effects the chosen base model misses (core/discovery). "Find
+// missing effect" runs one search, "Find all" the loop (find, add, refit everything, find
+// again until none), off the GUI thread with progress and Cancel (a cancelled loop keeps the
+// steps it finished). The panel shows the ladder of the gap shrinking step by step (held-out
+// residual RMS and fit % of the base and after each effect), and for the chosen step its
+// candidates table, verdict, evidence and confirmation, the residual in time and frequency
+// (with the model's resonances) and the measured, before and after simulations overlaid;
+// "Add to model" puts the final model (every effect found) in the model list (undoable).
 #include <QFutureWatcher>
 #include <QWidget>
 #include <atomic>
@@ -38,11 +40,18 @@ class DiscoveryPanel : public QWidget {
   // Base models offered: the model list's entries with a gear spring, then nominal structures.
   QComboBox* baseModelBox() const { return base_; }
   QPushButton* findButton() const { return find_; }
+  QPushButton* findAllButton() const { return findAll_; }
+  QCustomPlot* ladderPlot() const { return ladder_; }
+  // The steps of the shown result (the base's round, then one per effect found); choosing one
+  // shows its candidates, evidence and overlay.
+  QComboBox* stepBox() const { return step_; }
+  void selectStep(int step);
   QPushButton* addButton() const { return add_; }
   QTableWidget* candidatesTable() const { return table_; }
   QString verdictText() const;
   QString evidenceText() const;
   QString comparisonText() const;
+  QString stageText() const;
   QCustomPlot* residualTimePlot() const { return residualTime_; }
   QCustomPlot* residualSpectrumPlot() const { return residualSpectrum_; }
   QCustomPlot* overlayPlot() const { return overlay_; }
@@ -61,6 +70,7 @@ class DiscoveryPanel : public QWidget {
 
  public slots:
   void findMissingEffect();
+  void findAllEffects();
   void cancel();
   // Adds the augmented model to the model list (undoable) and shows the gap shrink.
   void addToModel();
@@ -76,8 +86,11 @@ class DiscoveryPanel : public QWidget {
     int run = 0;  // the run it answers
   };
   void refillModels();
+  void run(int maxEffects);
   void onFinished();
   void showResult();
+  void showLadder();
+  void showStep();
   void showOverlay();
   void showComparison();  // fit % and residual RMS before (and after adding) in words
   void clearPlots();
@@ -86,6 +99,7 @@ class DiscoveryPanel : public QWidget {
   Workspace* workspace_;
   QComboBox* base_;
   QPushButton* find_;
+  QPushButton* findAll_;
   QPushButton* cancel_;
   QPushButton* add_;
   QProgressBar* progress_;
@@ -95,6 +109,8 @@ class DiscoveryPanel : public QWidget {
   QLabel* where_;
   QLabel* comparison_;
   QTableWidget* table_;
+  QComboBox* step_;
+  QCustomPlot* ladder_;
   QCustomPlot* residualTime_;
   QCustomPlot* residualSpectrum_;
   QCustomPlot* overlay_;

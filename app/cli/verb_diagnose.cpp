@@ -2,7 +2,6 @@
 //                  [--tests ...] [--decide ...] [--window S|cumulative] [--json]
 #include <cmath>
 #include <cstdio>
-#include <fstream>
 #include <nlohmann/json.hpp>
 #include <ostream>
 #include <sstream>
@@ -10,6 +9,7 @@
 #include "app/cli/cli.h"
 #include "app/cli/log_args.h"
 #include "app/cli/model_args.h"
+#include "app/cli/progress_line.h"
 #include "core/diagnosis/diagnosis.h"
 #include "core/diagnosis/calibration.h"
 #include "core/diagnosis/diagnosis_json.h"
@@ -119,11 +119,7 @@ bool parseNames(const std::string& text, std::vector<std::string>& out) {
 }
 
 bool writeTrace(const DiagnosisResult& r, const std::string& path, std::string* why) {
-  std::ofstream f(path);
-  if (!f) {
-    *why = "cannot write " + path;
-    return false;
-  }
+  std::ostringstream f;
   f << "time_s";
   for (const auto& p : r.parameters) f << "," << p.name;
   for (const auto& t : r.tests)
@@ -138,7 +134,7 @@ bool writeTrace(const DiagnosisResult& r, const std::string& path, std::string* 
       for (std::size_t q = 0; q < t.columns.size(); ++q) f << "," << t.statistic[q][k] << "," << t.threshold[q][k];
     f << ",\"" << modeSetString(r.decision.statement[k], r.faults) << "\"\n";
   }
-  return static_cast<bool>(f);
+  return writeFileAtomically(path, f.str(), why);
 }
 
 std::string delayText(double d) {
@@ -279,13 +275,13 @@ int runDiagnose(const std::vector<std::string>& argv, std::ostream& out, std::os
   DiagnosisRequest request;
   request.calibrate = args.flag("calibrate");
   CalibrationOptions& calibration = request.calibration;
-  long runs = calibration.healthyRuns, threads = calibration.threads;
+  int runs = calibration.healthyRuns;
   if (!args.number("false-alarms-per-hour", calibration.targetFalseAlarmsPerHour) ||
-      !args.integer("runs", runs) || !args.integer("threads", threads))
+      !args.integer("runs", runs, 1, CalibrationOptions::kMaxRuns) ||
+      !args.integer("threads", calibration.threads, 1, 256))
     return usage(args.error());
-  calibration.healthyRuns = static_cast<int>(runs);
-  calibration.faultyRuns = static_cast<int>(std::max(1L, runs / 5));
-  calibration.threads = static_cast<int>(threads);
+  calibration.healthyRuns = runs;
+  calibration.faultyRuns = std::max(1, runs / 5);
   if (!calibration.isValid(&why)) return usage(why);
   if (!options.isValid(&why)) return usage(why);
   if (auto f = args.value("seed-fault")) {
@@ -340,10 +336,10 @@ int runDiagnose(const std::vector<std::string>& argv, std::ostream& out, std::os
     }
     request.referenceLog = std::make_shared<const IdData>(std::move(*healthy));
   }
-  const DiagnosisRun run = runDiagnosisRequest(request, *log);
+  const DiagnosisRun run = runDiagnosisRequest(request, *log, progressLine(err, "diagnose"));
   if (run.termination == Termination::Failed) {
     err << pre << run.message << "\n";
-    return kExitNumerical;
+    return run.badRequest ? kExitUsage : kExitNumerical;
   }
   const DiagnosisResult& r = run.result;
   if (auto trace = args.value("trace"); trace && !writeTrace(r, *trace, &why)) {

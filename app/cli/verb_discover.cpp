@@ -1,4 +1,5 @@
-// flexarm discover EST_LOG --model two-mass|three-mass [--validation-log VAL_LOG] [--json]
+// flexarm discover EST_LOG --model two-mass|three-mass [--validation-log VAL_LOG]
+//                  [--until-none [--max-effects N]] [--effect NAME[:values] ...] [--json]
 #include <cmath>
 #include <nlohmann/json.hpp>
 #include <ostream>
@@ -7,53 +8,63 @@
 #include "app/cli/log_args.h"
 #include "core/discovery/discovery.h"
 #include "core/session/report.h"
+#include "core/signal/excitation.h"
 
 namespace flexarm::cli {
 namespace {
 
 const char* kDiscoverHelp =
     "Usage: flexarm discover EST_LOG --model two-mass|three-mass [--validation-log VAL_LOG]\n"
+    "                        [--until-none [--max-effects N]] [--effect NAME[:V1[,V2]] ...]\n"
     "                        [--effects A,B,...] [--threads N] [--json]\n\n"
-    "Finds the effect the physical model misses. The base model (chapter 3: (3.13) or (3.21),\n"
+    "Finds the effects the physical model misses. The base model (chapter 3: (3.13) or (3.21),\n"
     "nominal parameters as the start) is fitted to the motor velocity differentiated from the\n"
     "motor angle (Section 5.2; a log whose output is the motor velocity, motor_velocity_rad_s\n"
     "or an output in rad/s, is integrated to an angle from zero and differentiated the same\n"
-    "way) by prediction error, simulating the model from the torque\n"
-    "reference at the data's rate with a slow load observer. Each candidate effect\n"
-    "(coulomb_friction, backlash, nonlinear_spring, input_delay, torque_ripple, extra_mass) is\n"
-    "added as a physical term and refitted with the base parameters. An effect is named only\n"
-    "when the F-test of the extra parameters passes at 99 %, the AIC falls, the effect\n"
-    "parameter's 99 % interval excludes zero and the validation residual RMS drops by 10 % or\n"
-    "more; otherwise the answer is none. Logs faster than 1.1 kHz are fitted at about 1 kHz\n"
-    "(torque averaged over blocks).\n\n"
+    "way) by prediction error, simulating the model from the torque reference at the data's\n"
+    "rate with a slow load observer (the predictor `flexarm fit --effect` uses on closed-loop\n"
+    "logs). Each candidate effect (coulomb_friction, backlash, nonlinear_spring, input_delay,\n"
+    "torque_ripple, extra_mass) is added as a physical term and refitted with the base\n"
+    "parameters and every effect already in the model. An effect is named only when the\n"
+    "F-test of its parameters passes at 99 %, the AIC falls, its parameter's 99 % interval\n"
+    "excludes zero and the residual on held-out data (the validation log, else the last 30 %\n"
+    "of every second of the log) is explained by the change the effect predicts (z-test at\n"
+    "99 %); otherwise the answer is none.\n"
+    "When several are significant, each pair is refitted together and the one whose\n"
+    "parameters still pass the F-test with the other in the model is named. Every verdict is\n"
+    "then confirmed or not by a second method on the held-out data: the residual before and\n"
+    "after, and a test specific to the effect (its signature regressed beside its\n"
+    "look-alikes'). Logs faster than 1.1 kHz are fitted at about 1 kHz (torque averaged over\n"
+    "blocks).\n\n"
     "  --model NAME          base model: two-mass, three-mass or four-mass (required)\n"
-    "  --validation-log LOG  validation data (else the log's validation range, if stored)\n"
+    "  --validation-log LOG  validation data (else the log's validation range, if stored;\n"
+    "                        else the last 0.3 s of every second of the log is held out)\n"
+    "  --until-none          the loop: find, add, refit the base and every effect so far,\n"
+    "                        find again, until none is missing (or --max-effects)\n"
+    "  --max-effects N       effects the loop finds at most (default 4)\n"
+    "  --effect NAME[:V1[,V2]]  an effect the base already has (repeatable, as in `fit`):\n"
+    "                        refitted with it and not looked for again\n"
     "  --effects A,B         candidates to test (default: all six)\n"
     "  --threads N           candidates fitted in parallel (default 2)\n"
+    "  --observer-bandwidth HZ  the load observer's bandwidth (default 1; 0: simulation)\n"
     "  --json                print the result as JSON\n\n"
-    "JSON fields: effect (a name or \"none\"), tied, effect_parameters {name: {value, std,\n"
-    "unit, lower, upper}}, evidence, candidates [{effect, loss_est, rms_val, aic, f, f_threshold,\n"
-    "significant, reason, parameters}], base and augmented {fit_percent,\n"
-    "fit_percent_validation (the seed's (5.2)), fit_percent_nrmse,\n"
+    "JSON fields: effect (the first effect named, or \"none\"), effects [{effect, parameters\n"
+    "{name: {value, std, unit, lower, upper}}, evidence, confirmed, confirmation, before and\n"
+    "after (scores)}] in the order found, stop_reason, tied, effect_parameters, evidence,\n"
+    "candidates [{effect, loss_est, rms_val, aic, f, f_threshold, held_out_z, significant,\n"
+    "reason, parameters}] of the first round, rounds [{effects, best, candidates}], base and\n"
+    "augmented {fit_percent, fit_percent_validation (the seed's (5.2)), fit_percent_nrmse,\n"
     "fit_percent_validation_nrmse (MATLAB compare's NRMSE fit), rms_estimation,\n"
-    "rms_validation}, disagreement (summary,\n"
-    "whiteness and independence tests), sample_time, seconds.\n";
+    "rms_validation}, validation_data, disagreement (summary, whiteness and independence\n"
+    "tests), sample_time, seconds.\n";
 
-nlohmann::json scoreJson(const DiscoveryScore& s, bool hasValidation) {
-  nlohmann::json j;
-  j["fit_percent"] = s.fitPercent;
-  j["fit_percent_nrmse"] = s.fitPercentNrmse;
-  j["rms_estimation"] = s.rmsEstimation;
-  if (hasValidation) {
-    j["fit_percent_validation"] = s.fitPercentValidation;
-    j["fit_percent_validation_nrmse"] = s.fitPercentValidationNrmse;
-    j["rms_validation"] = s.rmsValidation;
-  } else {
-    j["fit_percent_validation"] = nullptr;
-    j["fit_percent_validation_nrmse"] = nullptr;
-    j["rms_validation"] = nullptr;
-  }
-  return j;
+nlohmann::json scoreJson(const DiscoveryScore& s) {
+  return {{"fit_percent", s.fitPercent},
+          {"fit_percent_nrmse", s.fitPercentNrmse},
+          {"rms_estimation", s.rmsEstimation},
+          {"fit_percent_validation", s.fitPercentValidation},
+          {"fit_percent_validation_nrmse", s.fitPercentValidationNrmse},
+          {"rms_validation", s.rmsValidation}};
 }
 
 nlohmann::json finiteOrNull(double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(); }
@@ -67,12 +78,61 @@ nlohmann::json parametersJson(const std::vector<EffectParameterEstimate>& ps) {
   return j;
 }
 
+nlohmann::json candidatesJson(const std::vector<CandidateFit>& candidates) {
+  nlohmann::json list = nlohmann::json::array();
+  for (const auto& c : candidates)
+    list.push_back({{"effect", toString(c.kind)},
+                    {"loss_est", c.lossEst},
+                    {"rms_val", finiteOrNull(c.score.rmsValidation)},
+                    {"aic", finiteOrNull(c.aic)},
+                    {"f", c.fStatistic},
+                    {"f_threshold", c.fThreshold},
+                    {"held_out_z", finiteOrNull(c.heldOutZ)},
+                    {"significant", c.significant},
+                    {"reason", c.reason},
+                    {"parameters", parametersJson(c.parameters)}});
+  return list;
+}
+
+nlohmann::json confirmationJson(const Confirmation& c) {
+  return {{"confirmed", c.confirmed},
+          {"held_out_data", c.heldOutData},
+          {"rms_before", c.rmsBefore},
+          {"rms_after", c.rmsAfter},
+          {"held_out_z", finiteOrNull(c.heldOutZ)},
+          {"held_out_passes", c.heldOutPasses},
+          {"test", c.test},
+          {"value", finiteOrNull(c.value)},
+          {"std", finiteOrNull(c.std)},
+          {"z", finiteOrNull(c.z)},
+          {"fitted", c.fitted},
+          {"unit", c.unit},
+          {"rivals", c.rivals},
+          {"specific_passes", c.specificPasses},
+          {"text", c.text}};
+}
+
+// The `flexarm fit` command that refines the final model from where discovery ended: an
+// extra mass folded into the larger structure, the other effects as --effect.
+std::string refineLine(const std::string& log, const DiscoveryResult& r) {
+  const auto merged = mergedModel(*r.augmentedModel, r.augmentedEffects);
+  std::string s = "flexarm fit " + log + " --model " + merged.first->structureName();
+  for (const auto& e : merged.second) s += " --effect " + toString(e);
+  for (const auto& p : merged.first->parameters()) {
+    if (!p.free) continue;
+    s += " --start " + p.name + "=" + formatSignificant(p.value, 8);
+    // A damping the fit took below zero needs its default bound opened.
+    if (p.value < 0.0 && p.name.rfind("d_", 0) == 0) s += " --bound " + p.name + "=-inf:inf";
+  }
+  return s;
+}
+
 }  // namespace
 
 int runDiscover(const std::vector<std::string>& argv, std::ostream& out, std::ostream& err) {
   std::vector<std::string> valued = logReadOptionNames();
-  for (const char* n : {"model", "validation-log", "effects", "threads"}) valued.push_back(n);
-  ArgParser args({"json", "help"}, valued);
+  for (const char* n : {"model", "validation-log", "effects", "threads", "effect", "max-effects", "observer-bandwidth"}) valued.push_back(n);
+  ArgParser args({"json", "help", "until-none"}, valued);
   if (!args.parse(argv)) {
     err << "flexarm discover: " << args.error() << "\n" << kDiscoverHelp;
     return kExitUsage;
@@ -112,11 +172,31 @@ int runDiscover(const std::vector<std::string>& argv, std::ostream& out, std::os
       pos = comma + 1;
     }
   }
-  if (!args.integer("threads", options.threads, 1, 64)) {
+  std::string why;
+  for (const auto& spec : args.values("effect")) {
+    auto e = parseEffect(spec, &why);
+    if (!e) {
+      err << pre << "--effect " << spec << ": " << why << "\n";
+      return kExitUsage;
+    }
+    options.startEffects.push_back(*e);
+  }
+  if (!args.integer("threads", options.threads, 1, 64) ||
+      !args.number("observer-bandwidth", options.observerBandwidthHz)) {
     err << pre << args.error() << "\n";
     return kExitUsage;
   }
-  std::string why;
+  if (args.value("max-effects") && !args.flag("until-none")) {
+    err << pre << "--max-effects needs --until-none\n";
+    return kExitUsage;
+  }
+  if (args.flag("until-none")) {
+    options.maxEffects = 4;
+    if (!args.integer("max-effects", options.maxEffects, 1, 6)) {
+      err << pre << args.error() << "\n";
+      return kExitUsage;
+    }
+  }
   if (!options.isValid(&why)) {
     err << pre << why << "\n";
     return kExitUsage;
@@ -134,66 +214,87 @@ int runDiscover(const std::vector<std::string>& argv, std::ostream& out, std::os
     if (est->estimationRange && !est->estimationRange->empty())
       *est = est->select(*est->estimationRange);
   }
+  // Dead data are bad input, named by channel, before the search starts.
+  for (const auto& [data, file] : {std::pair{&*est, args.positional()[0]},
+                                   std::pair{val ? &*val : nullptr, args.value("validation-log").value_or(args.positional()[0])}}) {
+    if (!data) continue;
+    if (const std::string dead = deadDataProblem(*data); !dead.empty()) {
+      err << pre << file << ": " << dead << "\n";
+      return kExitBadInput;
+    }
+  }
   const auto base = makeModel(*modelName);
-  const DiscoveryResult r = discoverMissingEffect(*base, *est, val ? &*val : nullptr, options);
+  DiscoveryResult r;
+  try {
+    r = discoverMissingEffect(*base, *est, val ? &*val : nullptr, options);
+  } catch (const std::invalid_argument& e) {
+    err << pre << e.what() << "\n";
+    return kExitUsage;
+  }
   if (r.termination == Termination::Failed) {
     err << pre << r.message << "\n";
     return kExitNumerical;
   }
   const CandidateFit* best = r.best >= 0 ? &r.candidates[static_cast<std::size_t>(r.best)] : nullptr;
   if (!args.flag("json")) {
-    out << "Effect: " << (r.effect ? toString(*r.effect) : "none") << "\n"
-        << r.evidence << "\n\n"
-        << r.disagreement.summary << "\n\nCandidates:\n";
-    for (const auto& c : r.candidates) {
-      char line[200];
-      std::snprintf(line, sizeof line, "  %-17s loss %.4g  val RMS %.4g  AIC %+.1f  %s\n",
-                    toString(c.kind), c.lossEst, c.score.rmsValidation, c.aic - r.baseAic,
-                    c.significant ? "significant" : "-");
-      out << line << "      " << c.reason << "\n";
+    if (options.maxEffects > 1) {
+      out << "Effects: ";
+      if (r.found.empty()) out << "none";
+      for (std::size_t i = 0; i < r.found.size(); ++i) out << (i ? ", " : "") << toString(r.found[i].kind);
+      out << " (" << r.stopReason << ")\n";
     }
-    if (r.effect) {  // the augmented model as `flexarm fit` refines it
-      out << "Refine: flexarm fit " << args.positional()[0] << " --model " << *modelName;
-      for (const auto& e : r.augmentedEffects) out << " --effect " << toString(e);
-      // The refitted base as start values, so the fit starts where discovery ended.
-      if (r.augmentedModel)
-        for (const auto& p : r.augmentedModel->parameters()) {
-          if (!p.free) continue;
-          out << " --start " << p.name << "=" << formatSignificant(p.value, 8);
-          // A damping the base fit took below zero needs its default bound opened.
-          if (p.value < 0.0 && p.name.rfind("d_", 0) == 0) out << " --bound " << p.name << "=-inf:inf";
-        }
-      out << "\n";
+    for (std::size_t i = 0; i < r.rounds.size(); ++i) {
+      const DiscoveryRound& d = r.rounds[i];
+      out << (options.maxEffects > 1 ? "\nStep " + std::to_string(i + 1) + ": " : std::string()) << "Effect: "
+          << (d.effect ? toString(*d.effect) : "none") << "\n"
+          << d.evidence << "\n\n"
+          << d.disagreement.summary << "\n\nCandidates:\n";
+      for (const auto& c : d.candidates) {
+        char line[200];
+        std::snprintf(line, sizeof line, "  %-17s loss %.4g  held-out RMS %.4g  AIC %+.1f  %s\n", toString(c.kind),
+                      c.lossEst, c.score.rmsValidation, c.aic - d.aic, c.significant ? "significant" : "-");
+        out << line << "      " << c.reason << "\n";
+      }
     }
+    if (!r.found.empty() && r.augmentedModel) out << "Refine: " << refineLine(args.positional()[0], r) << "\n";
     out << "Seconds: " << r.seconds << "\n";
     return kExitOk;
   }
   nlohmann::json j;
   j["effect"] = r.effect ? toString(*r.effect) : "none";
+  j["effects"] = nlohmann::json::array();
+  for (const auto& f : r.found)
+    j["effects"].push_back({{"effect", toString(f.kind)},
+                            {"spec", toString(f.effect)},
+                            {"parameters", parametersJson(f.parameters)},
+                            {"evidence", f.evidence},
+                            {"confirmed", f.confirmation.confirmed},
+                            {"confirmation", confirmationJson(f.confirmation)},
+                            {"before", scoreJson(f.before)},
+                            {"after", scoreJson(f.after)}});
+  j["stop_reason"] = r.stopReason;
   j["tied"] = nlohmann::json::array();
   for (EffectKind k : r.tied) j["tied"].push_back(toString(k));
   j["effect_parameters"] = best ? parametersJson(best->parameters) : nlohmann::json::object();
   j["evidence"] = r.evidence;
-  j["candidates"] = nlohmann::json::array();
-  for (const auto& c : r.candidates) {
-    nlohmann::json cj;
-    cj["effect"] = toString(c.kind);
-    cj["loss_est"] = c.lossEst;
-    cj["rms_val"] = r.hasValidation ? finiteOrNull(c.score.rmsValidation) : nlohmann::json();
-    cj["aic"] = finiteOrNull(c.aic);
-    cj["f"] = c.fStatistic;
-    cj["f_threshold"] = c.fThreshold;
-    cj["significant"] = c.significant;
-    cj["reason"] = c.reason;
-    cj["parameters"] = parametersJson(c.parameters);
-    j["candidates"].push_back(cj);
+  j["candidates"] = candidatesJson(r.candidates);
+  j["rounds"] = nlohmann::json::array();
+  for (const auto& d : r.rounds) {
+    nlohmann::json effects = nlohmann::json::array();
+    for (const auto& e : d.effects) effects.push_back(toString(e));
+    j["rounds"].push_back({{"effects", effects},
+                           {"effect", d.effect ? toString(*d.effect) : "none"},
+                           {"decision", d.decision},
+                           {"score", scoreJson(d.score)},
+                           {"candidates", candidatesJson(d.candidates)}});
   }
-  j["base"] = scoreJson(r.base, r.hasValidation);
+  j["base"] = scoreJson(r.base);
   j["base"]["aic"] = r.baseAic;
-  j["augmented"] = scoreJson(r.augmented, r.hasValidation);
-  // The augmented model's effects as `flexarm fit --effect` takes them.
+  j["augmented"] = scoreJson(r.augmented);
+  // The final model's effects as `flexarm fit --effect` takes them.
   j["augmented"]["effects"] = nlohmann::json::array();
   for (const auto& e : r.augmentedEffects) j["augmented"]["effects"].push_back(toString(e));
+  j["validation_data"] = r.validationData;
   j["disagreement"] = {{"summary", r.disagreement.summary},
                        {"white", r.disagreement.tests.white},
                        {"independent", r.disagreement.tests.independent},

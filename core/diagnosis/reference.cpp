@@ -89,6 +89,16 @@ NominalFit fitNominalModel(const PhysicalModel& start, const DiagnosisSignals& d
   fit.model = std::shared_ptr<const PhysicalModel>(plantOf(*r.model));
   fit.freeNames = r.freeNames;
   fit.covariance = r.covariance;
+  // The monitored parameters' sigma_0 and the thresholds come from this covariance: a fit
+  // whose Hessian is singular (data that cannot tell the parameters apart) has none to give.
+  if (fit.covariance.rows() != static_cast<Eigen::Index>(fit.freeNames.size()) ||
+      fit.covariance.cols() != fit.covariance.rows() || !fit.covariance.allFinite()) {
+    fit.termination = Termination::Failed;
+    fit.message = "the data cannot tell the parameters apart (the fit's Hessian is singular, so it gives "
+                  "no covariance for sigma_0); a log with more excitation is needed";
+    fit.model.reset();
+    return fit;
+  }
   fit.loss = outputErrors(*fit.model, data).squaredNorm() / static_cast<double>(data.size());
   if (!std::isfinite(fit.loss)) {
     fit.termination = Termination::Diverged;

@@ -25,11 +25,12 @@ void boundWarnings(const PhysicalModel& start, FitResult& result);
 // estimation experiment (nonlinear_pem.h). Fills the estimate, its effects and parameter rows.
 void fitNonlinear(const FitOptions& options, FitResult& result, const ProgressCallback& progress);
 
-// One experiment of prepared data over range as the nonlinear estimator sees it: the output
-// the model gives (velocity or angle), the logged angle when there is one, and a start in
-// rigid-body motion at the speed of the range's first sample.
+// One experiment of prepared data over range as the nonlinear estimator sees it
+// (nonlinearSeries of nonlinear_pem.h, the output the model gives: velocity or angle), and the
+// estimator's options: on closed-loop data the predictor discovery uses (a load observer,
+// the predicted angle differentiated as the logged one was).
 NonlinearSeries nonlinearSeries(const FitResult& result, const PreparedData& data, SampleRange range);
-NonlinearPemOptions nonlinearOptions(const FitOptions& options);
+NonlinearPemOptions nonlinearOptions(const FitOptions& options, const FitResult& result);
 
 // Step 5: fit % on every experiment, residual tests, response, notches and peaks, warnings.
 void evaluate(const FitOptions& options, FitResult& result);

@@ -1,33 +1,36 @@
 // Steps 2-4 of the fit pipeline for physical models with effects: the nonlinear grey-box
 // estimator (nonlinear_pem.h, output error (5.7)) over every estimation experiment.
+#include <cstdio>
+
 #include "core/ident/fit_internal.h"
 
 namespace flexarm::fit_detail {
 
-NonlinearPemOptions nonlinearOptions(const FitOptions& o) {
+namespace {
+bool angleOutput(const FitResult& r) {
+  return r.model.start && r.model.start->options().output == ModelOutput::MotorAngle;
+}
+}  // namespace
+
+NonlinearPemOptions nonlinearOptions(const FitOptions& o, const FitResult& r) {
   NonlinearPemOptions no;
   no.maxIterations = o.maxIterations;
   no.level = o.level;
-  no.output = o.model.start && o.model.start->options().output == ModelOutput::MotorAngle
-                  ? PredictedOutput::MotorAngle
+  // A velocity differentiated from the angle at the fit's rate is compared with the predicted
+  // angle through the same central differences; a logged velocity, or one decimated behind
+  // the anti-alias filter, with the velocity state.
+  no.output = angleOutput(r) ? PredictedOutput::MotorAngle
+              : r.data.differentiated && r.data.decimation == 1 && r.data.angle.size() > 0
+                  ? PredictedOutput::DifferentiatedAngle
                   : PredictedOutput::MotorVelocity;
+  // A closed-loop log carries a load torque on the arm that the controller answers: the
+  // observer keeps the simulation on the measured operating point, as in discovery.
+  no.observerBandwidthHz = r.data.closedLoop ? kClosedLoopObserverHz : 0.0;
   return no;
 }
 
 NonlinearSeries nonlinearSeries(const FitResult& r, const PreparedData& d, SampleRange range) {
-  NonlinearSeries s;
-  const auto b = static_cast<Eigen::Index>(range.begin), n = static_cast<Eigen::Index>(range.size());
-  s.Ts = d.sampleTime;
-  s.startTime = d.timeAt(range.begin);
-  s.u.assign(d.u.data() + b, d.u.data() + b + n);
-  s.y.assign(d.y.data() + b, d.y.data() + b + n);
-  const bool angleOut = r.model.start && r.model.start->options().output == ModelOutput::MotorAngle;
-  if (angleOut) s.phi = s.y;
-  else if (d.angle.size() == d.u.size()) s.phi.assign(d.angle.data() + b, d.angle.data() + b + n);
-  // The start in rigid-body motion at the first sample's speed.
-  if (angleOut) s.initialSpeed = n > 1 ? (s.y[1] - s.y[0]) / s.Ts : 0.0;
-  else s.initialSpeed = n > 0 ? s.y[0] : 0.0;
-  return s;
+  return flexarm::nonlinearSeries(d, range, angleOutput(r));
 }
 
 void fitNonlinear(const FitOptions& o, FitResult& r, const ProgressCallback& progress) {
@@ -35,13 +38,19 @@ void fitNonlinear(const FitOptions& o, FitResult& r, const ProgressCallback& pro
   for (const auto& e : r.estimation) experiments.push_back(nonlinearSeries(r, e.data, e.data.estimation));
   // The start model with the start values and the fit's bounds, as for the linear fits.
   const std::shared_ptr<const PhysicalModel> start = fitStartModel(o, &r.warnings);
-  NonlinearPemResult e = nonlinearPem(*start, o.model.effects, experiments, nonlinearOptions(o), progress);
+  const NonlinearPemOptions no = nonlinearOptions(o, r);
+  NonlinearPemResult e = nonlinearPem(*start, o.model.effects, experiments, no, progress);
   r.summary = e.summary;
   if (!e.model) return;
   if (r.data.closedLoop) {
     r.method = ClosedLoopMethod::Direct;
     r.methodDescription = "direct fit of closed-loop data";
-    r.methodReason = "a fit with effects simulates the plant from the measured torque";
+    char reason[160];
+    std::snprintf(reason, sizeof reason,
+                  "a fit with effects simulates the plant from the measured torque, through a %g Hz load "
+                  "observer as discovery does",
+                  no.observerBandwidthHz);
+    r.methodReason = reason;
   }
   std::size_t row = 0;
   for (; row < e.model->parameters().size(); ++row) {

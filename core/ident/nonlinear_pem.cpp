@@ -11,6 +11,35 @@
 
 namespace flexarm {
 
+LoadObserver loadObserver(const PhysicalModel& model, double bandwidthHz) {
+  if (!(bandwidthHz > 0.0)) return {};
+  const double r = model.value("r");
+  double J = 0.0;  // J_m + r^2 (every other inertia)
+  for (const auto& p : model.parameters())
+    if (p.name.size() > 2 && p.name.compare(0, 2, "J_") == 0) J += p.name == "J_m" ? p.value : r * r * p.value;
+  return {2.0 * M_PI * bandwidthHz, J / model.value("k_T")};
+}
+
+NonlinearSeries nonlinearSeries(const PreparedData& d, SampleRange range, bool angleOutput) {
+  NonlinearSeries s;
+  const auto b = static_cast<Eigen::Index>(range.begin), n = static_cast<Eigen::Index>(range.size());
+  s.Ts = d.sampleTime;
+  s.startTime = d.timeAt(range.begin);
+  s.u.assign(d.u.data() + b, d.u.data() + b + n);
+  s.y.assign(d.y.data() + b, d.y.data() + b + n);
+  if (angleOutput) {
+    s.phi = s.y;
+    s.initialSpeed = n > 1 ? (s.y[1] - s.y[0]) / s.Ts : 0.0;
+    return s;
+  }
+  if (d.angle.size() == d.u.size()) {
+    s.phi.assign(d.angle.data() + b, d.angle.data() + b + n);
+    s.resetAngle = true;
+  }
+  s.initialSpeed = s.y.empty() ? 0.0 : s.y[0];
+  return s;
+}
+
 int defaultSubsteps(double Ts) { return std::max(2, static_cast<int>(std::ceil(Ts / 2.5e-4 - 1e-9))); }
 
 bool predictOutput(const NonlinearPlant& plant, const NonlinearSeries& s, int substeps,
@@ -143,12 +172,19 @@ bool NonlinearProblem::evaluate(const Eigen::VectorXd& phi, Eigen::VectorXd& eps
   Eigen::Index N = 0;
   for (std::size_t s = 0; s < series.size(); ++s) {
     if (!simulate(phi, *series[s], yhat[s])) return false;
-    N += static_cast<Eigen::Index>(yhat[s].size());
+    N += static_cast<Eigen::Index>(series[s]->fitSamples.empty() ? yhat[s].size() : series[s]->fitSamples.size());
   }
+  // The errors that enter the loss: every sample, or the series' fitSamples.
+  auto stack = [this](std::size_t s, const std::vector<double>& y, auto&& put) {
+    const auto& pick = series[s]->fitSamples;
+    if (pick.empty())
+      for (std::size_t k = 0; k < y.size(); ++k) put(k);
+    else
+      for (std::size_t k : pick) put(k);
+  };
   eps.resize(N);
   for (std::size_t s = 0, at = 0; s < series.size(); ++s)
-    for (std::size_t k = 0; k < yhat[s].size(); ++k, ++at)
-      eps[static_cast<Eigen::Index>(at)] = series[s]->y[k] - yhat[s][k];
+    stack(s, yhat[s], [&](std::size_t k) { eps[static_cast<Eigen::Index>(at++)] = series[s]->y[k] - yhat[s][k]; });
   if (!psi) return true;
   const std::size_t p = coords.size();
   psi->resize(N, static_cast<Eigen::Index>(p));
@@ -166,7 +202,7 @@ bool NonlinearProblem::evaluate(const Eigen::VectorXd& phi, Eigen::VectorXd& eps
       Eigen::Index at = 0;
       for (std::size_t s = 0; s < series.size() && ok; ++s) {
         ok = simulate(p2, *series[s], y2);
-        for (std::size_t k = 0; ok && k < y2.size(); ++k, ++at) (*psi)(at, jj) = (y2[k] - yhat[s][k]) / d;
+        if (ok) stack(s, y2, [&](std::size_t k) { (*psi)(at++, jj) = (y2[k] - yhat[s][k]) / d; });
       }
       if (ok) return true;
     }
@@ -253,6 +289,8 @@ bool NonlinearPemOptions::isValid(std::string* why) const {
   if (!(level > 0.0 && level < 1.0)) return fail("the level must lie strictly between 0 and 1");
   if (substeps < 0 || substeps > 200) return fail("substeps must be in 0..200");
   if (threads < 1 || threads > 64) return fail("threads must be in 1..64");
+  if (!(observerBandwidthHz >= 0.0) || !std::isfinite(observerBandwidthHz))
+    return fail("the observer bandwidth must be >= 0 Hz");
   if (why) why->clear();
   return true;
 }
@@ -314,6 +352,7 @@ NonlinearPemResult nonlinearPem(const PhysicalModel& start, const std::vector<Fi
   for (const auto& s : experiments) pr.series.push_back(&s);
   pr.substeps = o.substeps > 0 ? o.substeps : defaultSubsteps(experiments.front().Ts);
   pr.output = o.output;
+  pr.observer = loadObserver(*base, o.observerBandwidthHz);
   pr.threads = o.threads;
   LeastSquaresSolution sol =
       pr.solve(pr.coordinatesOf(values), o.maxIterations, o.relativeTolerance, progress);
@@ -381,7 +420,7 @@ Eigen::VectorXd simulateNonlinear(const PhysicalModel& model, const std::vector<
   const NonlinearPlant plant(*m, effects);
   std::vector<double> yhat;
   const int substeps = o.substeps > 0 ? o.substeps : defaultSubsteps(series.Ts);
-  if (!predictOutput(plant, series, substeps, {}, o.output, yhat)) return {};
+  if (!predictOutput(plant, series, substeps, loadObserver(*m, o.observerBandwidthHz), o.output, yhat)) return {};
   return Eigen::Map<const Eigen::VectorXd>(yhat.data(), static_cast<Eigen::Index>(yhat.size()));
 }
 

@@ -20,6 +20,7 @@
 #include <Eigen/Dense>
 
 #include "core/common/progress.h"
+#include "core/ident/fit_data.h"
 #include "core/ident/levenberg_marquardt.h"
 #include "core/ident/pem.h"
 #include "core/models/effects.h"
@@ -50,6 +51,9 @@ struct NonlinearSeries {
   // the stage point, which moves smoothly with a delay (a held value jumps only when a sample
   // edge crosses a stage point, giving a zero gradient). An input delay always averages.
   bool averageTorque = false;
+  // The samples whose errors enter the loss, ascending (empty: every sample): a log split
+  // into fitted and held-out samples is still simulated whole.
+  std::vector<std::size_t> fitSamples;
 };
 
 // A slow observer of an unmeasured arm-side load: a PI torque on the motor (in units of u)
@@ -59,6 +63,23 @@ struct LoadObserver {
   double wo = 0.0;
   double gain = 0.0;
 };
+
+// The bandwidth of the load observer on closed-loop logs (a log with a reference channel):
+// the one predictor `flexarm fit --effect` and discovery (core/discovery) both fit with. The
+// load torque of a closed-loop log (Figure 5.1) drifts faster than a 1 Hz observer follows,
+// and the residual it leaves biases the effects' values (Coulomb friction 0.02 +- 0.007 N m
+// on a log whose truth is 0.05, where 4 Hz gives 0.041 +- 0.004).
+constexpr double kClosedLoopObserverHz = 4.0;
+
+// The observer of a model: bandwidth in Hz, its gain the axis's inertia seen from the motor
+// over the torque constant (0 Hz: none, pure output error).
+LoadObserver loadObserver(const PhysicalModel& model, double bandwidthHz);
+
+// The series of the samples in range of prepared data (core/ident/fit_data.h): the torque
+// held over each sample (averaged over each Runge-Kutta step only with a delay), the output, the measured motor angle when the
+// data hold one (each step starts from it, so the ripple sees the real angle) and the first
+// sample's speed. angleOutput: the output is the angle itself.
+NonlinearSeries nonlinearSeries(const PreparedData& data, SampleRange range, bool angleOutput);
 
 // The predicted output of a plant for one experiment; false when the simulation blows up.
 // deflection, when given, receives the gear deflection at every sample.
@@ -135,7 +156,11 @@ struct NonlinearPemOptions {
   double level = 0.99;  // of the reported intervals
   int substeps = 0;     // Runge-Kutta steps per sample; 0: defaultSubsteps
   int threads = 2;      // gradient columns computed in parallel
+  // MotorVelocity or DifferentiatedAngle for a velocity output (the latter where the series
+  // holds the measured angle: the predicted angle through the same central differences).
   PredictedOutput output = PredictedOutput::MotorVelocity;
+  // Load observer (loadObserver) for closed-loop data: kClosedLoopObserverHz; 0: output error.
+  double observerBandwidthHz = 0.0;
   bool isValid(std::string* why) const;
 };
 

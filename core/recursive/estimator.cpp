@@ -289,6 +289,12 @@ struct RecursiveEstimator::Impl {
       zoh.advance(A, B, dA, dB, T, u, x, X);
     else
       zoh.advance(A, B, noDerivatives, noInputDerivatives, T, u, x, noSensitivities);
+    if (zoh.tooLongSubsteps() > 0.0) {
+      stop("The sample time of " + formatNumber(T) + " s is far longer than the model's fastest time scale: " +
+           "one sample would take " + formatNumber(zoh.tooLongSubsteps()) + " integration steps (at most " +
+           formatNumber(ExtendedZoh::kMaxSubsteps) + "); check the log's time column or resample it.");
+      return false;
+    }
     if (!x.allFinite() || !X.allFinite()) {
       stop("The predictor's state is no longer finite at t = " + formatNumber(t) +
            " s: the model at the estimate is unstable.");

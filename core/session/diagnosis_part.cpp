@@ -97,6 +97,7 @@ class DiagnosisPart : public SessionPart {
     if (!stored) return;  // validated on load
     const IdData* monitored = nullptr;
     auto fail = [&report](const std::string& text) {
+      report.warnings.push_back("diagnosis: could not run: " + text);  // e.g. a log the session lacks
       ReportSection s;
       s.title = "Diagnosis";
       s.paragraphs.push_back("The diagnosis could not run: " + text + ".");

@@ -37,6 +37,26 @@ bool readEffectList(const json& j, const char* key, const char* notList, const c
   return true;
 }
 
+// Effects written as `flexarm fit --effect` takes them ("backlash:0.0002"), if the key is there.
+bool readEffects(const json& j, const char* key, std::vector<Effect>& out, std::string* why, const std::string& where) {
+  if (!j.contains(key)) return true;
+  if (!j[key].is_array()) {
+    if (why) *why = where + key + " must be a list of effects";
+    return false;
+  }
+  out.clear();
+  for (const auto& e : j[key]) {
+    std::string reason;
+    auto effect = e.is_string() ? parseEffect(e.get<std::string>(), &reason) : std::nullopt;
+    if (!effect) {
+      if (why) *why = where + key + ": " + (e.is_string() ? reason : "each effect must be text, not " + e.dump());
+      return false;
+    }
+    out.push_back(*effect);
+  }
+  return true;
+}
+
 json dataRefToJson(const DiscoveryDataRef& d) {
   return {{"log", d.log}, {"range_s", secondsRangeToJson(d.range)}};
 }
@@ -138,10 +158,7 @@ std::unique_ptr<PhysicalModel> pickBase(const DiscoveryRequest& q, const Session
   if (q.baseModel.empty()) return makeModel(q.baseStructure);
   const auto spec = findListModel(session.parts.value("models", json::array()), q.baseModel, why);
   if (!spec) return nullptr;
-  if (!spec->effects.empty()) {
-    *why = "the base model '" + q.baseModel + "' has effects; discovery starts from a model without";
-    return nullptr;
-  }
+  // Its effects, if any, are the request's start effects (stored with it).
   auto c = spec->model->clone();
   return std::unique_ptr<PhysicalModel>(static_cast<PhysicalModel*>(c.release()));
 }
@@ -193,14 +210,20 @@ class DiscoveryPart : public SessionPart {
     std::string candidates;
     for (EffectKind k : request->options.candidates)
       candidates += (candidates.empty() ? "" : ", ") + std::string(toString(k));
-    s.paragraphs.push_back("Candidates tested: " + candidates + ". An effect is named only when the "
-                           "F-test of its parameters passes, the AIC falls, its parameter's " +
-                           formatSignificant(100.0 * request->options.level, 3) +
-                           " % interval excludes zero and the validation residual RMS drops by " +
-                           formatSignificant(100.0 * request->options.minValidationImprovement, 3) +
-                           " % or more.");
+    std::string start;
+    for (const Effect& e : request->options.startEffects) start += (start.empty() ? "" : ", ") + toString(e);
+    s.paragraphs.push_back("Candidates tested: " + candidates + (start.empty() ? "" : "; the base starts with " + start) +
+                           (request->options.maxEffects > 1
+                                ? "; the loop looks for up to " + std::to_string(request->options.maxEffects) +
+                                      " effects, refitting the base and every effect found after each"
+                                : std::string()) +
+                           ". An effect is named only when the F-test of its parameters passes, the AIC falls, "
+                           "its parameter's " + formatSignificant(100.0 * request->options.level, 3) +
+                           " % interval excludes zero and the residual on held-out data falls significantly; "
+                           "it is confirmed when a second test, specific to the effect, agrees on held-out data.");
     s.values = {{"base_model", baseName}};
     auto fail = [&](const std::string& text) {
+      report.warnings.push_back("discovery: could not run: " + text);  // e.g. a log the session lacks
       s.paragraphs.push_back("Discovery could not run: " + text + ".");
       s.values["effect"] = nullptr;
       s.values["message"] = text;
@@ -267,6 +290,28 @@ class DiscoveryPart : public SessionPart {
     }
     s.paragraphs.push_back(verdict);
     s.paragraphs.push_back("Evidence: " + r.evidence);
+    if (r.found.size() > 1 || (!r.found.empty() && !r.stopReason.empty())) {
+      // The ladder: the held-out residual and fit % of the base and after every effect.
+      ReportTable ladder{"The gap step by step (held-out data: " + r.validationData + ")",
+                         {"Step", "Model", "Fit % val.", "RMS val. (rad/s)", "Confirmed"}, {}};
+      ladder.rows.push_back({"0", "base", formatFixed(r.found.front().before.fitPercentValidation, 2),
+                             formatSignificant(r.found.front().before.rmsValidation), "-"});
+      std::string model = "base";
+      json steps = json::array();
+      for (std::size_t i = 0; i < r.found.size(); ++i) {
+        const FoundEffect& f = r.found[i];
+        model += " + " + std::string(toString(f.kind));
+        ladder.rows.push_back({std::to_string(i + 1), model, formatFixed(f.after.fitPercentValidation, 2),
+                               formatSignificant(f.after.rmsValidation), f.confirmation.confirmed ? "yes" : "no"});
+        steps.push_back({{"effect", toString(f.kind)}, {"confirmed", f.confirmation.confirmed},
+                         {"rms_validation", number(f.after.rmsValidation)}});
+        if (!f.confirmation.text.empty())
+          s.paragraphs.push_back(std::string(toString(f.kind)) + ": " + f.confirmation.text);
+      }
+      s.tables.push_back(ladder);
+      s.values["steps"] = steps;
+      s.values["stop_reason"] = r.stopReason;
+    }
     if (!r.disagreement.summary.empty())
       s.paragraphs.push_back("Where the base model disagrees: " + r.disagreement.summary);
 
@@ -307,7 +352,9 @@ class DiscoveryPart : public SessionPart {
                           r.hasValidation ? formatSignificant(sc.rmsValidation) : "-"});
     };
     row("base", r.base);
-    row(r.effect ? "base + " + effect : "augmented (= base)", r.augmented);
+    std::string all;
+    for (const auto& f : r.found) all += " + " + std::string(toString(f.kind));
+    row(all.empty() ? "augmented (= base)" : "base" + all, r.augmented);
     s.tables.push_back(cmp);
     if (r.hasValidation && r.base.rmsValidation > 0.0)
       s.paragraphs.push_back("The validation residual RMS falls from " + formatSignificant(r.base.rmsValidation) +
@@ -365,6 +412,8 @@ json discoveryRequestToJson(const DiscoveryRequest& q) {
   j["validation"] = q.validation ? dataRefToJson(*q.validation) : json(nullptr);
   json candidates = json::array();
   for (EffectKind k : q.options.candidates) candidates.push_back(toString(k));
+  json startEffects = json::array();
+  for (const Effect& e : q.options.startEffects) startEffects.push_back(toString(e));
   const DiscoveryOptions& o = q.options;
   j["options"] = {{"candidates", candidates},
                   {"observer_bandwidth_hz", o.observerBandwidthHz},
@@ -375,6 +424,9 @@ json discoveryRequestToJson(const DiscoveryRequest& q) {
                   {"level", o.level},
                   {"min_validation_improvement", o.minValidationImprovement},
                   {"tie_tolerance", o.tieTolerance},
+                  {"held_out_fraction", o.heldOutFraction},
+                  {"max_effects", o.maxEffects},
+                  {"start_effects", startEffects},
                   {"threads", o.threads}};
   return j;
 }
@@ -428,7 +480,9 @@ std::optional<DiscoveryRequest> discoveryRequestFromJson(const json& j, std::str
         !readNumber(o, "level", d.level, false, why, ow) ||
         !readNumber(o, "min_validation_improvement", d.minValidationImprovement, false, why, ow) ||
         !readNumber(o, "tie_tolerance", d.tieTolerance, false, why, ow) ||
-        !readWhole(o, "threads", d.threads, why, ow))
+        !readNumber(o, "held_out_fraction", d.heldOutFraction, false, why, ow) ||
+        !readWhole(o, "max_effects", d.maxEffects, why, ow) ||
+        !readWhole(o, "threads", d.threads, why, ow) || !readEffects(o, "start_effects", d.startEffects, why, ow))
       return std::nullopt;
   }
   std::string reason;
@@ -454,7 +508,20 @@ json discoveryResultToJson(const DiscoveryResult& r) {
                           {"score", scoreToJson(c.score)},
                           {"significant", c.significant},
                           {"reason", c.reason}});
+  json found = json::array();
+  for (const auto& f : r.found)
+    found.push_back({{"effect", toString(f.kind)},
+                     {"spec", toString(f.effect)},
+                     {"parameters", parametersToJson(f.parameters)},
+                     {"evidence", f.evidence},
+                     {"confirmed", f.confirmation.confirmed},
+                     {"confirmation", f.confirmation.text},
+                     {"before", scoreToJson(f.before)},
+                     {"after", scoreToJson(f.after)}});
   return {{"effect", r.effect ? toString(*r.effect) : "none"},
+          {"effects", found},
+          {"stop_reason", r.stopReason},
+          {"validation_data", r.validationData},
           {"tied", tied},
           {"evidence", r.evidence},
           {"disagreement", r.disagreement.summary},
@@ -486,8 +553,41 @@ std::optional<DiscoveryResult> discoveryResultFromJson(const json& j, std::strin
     }
   }
   if (!readEffectList(j, "tied", "tied must be a list", "unknown tied effect ", r.tied, why,
-                      where))
+                      where) ||
+      !readText(j, "stop_reason", r.stopReason, false, why, where) ||
+      !readText(j, "validation_data", r.validationData, false, why, where))
     return std::nullopt;
+  if (j.contains("effects")) {
+    if (!j["effects"].is_array()) {
+      if (why) *why = where + "effects must be a list";
+      return std::nullopt;
+    }
+    for (const auto& e : j["effects"]) {
+      const std::string ew = where + "found effect: ";
+      FoundEffect f;
+      std::string spec, reason;
+      if (!e.is_object() || !readText(e, "spec", spec, true, why, ew)) {
+        if (why && !e.is_object()) *why = ew + "must be an object";
+        return std::nullopt;
+      }
+      auto parsed = parseEffect(spec, &reason);
+      if (!parsed) {
+        if (why) *why = ew + reason;
+        return std::nullopt;
+      }
+      f.kind = parsed->kind;
+      f.effect = *parsed;
+      if ((e.contains("parameters") && !parametersFromJson(e["parameters"], f.parameters, why, ew)) ||
+          !readText(e, "evidence", f.evidence, false, why, ew) ||
+          !readFlag(e, "confirmed", f.confirmation.confirmed, why, ew) ||
+          !readText(e, "confirmation", f.confirmation.text, false, why, ew) ||
+          (e.contains("before") && !scoreFromJson(e["before"], f.before, why, ew + "before: ")) ||
+          (e.contains("after") && !scoreFromJson(e["after"], f.after, why, ew + "after: ")))
+        return std::nullopt;
+      f.confirmation.ran = !f.confirmation.text.empty();
+      r.found.push_back(std::move(f));
+    }
+  }
   if (!readText(j, "evidence", r.evidence, false, why, where) ||
       !readText(j, "disagreement", r.disagreement.summary, false, why, where) ||
       !readFlag(j, "has_validation", r.hasValidation, why, where) ||

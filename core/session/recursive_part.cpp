@@ -151,6 +151,8 @@ class RecursivePart : public SessionPart {
     s.paragraphs.push_back(design);
     s.values = {{"label", q.label}, {"algorithm", toString(o.algorithm)}};
     auto fail = [&](const std::string& text) {
+      report.warnings.push_back("recursive identification" + (q.label.empty() ? std::string() : " " + q.label) +
+                                ": could not run: " + text);  // e.g. a log the session lacks
       s.paragraphs.push_back("The recursive identification could not run: " + text + ".");
       s.values["termination"] = "failed";
       s.values["message"] = text;

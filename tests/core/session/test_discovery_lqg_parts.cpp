@@ -85,12 +85,17 @@ TEST(DiscoveryPart, RequestAndResultSurviveTheirJson) {
   DiscoveryRequest q = rippleRequest();
   q.options.observerBandwidthHz = 0.5;
   q.options.threads = 1;
+  q.options.maxEffects = 3;
+  q.options.startEffects = {Effect::withDefaults(EffectKind::CoulombFriction)};
   std::string why;
   auto back = discoveryRequestFromJson(discoveryRequestToJson(q), &why);
   ASSERT_TRUE(back) << why;
   EXPECT_EQ(discoveryRequestToJson(*back).dump(), discoveryRequestToJson(q).dump());
   EXPECT_EQ(back->options.candidates.size(), 3u);
   EXPECT_EQ(back->options.observerBandwidthHz, 0.5);
+  EXPECT_EQ(back->options.maxEffects, 3);
+  ASSERT_EQ(back->options.startEffects.size(), 1u);
+  EXPECT_EQ(back->options.startEffects[0].kind, EffectKind::CoulombFriction);
   ASSERT_TRUE(back->validation && back->validation->range);
   EXPECT_EQ(back->validation->range->start, 6.0);
 
@@ -109,10 +114,27 @@ TEST(DiscoveryPart, RequestAndResultSurviveTheirJson) {
   c.reason = "all four tests pass";
   r.candidates = {c};
   r.best = 0;
+  // The loop's steps: each effect with its parameters, confirmation and scores.
+  FoundEffect f;
+  f.kind = EffectKind::Backlash;
+  f.effect = Effect::withDefaults(EffectKind::Backlash);
+  f.parameters = c.parameters;
+  f.evidence = "a gap";
+  f.confirmation.confirmed = true;
+  f.confirmation.text = "confirmed on the validation data";
+  f.before.rmsValidation = 0.3;
+  f.after.rmsValidation = 0.1;
+  r.found = {f};
+  r.stopReason = "none of the candidates is significant";
+  r.validationData = "the validation data";
   auto rb = discoveryResultFromJson(discoveryResultToJson(r), &why);
   ASSERT_TRUE(rb) << why;
   EXPECT_EQ(discoveryResultToJson(*rb).dump(), discoveryResultToJson(r).dump());
   EXPECT_EQ(rb->candidates[0].parameters[0].std, 1e-5);
+  ASSERT_EQ(rb->found.size(), 1u);
+  EXPECT_TRUE(rb->found[0].confirmation.confirmed);
+  EXPECT_EQ(rb->found[0].after.rmsValidation, 0.1);
+  EXPECT_EQ(rb->stopReason, r.stopReason);
 }
 
 TEST(LqgPart, RequestSurvivesItsJsonAndBadOnesAreRefused) {
