@@ -227,7 +227,9 @@ int main() {
   diagnosisProcess();
   wholeProcess(std::string(FLEXARM_SOURCE_DIR) + "/sample_logs/diagnosis_no_fault.csv",
                "24 s log at 2 kHz (the chapter-6 sample log)");
-  // Ten minutes logged at 200 Hz: the seed's rate, nothing to decimate.
+  // Ten minutes of the 2 kHz loop logged at 200 Hz: the seed's rate, nothing to decimate, but
+  // the torque sampled where it changes ten times per sample, so the hold (6.27) is wrong and
+  // the row does not agree with the truth (the run's note says why).
   TempDir dir("flexarm_bench_recursive_long");
   const std::string longLog = dir.file("ten_minutes.csv");
   ReadError error;

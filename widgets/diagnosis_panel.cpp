@@ -2,6 +2,7 @@
 
 #include <QCheckBox>
 #include <QComboBox>
+#include <QDoubleSpinBox>
 #include <QFileDialog>
 #include <QFileInfo>
 #include <QHBoxLayout>
@@ -50,6 +51,7 @@ DiagnosisPanel::DiagnosisPanel(Workspace* workspace, QWidget* parent)
       referenceName_(new QLabel(tr("none: theta_0 from the model"), this)),
       window_(new QComboBox(this)),
       calibrate_(new QCheckBox(tr("Calibrate thresholds"), this)),
+      alpha_(new QDoubleSpinBox(this)),
       run_(new QPushButton(tr("Diagnose"), this)),
       cancel_(new QPushButton(tr("Cancel"), this)),
       progress_(new QProgressBar(this)),
@@ -117,6 +119,18 @@ DiagnosisPanel::DiagnosisPanel(Workspace* workspace, QWidget* parent)
   setupPlot(cusum_, tr("g / h [-]"));
   setupPlot(hypothesis_, tr("T [-]"));
   for (QCustomPlot* p : {cusum_, hypothesis_}) showLegendAbove(p);  // none until a result
+  alpha_->setObjectName("frictionAlpha");
+  alpha_->setRange(-2.5, 2.5);  // FrictionTemperatureModel::isValid over T_ref +- 40 degC
+  alpha_->setDecimals(3);
+  alpha_->setSingleStep(0.1);
+  alpha_->setSuffix(tr(" %/degC"));
+  alpha_->setValue(0.0);
+  alpha_->setToolTip(tr("Friction against temperature, f_m = f_m0 (1 + alpha (T - T_ref)): with "
+                        "alpha, theta_0's f_m is carried from the reference log's temperature to "
+                        "this log's (their temperature_c channel or metadata value) before the "
+                        "tests compare, so a warm healthy axis raises no friction alarm (negative: "
+                        "friction falling as the lubricant warms). 0: f_m is compared as fitted. flexarm diagnose --temperature-logs estimates "
+                        "alpha from healthy logs at several temperatures"));
   setupPlot(timeline_, "");
   timeline_->legend->setVisible(false);
   timeline_->yAxis->setRange(-0.3, 5.0);
@@ -138,6 +152,10 @@ DiagnosisPanel::DiagnosisPanel(Workspace* workspace, QWidget* parent)
   options->addWidget(window_);
   options->addWidget(calibrate_);
   options->addStretch(1);
+  auto* temperature = new QHBoxLayout;
+  temperature->addWidget(new QLabel(tr("Friction alpha (0: none):"), this));
+  temperature->addWidget(alpha_);
+  temperature->addStretch(1);
   options->addWidget(run_);
   options->addWidget(cancel_);
   auto* status = new QHBoxLayout;
@@ -184,6 +202,7 @@ DiagnosisPanel::DiagnosisPanel(Workspace* workspace, QWidget* parent)
   layout->addWidget(referenceName_);
   layout->addLayout(testsRow);
   layout->addLayout(options);
+  layout->addLayout(temperature);
   layout->addLayout(status);
   layout->addWidget(verdict_);
   layout->addWidget(plots, 1);
@@ -274,6 +293,14 @@ DiagnosisOptions DiagnosisPanel::chosenOptions() const {
   const double w = window_->currentData().toDouble();
   o.window = w > 0.0 ? HypothesisWindow::Sliding : HypothesisWindow::Cumulative;
   if (w > 0.0) o.windowS = w;
+  if (alpha_->value() == 0.0) {
+    o.friction.reset();
+  } else {
+    FrictionTemperatureModel f = o.friction.value_or(FrictionTemperatureModel{});
+    if (f.alpha != alpha_->value() / 100.0) f = FrictionTemperatureModel{};  // given, not estimated
+    f.alpha = alpha_->value() / 100.0;
+    o.friction = f;
+  }
   return o;
 }
 
@@ -438,6 +465,7 @@ void DiagnosisPanel::setRequest(const DiagnosisSessionRequest& request, const QS
                                DiagnosisTest::Hypothesis, DiagnosisTest::Joint};
   for (int i = 0; i < 5; ++i) tests_[i]->setChecked(request.options.uses(all[i]));
   window_->setCurrentIndex(request.options.window == HypothesisWindow::Sliding ? 0 : 1);
+  alpha_->setValue(request.options.friction ? 100.0 * request.options.friction->alpha : 0.0);
   const int k = request.model.empty() ? reference_->findData(QString::fromStdString(request.structure))
                                       : reference_->findText(QString::fromStdString(request.model));
   if (k >= 0) reference_->setCurrentIndex(k);

@@ -23,6 +23,7 @@ class QCPGraph;
 class QCheckBox;
 class QComboBox;
 class QCustomPlot;
+class QDoubleSpinBox;
 class QLabel;
 class QProgressBar;
 class QPushButton;
@@ -49,6 +50,9 @@ class DiagnosisPanel : public QWidget {
   QPushButton* runButton() const { return run_; }
   QCheckBox* calibrateBox() const { return calibrate_; }
   QComboBox* windowBox() const { return window_; }
+  // alpha of f_m = f_m0 (1 + alpha (T - T_ref)) in %/degC; 0: not known, f_m
+  // is compared as fitted whatever the logs' temperatures.
+  QDoubleSpinBox* frictionAlphaBox() const { return alpha_; }
   QTableWidget* decisionTable() const { return table_; }
   QCustomPlot* estimatesPlot() const { return estimates_; }
   QCustomPlot* cusumPlot() const { return cusum_; }
@@ -56,6 +60,8 @@ class DiagnosisPanel : public QWidget {
   QCustomPlot* timelinePlot() const { return timeline_; }
   QString verdictText() const;
   QString statementText() const;
+  // The thresholds with their provenance, the temperature correction and the model check.
+  QString thresholdsText() const;
 
   bool isBusy() const { return watcher_.isRunning(); }
   const DiagnosisRun* lastRun() const { return shownRun_ ? shownRun_.get() : nullptr; }
@@ -104,6 +110,7 @@ class DiagnosisPanel : public QWidget {
   QCheckBox* tests_[5];
   QComboBox* window_;
   QCheckBox* calibrate_;
+  QDoubleSpinBox* alpha_;
   QPushButton* run_;
   QPushButton* cancel_;
   QProgressBar* progress_;

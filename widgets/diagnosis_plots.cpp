@@ -158,8 +158,13 @@ void DiagnosisPanel::buildPlots() {
                            : storedCalibration_.is_object()
                                  ? tr("calibrated: %1").arg(QString::fromStdString(storedCalibration_.value("message", std::string())))
                                  : QString::fromStdString(defaultThresholdsProvenance());
-  thresholds_->setText(tr("Thresholds (sigma units, CUSUM alpha_2, level): %1. %2. Reference: %3.")
-                           .arg(th.join("; "), from, QString::fromStdString(r.referenceSource)));
+  thresholds_->setText(tr("Thresholds (sigma units, CUSUM alpha_2, level): %1. %2. Reference: %3. "
+                          "Temperature: %4. %5")
+                           .arg(th.join("; "), from, QString::fromStdString(r.referenceSource),
+                                QString::fromStdString(r.temperature.message.empty()
+                                                           ? std::string("not stated")
+                                                           : r.temperature.message),
+                                QString::fromStdString(r.modelCheck.message)));
   for (QCustomPlot* p : {cusum_, hypothesis_}) showLegendAbove(p);  // above the data, no curve under it
   for (QCustomPlot* p : {estimates_, cusum_, hypothesis_, timeline_}) p->replot();
 }
@@ -241,5 +246,6 @@ void DiagnosisPanel::showAt(double t) {
 
 QString DiagnosisPanel::verdictText() const { return verdict_->text(); }
 QString DiagnosisPanel::statementText() const { return statement_->text(); }
+QString DiagnosisPanel::thresholdsText() const { return thresholds_->text(); }
 
 }  // namespace flexarm

@@ -121,9 +121,11 @@ void RecursiveRunner::work(int id, std::shared_ptr<const IdData> log,
     }
     chunk.reached = t0 + (static_cast<double>(k) - 1.0) * T;
     chunk.finished = k == n || stopped || cancelled;
-    if (chunk.finished)
-      chunk.result = std::make_shared<const RecursiveResult>(
-          finishRecursive(est, all, n, cancelled, start->Q));
+    if (chunk.finished) {
+      RecursiveResult done = finishRecursive(est, all, n, cancelled, start->Q);
+      appendRateNote(done, prepared.decimation);
+      chunk.result = std::make_shared<const RecursiveResult>(std::move(done));
+    }
     {
       std::lock_guard<std::mutex> lock(mutex_);
       if (stop_) return;

@@ -84,12 +84,18 @@ TemperatureCorrection correctForTemperature(DiagnosisReference& reference,
                 "move it with nothing broken";
     return c;
   }
+  // A given alpha (no healthy logs behind it) is relative to the reference log's friction:
+  // T_ref is that log's temperature, f_m (T) = f_m,ref (1 + alpha (T - T_reference)).
+  FrictionTemperatureModel given = *model;
+  if (given.logs == 0) given.referenceC = *reference.temperatureC;
+  c.model = given;
+  const FrictionTemperatureModel& m = c.model;
   std::string why;
-  if (!model->isValid(&why)) throw std::invalid_argument("the friction temperature model: " + why);
+  if (!m.isValid(&why)) throw std::invalid_argument("the friction temperature model: " + why);
   // The model is the arm's friction: the plant's (free of the closed-loop bias). theta_0's f_m
   // (fitted through the diagnosis' predictor, which may offset it) moves by the same amount.
   const double plantFm = reference.plant ? reference.plant->value("f_m") : c.fmReference;
-  const double plantWarm = model->atTemperature(model->toReference(plantFm, *reference.temperatureC), *monitoredC);
+  const double plantWarm = m.atTemperature(m.toReference(plantFm, *reference.temperatureC), *monitoredC);
   const double shift = plantWarm - plantFm;
   c.fmExpected = c.fmReference + shift;
   if (!(c.fmExpected > 0.0)) {
@@ -97,11 +103,11 @@ TemperatureCorrection correctForTemperature(DiagnosisReference& reference,
     c.fmExpected = c.fmReference;
     return c;
   }
-  for (auto* m : {&reference.nominal, &reference.plant}) {
-    if (!*m) continue;
-    auto copy = (*m)->clone();
-    copy->setParameter("f_m", (*m)->value("f_m") + shift);
-    *m = std::shared_ptr<const PhysicalModel>(static_cast<PhysicalModel*>(copy.release()));
+  for (auto* part : {&reference.nominal, &reference.plant}) {
+    if (!*part) continue;
+    auto copy = (*part)->clone();
+    copy->setParameter("f_m", (*part)->value("f_m") + shift);
+    *part = std::shared_ptr<const PhysicalModel>(static_cast<PhysicalModel*>(copy.release()));
   }
   c.applied = true;
   char buf[400];
@@ -109,7 +115,7 @@ TemperatureCorrection correctForTemperature(DiagnosisReference& reference,
                 "f_m compared at the monitored log's %.1f degC: the arm's f_m %.4g at the reference's "
                 "%.1f degC is %.4g there with alpha = %.3g %%/degC (%+.1f %% for %+.1f degC), so "
                 "theta_0's f_m moves from %.4g to %.4g",
-                *monitoredC, plantFm, *reference.temperatureC, plantWarm, 100.0 * model->alpha,
+                *monitoredC, plantFm, *reference.temperatureC, plantWarm, 100.0 * m.alpha,
                 100.0 * (plantWarm / plantFm - 1.0), dT, c.fmReference, c.fmExpected);
   c.message = buf;
   return c;

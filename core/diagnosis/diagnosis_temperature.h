@@ -42,8 +42,9 @@ struct TemperatureCorrection {
 // temperature to the monitored one by `model`. The model is the arm's friction, the plant's
 // f_m: f_m0 = model.toReference(f_m, T_reference), then model.atTemperature(f_m0,
 // T_monitored); theta_0's f_m, fitted through the diagnosis' predictor, moves by the same
-// amount. Nothing changes, with a sentence saying why, when a temperature is unknown, alpha is
-// 0 (not known) or the model has no f_m.
+// amount. A given alpha (model.logs 0, not estimated from healthy logs) is relative to the
+// reference log: T_ref is taken as its temperature. Nothing changes, with a sentence saying
+// why, when a temperature is unknown, alpha is 0 (not known) or the model has no f_m.
 TemperatureCorrection correctForTemperature(DiagnosisReference& reference,
                                             const std::optional<double>& monitoredC,
                                             const std::optional<FrictionTemperatureModel>& model);

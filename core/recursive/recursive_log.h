@@ -52,6 +52,13 @@ struct RecursiveLogResult {
   int decimation = 1;
 };
 
+// What the rate does to the estimates: below 1 kHz the zero-order hold of the torque (6.27) is
+// exact only where the controller ran at that rate, and a faster one biases them (measured on
+// simulated logs of the 2 kHz loop of Figure 5.1). Empty at 1 kHz and above. appendRateNote
+// adds it to a result's caveat; every run of a log (command line, session, panel) does.
+std::string recursiveRateNote(double sampleTime, int decimation);
+void appendRateNote(RecursiveResult& result, int decimation);
+
 // prepareRecursiveData, then recursiveIdentification over the range's samples (times as in
 // the log).
 RecursiveLogResult recursiveIdentification(const IdData& log, const ParametricModel& nominal,

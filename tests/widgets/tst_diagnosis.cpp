@@ -3,10 +3,14 @@
 // log diagnosis_no_fault.csv as the reference, click "Diagnose", then move the window's
 // playhead: green before the fault, the decision table and the verdict naming k_T once the
 // playhead passes the alarm (a screenshot at that moment), and the session keeps the request.
-// The healthy log of the same experiment stays green to its end.
+// The healthy log of the same experiment stays green to its end. Logs the closed loop simulates
+// here: a healthy axis 15 degC warmer than its reference (f_m 20 % higher) stays green with
+// the friction's alpha and reads as an f_m fault without it; a gear with an unmodelled
+// backlash turns the verdict to "the model no longer fits".
 #include <QCheckBox>
 #include <QComboBox>
 #include <QDockWidget>
+#include <QDoubleSpinBox>
 #include <QPushButton>
 #include <QSignalSpy>
 #include <QTableWidget>
@@ -17,7 +21,10 @@
 #include "app/main_window.h"
 #include "app/panel_docks.h"
 #include "app/session_controller.h"
+#include "core/io/log_io.h"
+#include "core/models/effects.h"
 #include "core/session/session.h"
+#include "core/sim/closed_loop.h"
 #include "widget_test_support.h"
 #include "widgets/arm_panel.h"
 #include "widgets/diagnosis_panel.h"
@@ -45,8 +52,26 @@ class DiagnosisPanelTest : public QObject {
     QVERIFY(opened.wait(30000));
   }
 
-  void runDiagnosis() {
-    panel()->setReferenceLog(kReference);
+  // 20 s of the closed loop around the three-mass truth (Table 5.7 p6) with the multisine of
+  // the sample logs, its temperature in the metadata, written into dir.
+  static QString simulatedLog(const QTemporaryDir& dir, const QString& name, double fm, double celsius,
+                              std::vector<Effect> effects = {}, std::uint64_t seed = 1) {
+    auto truth = makeModel("three-mass");
+    truth->setParameter("f_m", fm);
+    SimulationOptions so;
+    so.durationS = 20.0;
+    so.seed = seed;
+    so.excitation.kind = ExcitationKind::Multisine;
+    so.excitation.amplitude = 0.2;
+    SimulationResult sim = simulateClosedLoop(*truth, effects, so);
+    if (sim.termination != Termination::Converged) return {};
+    sim.data.metadata.emplace_back(columns::kTemperature, QString::number(celsius).toStdString());
+    const QString path = dir.filePath(name);
+    return writeFlexArmCsv(sim.data, path.toStdString()) ? path : QString();
+  }
+
+  void runDiagnosis(const QString& reference = kReference) {
+    panel()->setReferenceLog(reference);
     QComboBox* model = panel()->referenceBox();
     model->setCurrentIndex(model->findText("three-mass (nominal)"));
     QSignalSpy done(panel(), &DiagnosisPanel::finished);
@@ -200,6 +225,68 @@ class DiagnosisPanelTest : public QObject {
     QVERIFY2(panel()->verdictText().startsWith("No fault"), qPrintable(panel()->verdictText()));
     QCOMPARE(panel()->decisionTable()->item(3, 4)->text(), QString("possible"));
     test::saveShot(window_->grab().toImage(), "diagnosis_window_healthy");
+  }
+
+  // The friction's alpha in the panel: a healthy axis logged at 40 degC, whose f_m is 20 %
+  // above the reference's at 25 degC, stays green once alpha = 1.333 %/degC is given (the
+  // thresholds' text states the correction), and reads as an f_m fault without it.
+  void aWarmAxisIsComparedAtItsTemperature() {
+    QTemporaryDir dir;
+    QVERIFY(dir.isValid());
+    const double fm = makeModel("three-mass")->value("f_m");
+    const QString cold = simulatedLog(dir, "cold.csv", fm, 25.0, {}, 101);
+    const QString warm = simulatedLog(dir, "warm.csv", 1.2 * fm, 40.0, {}, 4);
+    QVERIFY(!cold.isEmpty() && !warm.isEmpty());
+    open(warm);
+    QDoubleSpinBox* alpha = panel()->frictionAlphaBox();
+    QCOMPARE(alpha->value(), 0.0);  // not known until given
+    alpha->setValue(100.0 * 0.2 / 15.0);
+    QCOMPARE(panel()->frictionAlphaBox()->value(), 1.333);
+    runDiagnosis(cold);
+    const DiagnosisResult& r = panel()->lastRun()->result;
+    QVERIFY2(r.temperature.applied, r.temperature.message.c_str());
+    QCOMPARE(QString::fromStdString(r.verdictName()), QString("none"));
+    window_->playhead()->setTime(r.time.back());
+    QTest::qWait(100);
+    QVERIFY2(panel()->verdictText().startsWith("No fault"), qPrintable(panel()->verdictText()));
+    QVERIFY2(panel()->thresholdsText().contains("f_m compared at the monitored log's 40.0 degC"),
+             qPrintable(panel()->thresholdsText()));
+    test::saveShot(panel()->grab().toImage(), "diagnosis_panel_warm_axis");
+    alpha->setValue(0.0);
+    runDiagnosis(cold);
+    const DiagnosisResult& blind = panel()->lastRun()->result;
+    QCOMPARE(QString::fromStdString(blind.verdictName()), QString("f_m"));
+    QVERIFY2(panel()->thresholdsText().contains("without alpha"), qPrintable(panel()->thresholdsText()));
+  }
+
+  // A gear with a backlash of +-0.2 mrad, which no model of the list has: once the playhead
+  // passes the model check's time the verdict says the model no longer fits and names no
+  // parameter, and the thresholds' text says what the check saw.
+  void anUnmodelledBacklashIsNotNamedAParameter() {
+    QTemporaryDir dir;
+    QVERIFY(dir.isValid());
+    const double fm = makeModel("three-mass")->value("f_m");
+    Effect backlash = Effect::withDefaults(EffectKind::Backlash);
+    backlash.values[0] = 2e-4;
+    const QString reference = simulatedLog(dir, "healthy.csv", fm, 25.0, {}, 101);
+    const QString gap = simulatedLog(dir, "backlash.csv", fm, 25.0, {backlash}, 1);
+    QVERIFY(!reference.isEmpty() && !gap.isEmpty());
+    open(gap);
+    runDiagnosis(reference);
+    const DiagnosisResult& r = panel()->lastRun()->result;
+    QCOMPARE(QString::fromStdString(r.verdictName()), QString("model_mismatch"));
+    QVERIFY(r.modelCheck.time);
+    window_->playhead()->setTime(*r.modelCheck.time - 0.5);
+    QTest::qWait(100);
+    QVERIFY2(!panel()->verdictText().contains("no longer fits"), qPrintable(panel()->verdictText()));
+    window_->playhead()->setTime(*r.modelCheck.time + 0.01);
+    QTest::qWait(100);
+    QVERIFY2(panel()->verdictText().startsWith("The model no longer fits"), qPrintable(panel()->verdictText()));
+    for (const char* p : {"k_T", "J_a", "f_m"}) QVERIFY(!panel()->verdictText().contains(p));
+    QVERIFY2(panel()->thresholdsText().contains(QString::fromStdString(r.modelCheck.message)),
+             qPrintable(panel()->thresholdsText()));
+    QTest::qWait(200);
+    test::saveShot(panel()->grab().toImage(), "diagnosis_panel_model_mismatch");
   }
 
   void cleanupTestCase() { delete window_; }

@@ -96,6 +96,9 @@ TEST(DiagnosisTemperature, AWarmHealthyAxisRaisesNoFrictionAlarmAFaultStillDoes)
   friction.alpha = 0.2 / 15.0;
   friction.referenceC = 25.0;
   const double warmFm = friction.atTemperature(kFm, 40.0);
+  // A given alpha is relative to the reference log's friction whatever T_ref it carries: the
+  // diagnosis takes the reference's 25 degC (with T_ref 20 the shift would be 18.75 %).
+  friction.referenceC = 20.0;
   ASSERT_NEAR(warmFm / kFm, 1.2, 1e-12);
   const IdData warm = simulated(*arm(warmFm), 4, {}, {}, 40.0);
 
@@ -107,9 +110,12 @@ TEST(DiagnosisTemperature, AWarmHealthyAxisRaisesNoFrictionAlarmAFaultStillDoes)
   EXPECT_TRUE(corrected.temperature.applied) << corrected.temperature.message;
   EXPECT_NEAR(*corrected.temperature.monitoredC, 40.0, 1e-9);
   EXPECT_NEAR(*corrected.temperature.referenceC, 25.0, 1e-9);
-  // The arm's friction (the reference's plant, about the truth) rises 20 %; theta_0's f_m by the
-  // same amount.
-  EXPECT_NEAR(corrected.temperature.fmExpected - corrected.temperature.fmReference, 0.2 * kFm, 0.02 * kFm);
+  // The arm's friction (the reference's plant: its closed-loop fit on 20 s puts f_m 14 % above
+  // the truth) rises 20 %; theta_0's f_m moves by the same amount.
+  const double plantFm = reference().plant->value("f_m");
+  EXPECT_NEAR(plantFm, kFm, 0.15 * kFm);
+  EXPECT_NEAR(corrected.temperature.fmExpected - corrected.temperature.fmReference, 0.2 * plantFm, 1e-9 * kFm)
+      << corrected.temperature.message;
   EXPECT_NE(corrected.message.find("40.0 degC"), std::string::npos) << corrected.message;
 
   const DiagnosisResult uncorrected = diagnose(reference(), warm, DiagnosisOptions{});
