@@ -7,6 +7,7 @@
 #include "app/main_window.h"
 #include "app/session_controller.h"
 #include "widgets/arm/vtk_view.h"
+#include "widgets/file_output.h"
 
 namespace flexarm {
 
@@ -25,8 +26,9 @@ int runGui(int argc, char** argv, const std::string& log, const std::string& scr
   if (!screenshot.empty()) {
     auto save = [&] {
       QTimer::singleShot(700, &window, [&] {
-        if (!window.grab().save(QString::fromStdString(screenshot))) {
-          std::cerr << "flexarm: cannot write " << screenshot << "\n";
+        QString problem;
+        if (!saveImageFile(window.grab().toImage(), QString::fromStdString(screenshot), nullptr, &problem)) {
+          std::cerr << "flexarm: cannot write " << screenshot << ": " << problem.toStdString() << "\n";
           code = 3;
         }
         QApplication::quit();

@@ -6,6 +6,7 @@
 #include <QDateTime>
 #include <QDialog>
 #include <QDialogButtonBox>
+#include <QComboBox>
 #include <QDockWidget>
 #include <QDoubleSpinBox>
 #include <QDragEnterEvent>
@@ -42,6 +43,7 @@
 #include "widgets/compare_panel.h"
 #include "widgets/fit_panel.h"
 #include "widgets/diagnosis_panel.h"
+#include "widgets/fleet_panel.h"
 #include "widgets/discovery_panel.h"
 #include "widgets/log_panel.h"
 #include "widgets/lqg_panel.h"
@@ -146,6 +148,30 @@ MainWindow::MainWindow(QWidget* parent)
                             "diagnosisDock", "Ctrl+Shift+G", preprocessDock_);
   recursiveDock_ = addPanel(recursivePanel_ = new RecursivePanel(workspace_, this), tr("Recursive"),
                             "recursiveDock", "Ctrl+Shift+I", preprocessDock_);
+  // The Fleet panel: a day's log opens with its diagnosis against its axis' reference.
+  auto* fleetPanel = new FleetPanel(this);
+  addPanel(fleetPanel, tr("Fleet"), "fleetDock", "Ctrl+Shift+T", preprocessDock_);
+  connect(fleetPanel, &FleetPanel::logRequested, this,
+          [this](const QString& log, const QString& reference, const QString& model) {
+            auto once = std::make_shared<QMetaObject::Connection>();
+            *once = connect(workspace_, &Workspace::logChanged, this, [this, once, log, reference, model] {
+              QObject::disconnect(*once);
+              if (workspace_->logPath() != log) return;
+              diagnosisPanel_->setReferenceLog(reference);
+              QComboBox* box = diagnosisPanel_->referenceBox();
+              box->setCurrentIndex(std::max(0, box->findText(model + " (nominal)")));
+              docks_->showPanel(diagnosisDock_);
+              // The whole day's diagnosis at once: the playhead to the log's end when it is done.
+              auto shown = std::make_shared<QMetaObject::Connection>();
+              *shown = connect(diagnosisPanel_, &DiagnosisPanel::finished, this, [this, shown] {
+                QObject::disconnect(*shown);
+                const IdData* d = workspace_->raw();
+                if (d && d->samples() > 0) playhead_->setTime(d->timeAt(d->samples() - 1));
+              });
+              diagnosisPanel_->diagnose();
+            });
+            openFile(log);
+          });
   // A row of the time-stamp report shows its place in the Log panel.
   connect(preprocessPanel_, &PreprocessPanel::timeSelected, logPanel_, &LogPanel::showAround);
   // The playhead spans the log as read (preprocessing keeps its times); every panel that

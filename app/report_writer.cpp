@@ -8,13 +8,13 @@
 #include <QPageLayout>
 #include <QPageSize>
 #include <QPdfWriter>
-#include <QSaveFile>
 #include <QTextDocument>
 #include <algorithm>
 #include <cctype>
 #include <memory>
 #include <qcustomplot.h>
 
+#include "widgets/file_output.h"
 #include "widgets/plots/plot_tools.h"
 
 namespace flexarm {
@@ -216,24 +216,17 @@ bool writeReportHtml(const Report& report, const QString& path, QString* why) {
 
 bool writeReportHtml(const Report& report, const QList<QImage>& plots, const QString& path,
                      QString* why) {
-  QSaveFile f(path);
-  if (!f.open(QIODevice::WriteOnly)) {
-    if (why) *why = f.errorString();
-    return false;
-  }
-  f.write(reportHtml(report, plots).toUtf8());
-  if (!f.commit()) {
-    if (why) *why = f.errorString();
-    return false;
-  }
-  return true;
+  return writeFileBytes(path, reportHtml(report, plots).toUtf8(), why);
 }
 
 bool writeReportPdf(const Report& report, const QString& path, QString* why) {
-  // Written to a temporary sibling first so that a failure keeps any previous report.
-  const QString tmp = path + ".part";
+  // Drawn in memory, then written as every file is (writeFileAtomically): a failure keeps
+  // any previous report, and nothing is written through a link planted beside it.
+  QByteArray pdf;
   {
-    QPdfWriter writer(tmp);
+    QBuffer buffer(&pdf);
+    buffer.open(QIODevice::WriteOnly);
+    QPdfWriter writer(&buffer);
     writer.setResolution(96);
     writer.setPageSize(QPageSize(QPageSize::A4));
     writer.setPageMargins(QMarginsF(18, 16, 18, 16), QPageLayout::Millimeter);
@@ -241,7 +234,7 @@ bool writeReportPdf(const Report& report, const QString& path, QString* why) {
     writer.setCreator(QString("FlexArm %1").arg(FLEXARM_VERSION));
     QCPPainter painter;
     if (!painter.begin(&writer)) {
-      if (why) *why = "cannot write " + tmp;
+      if (why) *why = "cannot draw the report for " + path;
       return false;
     }
     painter.setMode(QCPPainter::pmVectorized);
@@ -300,13 +293,7 @@ bool writeReportPdf(const Report& report, const QString& path, QString* why) {
     }
     painter.end();
   }
-  QFile::remove(path);
-  if (!QFile::rename(tmp, path)) {
-    if (why) *why = "cannot rename " + tmp + " to " + path;
-    QFile::remove(tmp);
-    return false;
-  }
-  return true;
+  return writeFileBytes(path, pdf, why);
 }
 
 bool writeReportFile(const Report& report, const std::string& path, std::string* why) {

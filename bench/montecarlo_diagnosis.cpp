@@ -146,6 +146,9 @@ int main(int argc, char** argv) {
   for (DiagnosisTest t : options.decision) decide += std::string(decide.empty() ? "" : "+") + toString(t);
   printPoint(("decision " + decide).c_str(), r.decision, r.faults, r.decisionIsolatedFraction,
              r.decisionMedianDelayS);
+  std::printf("\nModel check (the verdict model_mismatch): %d of %d fault-free and %d of %d faulty runs "
+              "(the simulated arm has the model's own structure: none should be)\n",
+              r.healthyMismatches, r.healthyRuns, r.faultyMismatches, r.faultyRuns);
   std::printf("\nAt FlexArm's default thresholds (not calibrated on these runs):\n");
   printPoint(("decision " + decide).c_str(), r.given, r.faults, r.givenIsolatedFraction,
              r.givenMedianDelayS);

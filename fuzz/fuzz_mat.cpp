@@ -1,21 +1,10 @@
 // libFuzzer target: the .mat reader. The structure check runs on the bytes in memory; what it
 // lets through is written to a file (matio reads only files) and read as a log.
-#include <unistd.h>
-
 #include <cstdint>
-#include <cstdio>
-#include <string>
 #include <string_view>
 
-#include "core/io/log_io.h"
 #include "core/io/mat_check.h"
-
-namespace {
-std::string scratchFile() {
-  const char* dir = std::getenv("FLEXARM_FUZZ_TMP");
-  return std::string(dir ? dir : "/tmp") + "/flexarm_fuzz_" + std::to_string(::getpid()) + ".mat";
-}
-}  // namespace
+#include "fuzz/fuzz_support.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   const std::string_view bytes(reinterpret_cast<const char*>(data), size);
@@ -24,14 +13,6 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     if (check.problem.empty()) __builtin_trap();
     return 0;
   }
-  static const std::string path = scratchFile();
-  if (FILE* f = std::fopen(path.c_str(), "wb")) {
-    std::fwrite(data, 1, size, f);
-    std::fclose(f);
-  }
-  flexarm::LogReadOptions o;
-  o.format = flexarm::LogFormat::Mat;
-  const flexarm::LogReadResult r = flexarm::readLog(path, o);
-  if (!r.ok && r.error.problem.empty()) __builtin_trap();
+  flexarm::fuzz::readAsMatFile(data, size, "fuzz");
   return 0;
 }

@@ -5,7 +5,8 @@
 #
 #   bash scripts/fuzz.sh [--seconds N] [--seed N] [TARGET...]
 #
-# TARGET: fuzz_csv fuzz_table fuzz_mat fuzz_session fuzz_cli_options (default: all).
+# TARGET: fuzz_csv fuzz_table fuzz_mat fuzz_mat73 fuzz_session fuzz_cli_options fuzz_diagnose_log
+# (default: all).
 # The corpus grows in $FUZZ_DIR/corpus/TARGET (default build-fuzz/); crashing inputs are kept
 # in $FUZZ_DIR/artifacts. BUILD_DIR reuses an existing build configured with FLEXARM_FUZZ=ON
 # (scripts/sanitize.sh makes one).
@@ -22,7 +23,7 @@ while [ $# -gt 0 ]; do
     *) targets+=("$1"); shift ;;
   esac
 done
-[ ${#targets[@]} -gt 0 ] || targets=(fuzz_csv fuzz_table fuzz_mat fuzz_session fuzz_cli_options)
+[ ${#targets[@]} -gt 0 ] || targets=(fuzz_csv fuzz_table fuzz_mat fuzz_mat73 fuzz_session fuzz_cli_options fuzz_diagnose_log)
 
 build="${BUILD_DIR:-$here/build-fuzz}"
 fuzzdir="${FUZZ_DIR:-$build}"
@@ -32,11 +33,11 @@ fi
 cmake --build "$build" -j "${JOBS:-$(nproc)}" --target "${targets[@]}"
 
 # Seeds: the inputs the tests already use, good and bad, plus the heads of the sample logs.
-seed() {  # seed TARGET FILE...
+seed() {  # seed TARGET FILE... (the first 8 KiB of each; SEED_BYTES for more)
   local dir="$fuzzdir/corpus/$1"; shift
   mkdir -p "$dir"
   for f in "$@"; do
-    [ -f "$f" ] && head -c 8192 "$f" > "$dir/seed-$(basename "$f")"
+    [ -f "$f" ] && head -c "${SEED_BYTES:-8192}" "$f" > "$dir/seed-$(basename "$f")"
   done
   return 0
 }
@@ -45,6 +46,10 @@ seed fuzz_csv "$d"/bad/*.csv "$d"/hostile/*.csv "$d"/good/*.csv "$here"/sample_l
 seed fuzz_table "$d"/bad/*.dat "$d"/good/*.dat "$here"/sample_logs/daisy_robot_arm.dat
 seed fuzz_mat "$d"/bad/*.mat "$d"/hostile/*.mat "$d"/good/*.mat
 seed fuzz_session "$here"/sample_logs/sample_session.json "$d"/hostile/*.json
+# v7.3 files are walked whole: seeds up to the 64 KiB an input may have.
+SEED_BYTES=65536 seed fuzz_mat73 "$d"/hostile/v73_*.mat
+seed fuzz_diagnose_log "$d"/hostile/dead_*.csv "$d"/hostile/time_step_1e6.csv "$d"/hostile/controller_*.csv \
+  "$d"/good/small_log.csv "$here"/sample_logs/diagnosis_step_k_T.csv
 mkdir -p "$fuzzdir/corpus/fuzz_cli_options"
 printf 'x\0--model\0arx:2,2,1\0--range\0002:10\0--max-iterations\00050' > "$fuzzdir/corpus/fuzz_cli_options/seed-fit"
 printf 'x\0--input-column\0003\0--sample-time=0.01\0--format\0table\0--fix\0backlash:2e-4' \

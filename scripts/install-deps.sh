@@ -13,10 +13,15 @@ PACKAGES=(
   xvfb xauth libgl1-mesa-dri
   poppler-utils python3-scipy zlib1g-dev libfast-float-dev
   clang libclang-rt-14-dev
+  python3-h5py strace
+  libsqlite3-dev slurm-wlm munge
 )
 # clang and libclang-rt-14-dev (its sanitizer and libFuzzer runtimes, only recommended by
 # clang-14) build the AddressSanitizer/UBSan tests and the fuzz targets (scripts/sanitize.sh,
-# scripts/fuzz.sh).
+# scripts/fuzz.sh). python3-h5py writes the hostile v7.3 .mat files (scripts/make_hostile_data.py);
+# strace lets the hostile-input tests see every file a run opens. libsqlite3-dev is the fleet's
+# store; slurm-wlm and munge its cluster engine, which the tests run on a one-node Slurm they
+# start themselves (tests/cli/slurm_fixture.sh).
 
 if [ "${1:-}" = "--bench" ]; then
   PACKAGES=(python3-numpy python3-scipy python3-pandas python3-matplotlib

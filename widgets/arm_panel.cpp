@@ -27,6 +27,7 @@
 #include "widgets/arm/arm_scene.h"
 #include "widgets/arm/frame_exporter.h"
 #include "widgets/arm/vtk_view.h"
+#include "widgets/file_output.h"
 #include "widgets/playhead.h"
 
 namespace flexarm {
@@ -536,8 +537,9 @@ void ArmPanel::saveStill() {
       this, tr("Save the arm view"), settings.value("lastDir").toString() + "/arm.png",
       tr("PNG image (*.png)"));
   if (path.isEmpty()) return;
-  if (!view_->grabFramebuffer().save(path))
-    QMessageBox::warning(this, tr("Save still"), tr("Cannot write %1.").arg(path));
+  QString problem;
+  if (!saveImageFile(view_->grabFramebuffer(), path, "PNG", &problem))
+    QMessageBox::warning(this, tr("Save still"), tr("Cannot write %1: %2").arg(path, problem));
 }
 
 void ArmPanel::askExportFrames() {

@@ -68,15 +68,17 @@ DiagnosisPanel::DiagnosisPanel(Workspace* workspace, QWidget* parent)
   chooseLog_->setToolTip(tr("The fault-free log theta_0 is fitted on (another experiment on the same axis)"));
   calibrate_->setToolTip(tr("Choose the thresholds by Monte-Carlo runs of the arm under this log's "
                             "conditions for 1 false alarm per hour (takes a minute)"));
-  const char* names[] = {"classical", "robust", "CUSUM", "hypothesis"};
+  const char* names[] = {"classical", "robust", "CUSUM", "hypothesis", "joint"};
   const char* tips[] = {
       QT_TR_NOOP("Classical approach (Section 7.4.1): a fault when an estimate leaves theta_0 by "
                  "more than a fixed threshold"),
       QT_TR_NOOP("Adaptive threshold 3 sigma_i(t) from the estimate's variance (Section 7.4.1)"),
       QT_TR_NOOP("CUSUM test (7.1) with drift nu = 3 sigma_i(t) and alarm level h"),
       QT_TR_NOOP("Hypothesis tests and decision structure (Section 7.4.2): which fault explains "
-                 "the estimates, the table below")};
-  for (int i = 0; i < 4; ++i) {
+                 "the estimates, the table below"),
+      QT_TR_NOOP("Joint test: the change of every parameter at once against its full covariance "
+                 "(chi-square, correlations from P), isolated by the change's direction")};
+  for (int i = 0; i < 5; ++i) {
     tests_[i] = new QCheckBox(tr(names[i]), this);
     tests_[i]->setChecked(true);
     tests_[i]->setToolTip(tr(tips[i]));
@@ -118,7 +120,7 @@ DiagnosisPanel::DiagnosisPanel(Workspace* workspace, QWidget* parent)
   setupPlot(timeline_, "");
   timeline_->legend->setVisible(false);
   timeline_->yAxis->setRange(-0.3, 5.0);
-  timeline_->setMinimumHeight(120);  // five rows whose labels must not overlap
+  timeline_->setMinimumHeight(140);  // six rows whose labels must not overlap
 
   // Short rows, so that the dock's usual width (a third of a 1366-pixel window) shows them
   // whole, "Diagnose" included.
@@ -261,9 +263,9 @@ void DiagnosisPanel::refillReferences() {
 DiagnosisOptions DiagnosisPanel::chosenOptions() const {
   DiagnosisOptions o = storedOptions_ ? *storedOptions_ : DiagnosisOptions{};
   const DiagnosisTest all[] = {DiagnosisTest::Classical, DiagnosisTest::Robust, DiagnosisTest::Cusum,
-                               DiagnosisTest::Hypothesis};
+                               DiagnosisTest::Hypothesis, DiagnosisTest::Joint};
   o.tests.clear();
-  for (int i = 0; i < 4; ++i)
+  for (int i = 0; i < 5; ++i)
     if (tests_[i]->isChecked()) o.tests.push_back(all[i]);
   std::vector<DiagnosisTest> decide;
   for (DiagnosisTest t : DiagnosisOptions{}.decision)
@@ -433,8 +435,8 @@ void DiagnosisPanel::setRequest(const DiagnosisSessionRequest& request, const QS
   seedFault_ = request.seedFault;
   setReferenceLog(referencePath);
   const DiagnosisTest all[] = {DiagnosisTest::Classical, DiagnosisTest::Robust, DiagnosisTest::Cusum,
-                               DiagnosisTest::Hypothesis};
-  for (int i = 0; i < 4; ++i) tests_[i]->setChecked(request.options.uses(all[i]));
+                               DiagnosisTest::Hypothesis, DiagnosisTest::Joint};
+  for (int i = 0; i < 5; ++i) tests_[i]->setChecked(request.options.uses(all[i]));
   window_->setCurrentIndex(request.options.window == HypothesisWindow::Sliding ? 0 : 1);
   const int k = request.model.empty() ? reference_->findData(QString::fromStdString(request.structure))
                                       : reference_->findText(QString::fromStdString(request.model));

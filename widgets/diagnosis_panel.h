@@ -101,7 +101,7 @@ class DiagnosisPanel : public QWidget {
   QComboBox* reference_;
   QPushButton* chooseLog_;
   QLabel* referenceName_;
-  QCheckBox* tests_[4];
+  QCheckBox* tests_[5];
   QComboBox* window_;
   QCheckBox* calibrate_;
   QPushButton* run_;

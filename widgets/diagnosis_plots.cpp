@@ -140,6 +140,8 @@ void DiagnosisPanel::buildPlots() {
     QStringList values;
     if (t.test == DiagnosisTest::Hypothesis) {
       values << QString::number(o.hypothesisThreshold, 'g', 4);
+    } else if (t.test == DiagnosisTest::Joint) {
+      values << QString("%1 x chi2 quantile").arg(o.jointScale, 0, 'g', 3);
     } else {
       for (std::size_t q = 0; q < t.columns.size(); ++q) {
         const double base = t.test == DiagnosisTest::Classical ? o.classicalK
@@ -209,7 +211,11 @@ void DiagnosisPanel::showAt(double t) {
   QString verdict, color;
   QString parameter;
   const double now = r.time[k];
-  if (r.decision.verdictTime && now >= *r.decision.verdictTime - 1e-9) {
+  if (r.modelCheck.mismatch && now >= *r.modelCheck.time - 1e-9) {
+    verdict = tr("The model no longer fits (at %1): no parameter is named").arg(seconds(*r.modelCheck.time));
+    verdict_->setToolTip(QString::fromStdString(r.modelCheck.message));
+    color = "color: rgb(130,60,170)";
+  } else if (r.decision.verdictTime && now >= *r.decision.verdictTime - 1e-9) {
     parameter = QString::fromStdString(r.verdictName());
     verdict = tr("Fault in %1 - isolated at %2").arg(parameter, seconds(*r.decision.verdictTime));
     color = "color: rgb(200,40,40)";

@@ -75,6 +75,7 @@ RecursivePanel::RecursivePanel(Workspace* workspace, QWidget* parent)
       mu_(spin(this, 0.0, 1e12, 4, 0.0, 0.1)),
       startOffset_(spin(this, -90.0, 500.0, 1, 20.0, 5.0)),
       decimation_(new QSpinBox(this)),
+      tracking_(new QComboBox(this)),
       inverse_(new QCheckBox(tr("theta holds J_a^-1 (seed)"), this)),
       parameters_(new QListWidget(this)),
       overlay_(new QCheckBox(tr("Overlay the previous run"), this)),
@@ -98,6 +99,15 @@ RecursivePanel::RecursivePanel(Workspace* workspace, QWidget* parent)
   again_->setToolTip(tr("Start again from the log's beginning with the settings as they are now"));
   algorithm_->addItem(tr("forgetting factor (6.1)"), "forgetting");
   algorithm_->addItem(tr("Kalman gain (6.2)"), "kalman");
+  tracking_->setObjectName("recursiveTracking");
+  tracking_->addItem(tr("fixed"), "fixed");
+  tracking_->addItem(tr("variable forgetting"), "variable");
+  tracking_->addItem(tr("bank of change times"), "bank");
+  tracking_->setToolTip(tr("How changing parameters are followed (the seed's 9.2): lambda or R1 as "
+                           "designed; information-constant forgetting, lambda(t) lower while the "
+                           "prediction errors grow; or estimators started at hypothesised change "
+                           "times every 0.25 s, the change accepted (a dashed line) when one "
+                           "explains the data since then better"));
   gradient_->addItem(tr("sensitivity (6.27)"), "sensitivity");
   gradient_->addItem(tr("differences (6.33)"), "difference");
   model_->setToolTip(tr("Model of the shared list the estimator starts from and predicts with"));
@@ -105,16 +115,19 @@ RecursivePanel::RecursivePanel(Workspace* workspace, QWidget* parent)
                             "of the parameters with covariance R1 (6.7)"));
   gradient_->setToolTip(tr("How the gradient psi of the prediction is computed: sensitivity "
                            "equations (6.27) or finite differences (6.33)"));
-  lambda_->setToolTip(tr("Forgetting factor lambda of (6.6), 0.5 .. 1; memory about 1/(1 - lambda) "
-                         "samples"));
+  lambda_->setToolTip(tr("Forgetting factor lambda of (6.6) per 200 Hz sample, 0.5 .. 1; memory "
+                         "about 1/(1 - lambda) samples of 5 ms at whatever rate the estimator runs"));
   r2_->setToolTip(tr("Measurement noise variance R2 of the Kalman-gain algorithm"));
   mu_->setToolTip(tr("Regularisation mu of (6.8) and (6.9); 0 switches it off, as the seed's "
                      "experiments do"));
-  decimation_->setToolTip(tr("Use every N-th sample; the special value decimates to 200 Hz"));
+  decimation_->setToolTip(tr("Use every N-th sample (the torque held as its mean over each new "
+                             "period); the special value runs at the log's rate up to 2 kHz, "
+                             "where the zero-order hold of the torque is exact"));
   r1_->setPlaceholderText(tr("(6.54): 5e-8, 5e-7, 5e-6"));
-  r1_->setToolTip(tr("diag R1, one value per tracked parameter; empty: the seed's (6.54)"));
+  r1_->setToolTip(tr("diag R1 per 200 Hz sample, one value per tracked parameter; empty: the "
+                     "seed's (6.54)"));
   decimation_->setRange(0, 1000);
-  decimation_->setSpecialValueText(tr("to 200 Hz"));
+  decimation_->setSpecialValueText(tr("log's rate"));
   startOffset_->setSuffix(" %");
   startOffset_->setToolTip(tr("theta(0) = (1 + offset) x nominal; the seed starts 20 % above"));
   inverse_->setChecked(true);
@@ -151,6 +164,8 @@ RecursivePanel::RecursivePanel(Workspace* workspace, QWidget* parent)
   pair(0, tr("Gradient"), gradient_);
   pair(1, tr("Decimate"), decimation_);
   ++row;
+  pair(0, tr("Tracking"), tracking_);
+  ++row;
   auto* buttons = new QHBoxLayout;
   buttons->addWidget(play_);
   buttons->addWidget(again_);
@@ -164,7 +179,7 @@ RecursivePanel::RecursivePanel(Workspace* workspace, QWidget* parent)
     w->setMinimumWidth(60);
   model_->setSizeAdjustPolicy(QComboBox::AdjustToMinimumContentsLengthWithIcon);
   model_->setMinimumContentsLength(12);
-  for (QComboBox* c : {algorithm_, gradient_}) {
+  for (QComboBox* c : {algorithm_, gradient_, tracking_}) {
     c->setSizeAdjustPolicy(QComboBox::AdjustToMinimumContentsLengthWithIcon);
     c->setMinimumContentsLength(8);
   }
@@ -270,7 +285,9 @@ RecursiveRequest RecursivePanel::request() const {
   if (v.typeId() == QMetaType::Int) q.model = model_->currentText().toStdString();
   else q.structure = v.toString().toStdString();
   q.data.decimation = decimation_->value();
+  q.data.maxRateHz = maxRateHz_;
   RecursiveOptions& o = q.options;
+  o.designSampleTime = designSampleTime_;
   // The seed's parameters first, in its order (k_T, J_a, f_m), then the others as the model
   // lists them.
   o.estimate.clear();
@@ -285,7 +302,12 @@ RecursiveRequest RecursivePanel::request() const {
   o.inverted = inverse_->isChecked() ? std::vector<std::string>{"J_a"} : std::vector<std::string>{};
   o.algorithm = *recursiveAlgorithmFromString(algorithm_->currentData().toString().toStdString());
   o.gradient = *recursiveGradientFromString(gradient_->currentData().toString().toStdString());
+  o.tracking = *recursiveTrackingFromString(tracking_->currentData().toString().toStdString());
+  // Variable forgetting belongs to the forgetting factor: with the Kalman gain it stays fixed.
+  if (o.tracking == RecursiveTracking::Variable && o.algorithm == RecursiveAlgorithm::Kalman)
+    o.tracking = RecursiveTracking::Fixed;
   o.lambda = lambda_->value();
+  o.lambdaMin = std::min(o.lambdaMin, o.lambda);
   parseList(r1_->text(), o.r1);
   o.r2 = r2_->value();
   o.mu = mu_->value();
@@ -309,6 +331,9 @@ void RecursivePanel::setRequest(const RecursiveRequest& q) {
                        q.options.inverted.end());
   algorithm_->setCurrentIndex(algorithm_->findData(QString(toString(q.options.algorithm))));
   gradient_->setCurrentIndex(gradient_->findData(QString(toString(q.options.gradient))));
+  tracking_->setCurrentIndex(tracking_->findData(QString(toString(q.options.tracking))));
+  maxRateHz_ = q.data.maxRateHz;
+  designSampleTime_ = q.options.designSampleTime;
   lambda_->setValue(q.options.lambda);
   QStringList r1;
   for (double v : q.options.r1) r1 << QString::number(v, 'g', 6);
@@ -455,6 +480,9 @@ void RecursivePanel::onChunk(RecursiveRunner::Chunk c) {
   extend(all.yhat, add.yhat);
   extend(all.epsilon, add.epsilon);
   extend(all.noiseVariance, add.noiseVariance);
+  extend(all.lambda, add.lambda);
+  extend(all.changeDetected, add.changeDetected);
+  extend(all.changeTime, add.changeTime);
   for (auto* m : {&all.theta, &all.pDiagonal, &all.sigma}) m->resize(run.parameters.size());
   for (std::size_t i = 0; i < add.theta.size() && i < run.parameters.size(); ++i) {
     extend(all.theta[i], add.theta[i]);
@@ -487,6 +515,9 @@ void RecursivePanel::onChunk(RecursiveRunner::Chunk c) {
                       .arg(unit.empty() || unit == "1" ? QString() : " " + QString::fromStdString(unit));
       }
       QString text = QString::fromStdString(run.result->message) + "\n" + values.join(",  ");
+      if (run.request.options.tracking == RecursiveTracking::Variable && !run.rows.lambda.empty())
+        text += tr("; lambda(t) down to %1")
+                    .arg(*std::min_element(run.rows.lambda.begin(), run.rows.lambda.end()), 0, 'f', 4);
       QString tip = status_->toolTip();
       if (!run.result->caveat.empty()) {
         text += QString::fromUtf8(" (σ understates: hover)");
@@ -526,6 +557,7 @@ void RecursivePanel::updateHold() {
 void RecursivePanel::buildPlot() {
   plot_->clearGraphs();
   plot_->clearItems();
+  changesShown_ = 0;
   plot_->plotLayout()->clear();
   graphs_.clear();
   epsilon_ = nullptr;
@@ -748,7 +780,30 @@ void RecursivePanel::showUpTo(double t) {
     return;
   }
   shown_ = target;
+  showChanges(target > 0 ? time[target - 1] : run.start - 1.0);
   plot_->replot(QCustomPlot::rpQueuedReplot);
+}
+
+// The changes the bank accepted up to time t: a dashed line at each hypothesised change time
+// in every estimate's rect, drawn once its detection time is shown.
+void RecursivePanel::showChanges(double t) {
+  const RecursiveTrajectory& rows = current_->rows;
+  std::size_t due = 0;
+  while (due < rows.changeDetected.size() && rows.changeDetected[due] <= t + 1e-9) ++due;
+  if (due == changesShown_) return;
+  for (int i = plot_->itemCount() - 1; i >= 0; --i)
+    if (plot_->item(i)->objectName() == "change") plot_->removeItem(i);
+  for (std::size_t c = 0; c < due; ++c)
+    for (const ParameterGraphs& g : graphs_) {
+      auto* line = new QCPItemStraightLine(plot_);
+      line->setObjectName("change");
+      line->setClipAxisRect(g.rect);
+      for (auto* p : {line->point1, line->point2}) p->setAxes(g.rect->axis(QCPAxis::atBottom), g.rect->axis(QCPAxis::atLeft));
+      line->point1->setCoords(rows.changeTime[c], 0.0);
+      line->point2->setCoords(rows.changeTime[c], 1.0);
+      line->setPen(QPen(QColor(150, 60, 170), 1.2, Qt::DashLine));
+    }
+  changesShown_ = due;
 }
 
 void RecursivePanel::frameDrawn() {

@@ -79,6 +79,7 @@ class RecursivePanel : public QWidget {
 
   QComboBox* modelBox() const { return model_; }
   QComboBox* algorithmBox() const { return algorithm_; }
+  QComboBox* trackingBox() const { return tracking_; }
   QDoubleSpinBox* lambdaBox() const { return lambda_; }
   QLineEdit* r1Edit() const { return r1_; }
   QDoubleSpinBox* startBox() const { return startOffset_; }
@@ -114,6 +115,7 @@ class RecursivePanel : public QWidget {
   void buildPlot();
   // Draws the current run's rows up to time t (adds or removes points), the overlay whole.
   void showUpTo(double t);
+  void showChanges(double t);
   void drawOverlay();
   void updateHold();
   void frameDrawn();
@@ -131,6 +133,12 @@ class RecursivePanel : public QWidget {
   QDoubleSpinBox* mu_;
   QDoubleSpinBox* startOffset_;
   QSpinBox* decimation_;
+  QComboBox* tracking_;
+  // What a session's request said beyond the controls (the highest rate of the default
+  // decimation, what lambda and R1 are given per): kept for the next run.
+  double maxRateHz_ = 2000.0, designSampleTime_ = 0.005;
+  // The change times of the bank drawn so far (vertical lines in every estimate's rect).
+  std::size_t changesShown_ = 0;
   QCheckBox* inverse_;
   QListWidget* parameters_;
   QCheckBox* overlay_;

@@ -2,6 +2,7 @@
 
 #include <ostream>
 #include <stdexcept>
+#include <string>
 
 namespace flexarm::cli {
 
@@ -25,6 +26,8 @@ const std::vector<Verb>& verbs() {
        runRecursive},
       {"diagnose", "detect and isolate a fault in k_T, J_a or f_m from recursive estimates",
        runDiagnose},
+      {"fleet", "every robot's axes over days: new logs diagnosed, stored, trends, maintenance",
+       runFleet},
   };
   return kVerbs;
 }
@@ -75,7 +78,13 @@ int runCommandLine(const std::vector<std::string>& args, std::ostream& out, std:
       err << "flexarm " << v.name << ": " << e.what() << "\n";
       return kExitUsage;
     } catch (const std::exception& e) {
-      err << "flexarm " << v.name << ": " << e.what() << "\n";
+      // A library's own words ("[json.exception.type_error.316] ...") are no message for a user.
+      const std::string what = e.what();
+      if (what.rfind("[json.exception.", 0) == 0)
+        err << "flexarm " << v.name << ": the result could not be written as JSON: a name or text in the input "
+            << "is not UTF-8\n";
+      else
+        err << "flexarm " << v.name << ": " << what << "\n";
       return kExitNumerical;
     }
   }

@@ -84,5 +84,6 @@ int runRun(const std::vector<std::string>& args, std::ostream& out, std::ostream
 int runDiscover(const std::vector<std::string>& args, std::ostream& out, std::ostream& err);
 int runRecursive(const std::vector<std::string>& args, std::ostream& out, std::ostream& err);
 int runDiagnose(const std::vector<std::string>& args, std::ostream& out, std::ostream& err);
+int runFleet(const std::vector<std::string>& args, std::ostream& out, std::ostream& err);
 
 }  // namespace flexarm::cli

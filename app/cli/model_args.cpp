@@ -1,9 +1,9 @@
 #include "app/cli/model_args.h"
 
+#include "core/io/input_file.h"
 #include "core/session/model_json.h"
 
 #include <charconv>
-#include <fstream>
 #include <cmath>
 #include <ostream>
 #include <stdexcept>
@@ -83,16 +83,17 @@ bool applyParams(const ArgParser& args, PhysicalModel& model, const std::string&
 }
 
 std::unique_ptr<PhysicalModel> modelFromFile(const std::string& path, std::string* why) {
-  std::ifstream in(path);
-  if (!in) {
-    *why = "cannot be read";
-    return nullptr;
-  }
+  // A regular file of sensible size only: a pipe or device would block or never end.
+  FileBytes bytes;
+  if (!readInputFile(path, 64u << 20, bytes, why)) return nullptr;
   nlohmann::json j;
   try {
-    in >> j;
-  } catch (const nlohmann::json::exception& e) {
-    *why = std::string("is not JSON: ") + e.what();
+    j = nlohmann::json::parse(bytes.view());
+  } catch (const nlohmann::json::parse_error& e) {
+    *why = "is not JSON (a syntax error near byte " + std::to_string(e.byte) + ")";
+    return nullptr;
+  } catch (const nlohmann::json::exception&) {
+    *why = "is not JSON";
     return nullptr;
   }
   if (!j.is_object()) {

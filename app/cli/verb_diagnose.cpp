@@ -2,7 +2,6 @@
 //                  [--tests ...] [--decide ...] [--window S|cumulative] [--json]
 #include <cmath>
 #include <cstdio>
-#include <fstream>
 #include <nlohmann/json.hpp>
 #include <ostream>
 #include <sstream>
@@ -10,6 +9,7 @@
 #include "app/cli/cli.h"
 #include "app/cli/log_args.h"
 #include "app/cli/model_args.h"
+#include "app/cli/progress_line.h"
 #include "core/diagnosis/diagnosis.h"
 #include "core/diagnosis/calibration.h"
 #include "core/diagnosis/diagnosis_json.h"
@@ -20,8 +20,9 @@ namespace {
 
 const char* kDiagnoseHelp =
     "Usage: flexarm diagnose LOG --model three-mass (--reference-log HEALTHY_LOG | --param ...)\n"
-    "                        [--tests classical,robust,cusum,hypothesis] [--decide TESTS]\n"
-    "                        [--window S|cumulative] [--json]\n\n"
+    "                        [--tests classical,robust,cusum,hypothesis,joint] [--decide TESTS]\n"
+    "                        [--window S|cumulative] [--friction-alpha A | --temperature-logs\n"
+    "                        A,B,C] [--json]\n\n"
     "Detects and isolates a fault in the torque constant k_T, the arm's inertia J_a (a load\n"
     "change) or the motor friction f_m (the seed's chapter 7). The recursive estimator of\n"
     "chapter 6 (forgetting factor 0.995) follows k_T, J_a^-1 and f_m through LOG (by default\n"
@@ -34,11 +35,23 @@ const char* kDiagnoseHelp =
     "  hypothesis  a bank of predictors (theta_0 fixed; each parameter alone estimated), their\n"
     "              squared prediction errors normalised by the full estimate's (7.20)/(7.21),\n"
     "              threshold 1.12 (seed: 1), and the decision structure of Section 7.5.2\n"
+    "  joint       the change of every parameter at once, chi-square in the metric of the\n"
+    "              spreads (7.13) with the correlations of the full P, against its quantile at\n"
+    "              3 sigma; isolated by the change's direction (the decision structure of the\n"
+    "              hypothesis tests: F_i is rejected when the change does not lie along it)\n"
     "The robust and CUSUM thresholds carry per-parameter factors from the Monte-Carlo\n"
     "calibration (k_T, J_a^-1, f_m: robust 2, 1, 1.8; CUSUM h 0.2, 0.27, 1.25); --calibrate\n"
     "chooses them again for LOG.\n"
     "The decision structure combines the alarms of the --decide tests into the diagnosis S and a\n"
-    "verdict: the parameter whose fault alone explains them, and the time it was reached.\n\n"
+    "verdict: the parameter whose fault alone explains them, and the time it was reached.\n"
+    "Before a parameter is named the model must still fit: when the errors of the estimator of\n"
+    "every monitored parameter stay above --mismatch-ratio (2) times the fault-free mean square\n"
+    "lambda_0 for a whole window, no parameter change explains the data and the verdict is\n"
+    "model_mismatch (\"the model no longer fits: ...\", with the residual tests of that window).\n"
+    "Temperature: a log's temperature is the mean of its temperature_c channel or its metadata\n"
+    "value temperature_c. With alpha (--friction-alpha, or estimated from --temperature-logs),\n"
+    "theta_0's f_m is carried from the reference's temperature to LOG's by\n"
+    "f_m = f_m0 (1 + alpha (T - T_ref)) before the tests compare, so a warm axis is not a fault.\n\n"
     "Reference (one of):\n"
     "  --reference-log LOG   fault-free log: theta_0 is the output-error fit of --model on it\n"
     "                        (direct: the recursive estimator's criterion), the plant for a\n"
@@ -47,7 +60,7 @@ const char* kDiagnoseHelp =
     "                        a fault-free run of it simulated under LOG's controller and reference\n\n"
     "Options:\n"
     "  --monitor A,B,C       the monitored parameters (default k_T,J_a,f_m; J_a as J_a^-1)\n"
-    "  --tests LIST          tests to run (default all four)\n"
+    "  --tests LIST          tests to run (default all five)\n"
     "  --decide LIST         tests the verdict combines (default robust,cusum,hypothesis)\n"
     "  --window S|cumulative hypothesis tests' sums over the last S seconds (on-line use), or\n"
     "                        from the first sample as the seed (default 5)\n"
@@ -74,9 +87,21 @@ const char* kDiagnoseHelp =
     "  --runs N              fault-free runs of the calibration (default 40; plus N/5 runs per\n"
     "                        fault, 20 % steps in the middle of the run)\n"
     "  --threads N           calibration runs in parallel (default 2)\n"
+    "  --mismatch-ratio R    the model no longer fits when the re-estimated model's errors stay\n"
+    "                        above R times lambda_0 for a window (default 2)\n"
+    "  --no-model-check      name a parameter even when the model no longer fits\n"
+    "  --friction-alpha A    relative change of f_m per degC (e.g. 0.004), T_ref the reference\n"
+    "                        log's temperature\n"
+    "  --temperature-logs A,B,C  healthy logs at three or more temperatures: alpha is estimated\n"
+    "                        from their fitted f_m (with its standard deviation)\n"
+    "  --temperature C, --reference-temperature C  the temperatures when the logs do not state\n"
+    "                        them (degC)\n"
     "  --json                print the result as JSON\n\n"
-    "JSON: verdict (\"none\", \"k_T\", \"J_a\", \"f_m\"), alarm_time_s (the verdict's time,\n"
-    "null when none), detection_time_s, window, reference {source, theta0, sigma0, lambda0},\n"
+    "JSON: verdict (\"none\", \"k_T\", \"J_a\", \"f_m\", \"model_mismatch\"), alarm_time_s (the\n"
+    "verdict's time, null when none), tests_verdict (the tests' own), model_check {fits, time_s,\n"
+    "threshold, median_ratio, peak_ratio, white, independent, what, message}, temperature\n"
+    "{monitored_c, reference_c, alpha_per_c, applied, f_m_reference, f_m_expected, message},\n"
+    "detection_time_s, window, reference {source, theta0, sigma0, lambda0},\n"
     "estimates {name: {theta0, final, sigma}}, decision {tests, statement_final},\n"
     "tests {name: {verdict, alarm_time_s, detection_time_s, thresholds, columns {q: {first_alarm_s,\n"
     "alarms, max_ratio, final_statistic, final_threshold}}}}, seconds.\n";
@@ -94,11 +119,7 @@ bool parseNames(const std::string& text, std::vector<std::string>& out) {
 }
 
 bool writeTrace(const DiagnosisResult& r, const std::string& path, std::string* why) {
-  std::ofstream f(path);
-  if (!f) {
-    *why = "cannot write " + path;
-    return false;
-  }
+  std::ostringstream f;
   f << "time_s";
   for (const auto& p : r.parameters) f << "," << p.name;
   for (const auto& t : r.tests)
@@ -113,7 +134,7 @@ bool writeTrace(const DiagnosisResult& r, const std::string& path, std::string* 
       for (std::size_t q = 0; q < t.columns.size(); ++q) f << "," << t.statistic[q][k] << "," << t.threshold[q][k];
     f << ",\"" << modeSetString(r.decision.statement[k], r.faults) << "\"\n";
   }
-  return static_cast<bool>(f);
+  return writeFileAtomically(path, f.str(), why);
 }
 
 std::string delayText(double d) {
@@ -152,12 +173,14 @@ int runDiagnose(const std::vector<std::string>& argv, std::ostream& out, std::os
   for (const auto& v : modelValuedOptions()) valued.push_back(v);
   for (const char* n : {"reference-log", "monitor", "tests", "decide", "window", "lambda", "k",
                         "alpha1", "alpha2", "hypothesis-threshold", "confirm", "settle", "trace", "predictor",
-                        "seed-fault",
+                        "seed-fault", "mismatch-ratio", "friction-alpha", "temperature-logs",
+                        "temperature", "reference-temperature",
                         "false-alarms-per-hour", "runs", "threads"})
     valued.push_back(n);
   auto flags = modelFlagOptions();
   flags.push_back("json");
   flags.push_back("calibrate");
+  flags.push_back("no-model-check");
   flags.push_back("help");
   ArgParser args(flags, valued);
   const std::string pre = "flexarm diagnose: ";
@@ -221,8 +244,24 @@ int runDiagnose(const std::vector<std::string>& argv, std::ostream& out, std::os
   if (!args.number("lambda", lambda) || !args.number("k", k) ||
       !args.number("alpha1", options.cusumAlpha1) || !args.number("alpha2", options.cusumAlpha2) ||
       !args.number("hypothesis-threshold", options.hypothesisThreshold) ||
-      !args.number("confirm", options.confirmS) || !args.number("settle", options.settleS))
+      !args.number("confirm", options.confirmS) || !args.number("settle", options.settleS) ||
+      !args.number("mismatch-ratio", options.mismatchRatio))
     return usage(args.error());
+  if (args.flag("no-model-check")) options.checkModel = false;
+  for (const auto& [key, target] : {std::pair{"temperature", &options.monitoredTemperatureC},
+                                    std::pair{"reference-temperature", &options.referenceTemperatureC}})
+    if (args.value(key)) {
+      double c = 0.0;
+      if (!args.number(key, c)) return usage(args.error());
+      *target = c;
+    }
+  if (args.value("friction-alpha")) {
+    FrictionTemperatureModel friction;
+    if (!args.number("friction-alpha", friction.alpha)) return usage(args.error());
+    options.friction = friction;
+  }
+  if (args.value("friction-alpha") && args.value("temperature-logs"))
+    return usage("give alpha (--friction-alpha) or the logs to estimate it from (--temperature-logs), not both");
   if (args.value("k")) {
     options.classicalK = options.robustK = k;
     options.classicalScales.clear();
@@ -236,13 +275,13 @@ int runDiagnose(const std::vector<std::string>& argv, std::ostream& out, std::os
   DiagnosisRequest request;
   request.calibrate = args.flag("calibrate");
   CalibrationOptions& calibration = request.calibration;
-  long runs = calibration.healthyRuns, threads = calibration.threads;
+  int runs = calibration.healthyRuns;
   if (!args.number("false-alarms-per-hour", calibration.targetFalseAlarmsPerHour) ||
-      !args.integer("runs", runs) || !args.integer("threads", threads))
+      !args.integer("runs", runs, 1, CalibrationOptions::kMaxRuns) ||
+      !args.integer("threads", calibration.threads, 1, 256))
     return usage(args.error());
-  calibration.healthyRuns = static_cast<int>(runs);
-  calibration.faultyRuns = static_cast<int>(std::max(1L, runs / 5));
-  calibration.threads = static_cast<int>(threads);
+  calibration.healthyRuns = runs;
+  calibration.faultyRuns = std::max(1, runs / 5);
   if (!calibration.isValid(&why)) return usage(why);
   if (!options.isValid(&why)) return usage(why);
   if (auto f = args.value("seed-fault")) {
@@ -255,11 +294,33 @@ int runDiagnose(const std::vector<std::string>& argv, std::ostream& out, std::os
 
   auto model = modelFromArgs(args, "diagnose", err);
   if (!model) return kExitUsage;
+  auto readOptions = logReadOptions(args, err);
+  if (!readOptions) return kExitUsage;
+  if (auto list = args.value("temperature-logs")) {
+    std::vector<std::string> paths;
+    if (!parseNames(*list, paths)) return usage("--temperature-logs expects FILE,FILE,...");
+    std::vector<IdData> logs;
+    for (const auto& p : paths) {
+      auto l = loadLog(p, *readOptions, err);
+      if (!l) return kExitBadInput;
+      logs.push_back(std::move(*l));
+    }
+    std::vector<const IdData*> pointers;
+    for (const auto& l : logs) pointers.push_back(&l);
+    // T_ref: the first log's temperature (any value works; it only names f_m0).
+    const auto first = logTemperature(logs.front()).celsius;
+    const FrictionTemperatureFit fit =
+        frictionFromHealthyLogs(*model, pointers, paths, options, first.value_or(20.0));
+    if (fit.termination != Termination::Converged) {
+      err << pre << "--temperature-logs: " << fit.message << "\n";
+      return kExitBadInput;
+    }
+    options.friction = fit.model;
+    if (!args.flag("json")) out << "Friction against temperature: " << fit.message << "\n";
+  }
   request.model = std::move(model);
   request.options = options;
   if (!request.isValid(&why)) return usage(why);
-  auto readOptions = logReadOptions(args, err);
-  if (!readOptions) return kExitUsage;
   auto log = loadLog(args.positional()[0], *readOptions, err);
   if (!log) return kExitBadInput;
   if (auto s = diagnosisSignals(*log, options.predictor, &why); !s) {
@@ -275,10 +336,10 @@ int runDiagnose(const std::vector<std::string>& argv, std::ostream& out, std::os
     }
     request.referenceLog = std::make_shared<const IdData>(std::move(*healthy));
   }
-  const DiagnosisRun run = runDiagnosisRequest(request, *log);
+  const DiagnosisRun run = runDiagnosisRequest(request, *log, progressLine(err, "diagnose"));
   if (run.termination == Termination::Failed) {
     err << pre << run.message << "\n";
-    return kExitNumerical;
+    return run.badRequest ? kExitUsage : kExitNumerical;
   }
   const DiagnosisResult& r = run.result;
   if (auto trace = args.value("trace"); trace && !writeTrace(r, *trace, &why)) {
@@ -295,6 +356,8 @@ int runDiagnose(const std::vector<std::string>& argv, std::ostream& out, std::os
     else out << "Thresholds: " << defaultThresholdsProvenance() << "\n";
     out << r.summary() << "\n";
     if (r.termination != Termination::Converged) out << r.message << "\n";
+    if (r.modelCheck.checked && !r.modelCheck.mismatch) out << r.modelCheck.message << "\n";
+    out << "Temperature: " << r.temperature.message << "\n";
     out << "Reference: " << r.referenceSource << "\n";
   }
   return r.termination == Termination::Converged ? kExitOk : kExitNumerical;

@@ -8,6 +8,7 @@
 #include "app/cli/log_args.h"
 #include "core/discovery/discovery.h"
 #include "core/session/report.h"
+#include "core/signal/excitation.h"
 
 namespace flexarm::cli {
 namespace {
@@ -212,6 +213,15 @@ int runDiscover(const std::vector<std::string>& argv, std::ostream& out, std::os
     val = est->select(*est->validationRange);
     if (est->estimationRange && !est->estimationRange->empty())
       *est = est->select(*est->estimationRange);
+  }
+  // Dead data are bad input, named by channel, before the search starts.
+  for (const auto& [data, file] : {std::pair{&*est, args.positional()[0]},
+                                   std::pair{val ? &*val : nullptr, args.value("validation-log").value_or(args.positional()[0])}}) {
+    if (!data) continue;
+    if (const std::string dead = deadDataProblem(*data); !dead.empty()) {
+      err << pre << file << ": " << dead << "\n";
+      return kExitBadInput;
+    }
   }
   const auto base = makeModel(*modelName);
   DiscoveryResult r;

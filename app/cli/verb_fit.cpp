@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include "app/cli/log_args.h"
+#include "app/cli/progress_line.h"
 #include "core/ident/evaluation.h"
 #include "core/ident/fit_experiments.h"
 
@@ -468,7 +469,7 @@ int runFitPipeline(ArgParser& args, const std::string& verb, FitResult& result, 
     err << pre << why << "\n";
     return kExitUsage;
   }
-  result = fitModel(o);
+  result = fitModel(o, progressLine(err, "fit"));
   if (result.ok()) return kExitOk;
   if (result.badRequest) {
     err << pre << result.message << "\n";

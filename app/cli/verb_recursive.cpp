@@ -2,6 +2,7 @@
 //                   [--algorithm forgetting|kalman] [--lambda 0.995] [--r1 a,b,c] [--r2 v]
 //                   [--start-scale 1.2] [--gradient sensitivity|difference]
 //                   [--decimate N] [--out trajectory.csv] [--json]
+#include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <fstream>
@@ -25,9 +26,13 @@ const char* kRecursiveHelp =
     "the recursive prediction-error method on the continuous-time model sampled with a\n"
     "zero-order hold at the current estimate every sample, its gradient from the sensitivity\n"
     "system (6.27). The log is prepared as for a fit: the motor velocity from the motor angle\n"
-    "(central differences at the log's rate), decimated to 200 Hz (the seed's rate) behind the\n"
-    "anti-alias filter, means removed. P(0) is chosen as the seed does (Section 6.6.2): the P\n"
-    "update run at the nominal parameters, its diagonal averaged.\n\n"
+    "(central differences at the log's rate), means removed. The estimator runs at the log's\n"
+    "own rate up to 2 kHz, where the zero-order hold of the torque is what the controller did\n"
+    "(a faster log is decimated to 2 kHz or below, the torque held as its mean over each new\n"
+    "period). The seed's design variables are per 200 Hz sample and keep their memory and\n"
+    "random walk per second at any rate (lambda^(T/5 ms), R1 T/5 ms). P(0) is chosen as the\n"
+    "seed does (Section 6.6.2): the P update run at the nominal parameters, its diagonal\n"
+    "averaged.\n\n"
     "  --model NAME          the structure (default three-mass); nominal values are its\n"
     "                        defaults (three-mass: Table 5.7 p6) or a fit's (--nominal)\n"
     "  --param NAME=VALUE    set a nominal parameter (repeatable)\n"
@@ -39,23 +44,39 @@ const char* kRecursiveHelp =
     "  --invert A,B|none     parameters theta holds as inverses (default J_a); NAME^-1 in\n"
     "                        --estimate does the same\n"
     "  --algorithm NAME      forgetting (Algorithm 6.1, default) or kalman (Algorithm 6.2)\n"
-    "  --lambda L            forgetting factor (default 0.995)\n"
-    "  --r1 a,b,c            diag R1 of Algorithm 6.2, one per estimated parameter (default\n"
-    "                        (6.54): 5e-8, 5e-7, 5e-6 for k_T, J_a^-1, f_m)\n"
+    "  --lambda L            forgetting factor per 200 Hz sample (default 0.995, the seed's:\n"
+    "                        a memory of one second at any rate)\n"
+    "  --r1 a,b,c            diag R1 of Algorithm 6.2 per 200 Hz sample, one per estimated\n"
+    "                        parameter (default (6.54): 5e-8, 5e-7, 5e-6 for k_T, J_a^-1, f_m)\n"
+    "  --per-sample          --lambda and --r1 are per sample at the rate the estimator runs\n"
+    "                        at, not per 200 Hz sample\n"
+    "  --tracking KIND       how changing parameters are followed (the seed's 9.2): fixed\n"
+    "                        (lambda or R1 as designed, default), variable (information-\n"
+    "                        constant forgetting: lambda(t) drops when the prediction errors\n"
+    "                        grow, down to --lambda-min, default 0.95 per 200 Hz sample;\n"
+    "                        forgetting algorithm), bank (estimators started at hypothesised\n"
+    "                        change times every --bank-spacing S (0.25), the last\n"
+    "                        --bank-size N (6) kept; a change is accepted when one predicts\n"
+    "                        the data since its start better by --bank-threshold (40) noise\n"
+    "                        variances)\n"
     "  --r2 V                R2 of Algorithm 6.2 (default 1)\n"
     "  --mu M                regularisation (6.9) (default 0)\n"
     "  --start-scale S       theta(0) = S * nominal (the seed starts 20 % above: 1.2; default 1)\n"
     "  --p0 a,b,c            diag P(0) (default: the seed's pre-run)\n"
     "  --gradient KIND       sensitivity ((6.27), default) or difference ((6.33); can diverge\n"
     "                        for an output-error model, Example 6.1)\n"
-    "  --decimate N          decimation factor (default: to 200 Hz, 10 on a 2 kHz log)\n"
+    "  --decimate N          decimation factor (default: the log's rate up to 2 kHz; 10 on a\n"
+    "                        2 kHz log is the seed's 200 Hz, with the torque held as its mean\n"
+    "                        over each period)\n"
     "  --range A:B           use the log from A to B seconds (default: all of it)\n"
     "  --out FILE.csv        write the trajectory: time_s, theta, sigma per parameter, y, yhat,\n"
     "                        epsilon\n"
     "  --json                print the result as JSON\n\n"
     "JSON fields: final and std (the model's names: J_a even when theta holds J_a^-1), theta\n"
     "{name: {nominal, start, final, std}} (theta's names), nominal, start, termination, message,\n"
-    "caveat, samples, sample_time_s, decimation, preparation, algorithm, gradient, p0,\n"
+    "caveat, samples, sample_time_s, decimation, preparation, algorithm, gradient, lambda and\n"
+    "r1 (as given), design_sample_time_s, lambda_per_sample and r1_per_sample (as run),\n"
+    "tracking, changes [{detected_s, time_s}] (bank), lambda_min_reached (variable), p0,\n"
     "psi_variance (diag Q (6.53)), rms_prediction_error, seconds, out.\n"
     "Exit status: 0 the estimates stayed within their bounds, 2 usage, 3 bad log, 4 the\n"
     "estimate left its bounds or P blew up (the message says when; the trajectory up to there\n"
@@ -93,9 +114,10 @@ int runRecursive(const std::vector<std::string>& argv, std::ostream& out, std::o
   std::vector<std::string> valued = logReadOptionNames();
   for (const char* n : {"model", "param", "nominal", "estimate", "invert", "algorithm", "lambda",
                         "r1", "r2", "mu", "start-scale", "p0", "gradient", "decimate", "range",
-                        "out"})
+                        "out", "tracking", "lambda-min", "bank-spacing", "bank-size",
+                        "bank-threshold"})
     valued.push_back(n);
-  ArgParser args({"json", "help"}, valued);
+  ArgParser args({"json", "help", "per-sample"}, valued);
   const std::string pre = "flexarm recursive: ";
   if (!args.parse(argv)) {
     err << pre << args.error() << "\n" << kRecursiveHelp;
@@ -134,24 +156,27 @@ int runRecursive(const std::vector<std::string>& argv, std::ostream& out, std::o
   std::string why;
   if (auto e = args.value("estimate")) o.estimate = splitList(*e);
   if (auto inv = args.value("invert")) o.inverted = *inv == "none" ? std::vector<std::string>{} : splitList(*inv);
-  if (auto a = args.value("algorithm")) {
-    const auto parsed = recursiveAlgorithmFromString(*a);
+  // An option naming one of an enum's words: false (with the sentence written) for another.
+  auto choose = [&](const char* option, auto fromString, auto& target, const char* words) {
+    const auto text = args.value(option);
+    if (!text) return true;
+    const auto parsed = fromString(*text);
     if (!parsed) {
-      err << pre << "--algorithm must be forgetting or kalman, not '" << *a << "'\n";
-      return kExitUsage;
+      err << pre << "--" << option << " must be " << words << ", not '" << *text << "'\n";
+      return false;
     }
-    o.algorithm = *parsed;
-  }
-  if (auto g = args.value("gradient")) {
-    const auto parsed = recursiveGradientFromString(*g);
-    if (!parsed) {
-      err << pre << "--gradient must be sensitivity or difference, not '" << *g << "'\n";
-      return kExitUsage;
-    }
-    o.gradient = *parsed;
-  }
+    target = *parsed;
+    return true;
+  };
+  if (!choose("algorithm", recursiveAlgorithmFromString, o.algorithm, "forgetting or kalman") ||
+      !choose("gradient", recursiveGradientFromString, o.gradient, "sensitivity or difference") ||
+      !choose("tracking", recursiveTrackingFromString, o.tracking, "fixed, variable or bank"))
+    return kExitUsage;
+  long bankSize = o.bankSize;
   if (!args.number("lambda", o.lambda) || !args.number("r2", o.r2) || !args.number("mu", o.mu) ||
-      !args.number("start-scale", o.startScale)) {
+      !args.number("start-scale", o.startScale) || !args.number("lambda-min", o.lambdaMin) ||
+      !args.number("bank-spacing", o.bankSpacingS) || !args.integer("bank-size", bankSize) ||
+      !args.number("bank-threshold", o.bankThreshold)) {
     err << pre << args.error() << "\n";
     return kExitUsage;
   }
@@ -163,6 +188,8 @@ int runRecursive(const std::vector<std::string>& argv, std::ostream& out, std::o
     err << pre << why << "\n";
     return kExitUsage;
   }
+  if (args.flag("per-sample")) o.designSampleTime = 0.0;
+  o.bankSize = static_cast<int>(std::clamp<long>(bankSize, -1, 1000));
   if (!o.isValid(&why)) {
     err << pre << why << "\n";
     return kExitUsage;
@@ -220,6 +247,9 @@ int runRecursive(const std::vector<std::string>& argv, std::ostream& out, std::o
     }
     out << "samples " << r.samples << " at " << 1.0 / run.sampleTime << " Hz (" << run.preparation
         << "), " << r.seconds << " s\n";
+    if (o.algorithm == RecursiveAlgorithm::ForgettingFactor)
+      out << "lambda " << o.lambda << " " << designRateText(o) << ": " << r.asRun.lambda
+          << " per sample at " << 1.0 / run.sampleTime << " Hz\n";
     if (!r.caveat.empty()) out << "note: " << r.caveat << "\n";
     return status;
   }
@@ -228,6 +258,13 @@ int runRecursive(const std::vector<std::string>& argv, std::ostream& out, std::o
     theta[e.parameter.name] = {{"nominal", e.parameter.nominal}, {"start", e.start},
                                {"final", e.final},               {"std", e.sigma},
                                {"unit", e.parameter.unit},       {"spread", e.spread}};
+  nlohmann::json changes = nlohmann::json::array();
+  for (std::size_t i = 0; i < r.trajectory.changeTime.size(); ++i)
+    changes.push_back({{"detected_s", r.trajectory.changeDetected[i]},
+                       {"time_s", r.trajectory.changeTime[i]}});
+  const double lambdaLow = r.trajectory.lambda.empty()
+                               ? 1.0
+                               : *std::min_element(r.trajectory.lambda.begin(), r.trajectory.lambda.end());
   nlohmann::json p0 = nlohmann::json::object(), psi = nlohmann::json::object();
   for (std::size_t i = 0; i < r.estimates.size(); ++i) {
     const auto k = static_cast<Eigen::Index>(i);
@@ -250,7 +287,14 @@ int runRecursive(const std::vector<std::string>& argv, std::ostream& out, std::o
                       {"algorithm", toString(o.algorithm)},
                       {"gradient", toString(o.gradient)},
                       {"lambda", o.lambda},
+                      {"r1", o.r1},
+                      {"design_sample_time_s", o.designSampleTime},
+                      {"lambda_per_sample", r.asRun.lambda},
+                      {"r1_per_sample", r.asRun.r1},
                       {"r2", o.r2},
+                      {"tracking", toString(o.tracking)},
+                      {"changes", changes},
+                      {"lambda_min_reached", lambdaLow},
                       {"mu", o.mu},
                       {"p0", p0},
                       {"psi_variance", psi},

@@ -31,6 +31,7 @@ bool endsWith(const std::string& s, const std::string& tail) {
 }  // namespace
 
 void setReportRenderer(ReportRenderer renderer) { gRenderer = renderer; }
+ReportRenderer reportRenderer() { return gRenderer; }
 
 int runRun(const std::vector<std::string>& argv, std::ostream& out, std::ostream& err) {
   ArgParser args({"json", "help"}, {"log", "report"});

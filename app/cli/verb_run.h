@@ -11,5 +11,7 @@ namespace flexarm::cli {
 // Writes report to path; the extension (.pdf or .html) picks the format. False with why.
 using ReportRenderer = bool (*)(const Report& report, const std::string& path, std::string* why);
 void setReportRenderer(ReportRenderer renderer);
+// The renderer installed (nullptr in a build without the GUI): other verbs' --report.
+ReportRenderer reportRenderer();
 
 }  // namespace flexarm::cli

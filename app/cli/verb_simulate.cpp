@@ -9,6 +9,7 @@
 
 #include "app/cli/cli.h"
 #include "app/cli/model_args.h"
+#include "app/cli/verb_fleet.h"
 #include "core/io/log_io.h"
 #include "core/sim/closed_loop.h"
 
@@ -145,6 +146,7 @@ int runSimulate(const std::vector<std::string>& argv, std::ostream& out, std::os
                         "rate", "controller-rate", "kp", "kv", "ti", "torque-noise", "load-noise",
                         "encoder-counts", "substeps", "out"})
     valued.push_back(v);
+  for (const char* v : kSimulateFleetOptions) valued.push_back(v);
   auto flags = modelFlagOptions();
   for (const char* f : {"json", "help", "motor-velocity", "log-arm-accel"}) flags.push_back(f);
   ArgParser args(flags, valued);
@@ -154,9 +156,10 @@ int runSimulate(const std::vector<std::string>& argv, std::ostream& out, std::os
   };
   if (!args.parse(argv)) return usage(args.error());
   if (args.flag("help")) {
-    out << kSimulateHelp << modelOptionsHelp() << kSimulateHelpTail;
+    out << kSimulateHelp << modelOptionsHelp() << kSimulateHelpTail << kSimulateFleetHelp;
     return kExitOk;
   }
+  if (args.value("fleet")) return runSimulateFleet(args, out, err);
   if (!args.positional().empty()) return usage("unexpected argument '" + args.positional()[0] + "'");
   const auto outPath = args.value("out");
   if (!outPath) return usage("--out LOG.csv is required");

@@ -11,6 +11,8 @@
 #include <stdexcept>
 #include <thread>
 
+#include "core/recursive/recursive_log.h"
+
 namespace flexarm {
 
 namespace {
@@ -39,6 +41,7 @@ struct RunTrace {
   double from = 0.0;
   std::vector<double> time;
   std::vector<TestTrace> traces;  // ratio only
+  bool mismatch = false;          // the model check found the model no longer fits
 };
 
 // The reference of a run: its own, or fitted on a fault-free run of the same arm.
@@ -98,6 +101,7 @@ RunTrace runOnce(const MonteCarloRun& m, const DiagnosisOptions& options) {
     return out;
   }
   out.ok = true;
+  out.mismatch = r.modelCheck.mismatch;
   out.from = m.fault >= 0 ? m.faultTimeS : options.settleS;
   out.time = std::move(r.time);
   for (auto& t : r.tests) {
@@ -117,8 +121,9 @@ bool CalibrationOptions::isValid(std::string* why) const {
     if (why) *why = text;
     return false;
   };
-  if (healthyRuns < 1 || healthyRuns > 100000 || faultyRuns < 0 || faultyRuns > 100000)
-    return fail("the calibration needs at least one fault-free run");
+  if (healthyRuns < 1) return fail("the calibration needs at least one fault-free run");
+  if (healthyRuns > kMaxRuns || faultyRuns < 0 || faultyRuns > kMaxRuns)
+    return fail("the calibration takes 1 to 100000 fault-free runs and 0 to 100000 faulty runs per parameter");
   if (!(faultSize > -0.9 && faultSize < 10.0) || faultSize == 0.0)
     return fail("the fault size must be a non-zero part in (-0.9, 10)");
   if (!(faultTimeS >= 0.0) || !(durationS >= 0.0) || !(horizonS > 0.0))
@@ -138,6 +143,7 @@ double designThreshold(DiagnosisTest test, const DiagnosisOptions& o) {
     case DiagnosisTest::Robust: return o.robustK;
     case DiagnosisTest::Cusum: return o.cusumAlpha2;
     case DiagnosisTest::Hypothesis: return o.hypothesisThreshold;
+    case DiagnosisTest::Joint: return o.jointScale;
   }
   return 1.0;
 }
@@ -180,6 +186,7 @@ DiagnosisOptions withThresholdScale(const DiagnosisOptions& options, DiagnosisTe
     case DiagnosisTest::Robust: o.robustK *= scale; break;
     case DiagnosisTest::Cusum: o.cusumAlpha2 *= scale; break;
     case DiagnosisTest::Hypothesis: o.hypothesisThreshold *= scale; break;
+    case DiagnosisTest::Joint: o.jointScale *= scale; break;
   }
   return o;
 }
@@ -217,6 +224,32 @@ CalibrationResult calibrateUnder(const DiagnosisReference& reference, const LogC
     CalibrationResult r;
     r.message = why;
     return r;
+  }
+  // The budget, before any run is set up: every run keeps its conditions (the log's reference)
+  // and its tests' statistics at the diagnosis rate until the thresholds are chosen.
+  {
+    const double rate = conditions.simulation.logRateHz /
+                        recursiveDecimation(0, conditions.simulation.logRateHz);
+    double columns = 1.0;  // the time
+    for (DiagnosisTest t : options.tests)
+      columns += t == DiagnosisTest::Hypothesis ? 1.0 : static_cast<double>(options.parameters.size());
+    const double perRun = duration * rate * columns * sizeof(double) +
+                          static_cast<double>(conditions.simulation.referenceSignal.size()) * sizeof(double);
+    const double total = static_cast<double>(calibration.healthyRuns) +
+                         static_cast<double>(calibration.faultyRuns) * static_cast<double>(options.parameters.size());
+    if (total * perRun > CalibrationOptions::kMaxCalibrationBytes) {
+      CalibrationResult r;
+      char buf[400];
+      std::snprintf(buf, sizeof buf,
+                    "%.0f runs of %.4g s would hold %.3g GB (%.3g MB a run), more than the %.3g GB a calibration may "
+                    "take; at most %.0f runs fit (with --runs N, N fault-free and N/5 faulty runs per parameter)",
+                    total, duration, total * perRun / 1e9, perRun / 1e6,
+                    CalibrationOptions::kMaxCalibrationBytes / 1e9,
+                    std::floor(CalibrationOptions::kMaxCalibrationBytes / perRun));
+      r.message = buf;
+      r.badRequest = true;
+      return r;
+    }
   }
   std::vector<MonteCarloRun> runs;
   std::uint64_t seed = calibration.seed + 1;
@@ -261,8 +294,9 @@ CalibrationResult monteCarlo(const std::vector<MonteCarloRun>& plan, const Diagn
   result.faults = options.parameters;
 
   // Runs of one arm share its reference: fitted first, once per arm, then every run; both in
-  // parallel, with progress and cancellation from this thread.
-  std::vector<MonteCarloRun> filled = plan;
+  // parallel, with progress and cancellation from this thread. The plan is not copied: each
+  // run is drawn from it with its reference when its turn comes.
+  std::vector<std::shared_ptr<const DiagnosisReference>> references(plan.size());
   std::vector<std::size_t> owner(plan.size());  // the first run of each arm fits its reference
   for (std::size_t i = 0; i < plan.size(); ++i) {
     owner[i] = i;
@@ -300,18 +334,24 @@ CalibrationResult monteCarlo(const std::vector<MonteCarloRun>& plan, const Diagn
     for (auto& t : pool) t.join();
   };
   parallel(plan.size(), [&](std::size_t i) {
+    references[i] = plan[i].reference;
     if (owner[i] != i || plan[i].reference) return;
     std::string problem;
-    filled[i].reference = referenceFor(plan[i], options, &problem);
-    if (!filled[i].reference) failures[i] = problem;
+    references[i] = referenceFor(plan[i], options, &problem);
+    if (!references[i]) failures[i] = problem;
   }, 0.0, 0.2);
   for (std::size_t i = 0; i < plan.size(); ++i)
     if (!failures[owner[i]].empty())
       return finish(Termination::Failed, "a simulated arm could not be referenced: " + failures[owner[i]]);
-    else if (!filled[i].reference)
-      filled[i].reference = filled[owner[i]].reference;
+    else if (!references[i])
+      references[i] = references[owner[i]];
   std::vector<RunTrace> runs(plan.size());
-  if (!cancel) parallel(plan.size(), [&](std::size_t i) { runs[i] = runOnce(filled[i], options); }, 0.2, 1.0);
+  if (!cancel)
+    parallel(plan.size(), [&](std::size_t i) {
+      MonteCarloRun run = plan[i];
+      run.reference = references[i];
+      runs[i] = runOnce(run, options);
+    }, 0.2, 1.0);
   if (cancel) return finish(Termination::Cancelled, "cancelled");
   for (std::size_t i = 0; i < runs.size(); ++i)
     if (!failures[i].empty()) runs[i].message = failures[i];
@@ -326,6 +366,8 @@ CalibrationResult monteCarlo(const std::vector<MonteCarloRun>& plan, const Diagn
                     m.conditions.note.c_str(), m.noiseScale, static_cast<unsigned long long>(m.seed));
       return finish(Termination::Failed, std::string(what) + " could not be diagnosed: " + runs[i].message);
     }
+  for (const RunTrace& r : runs)
+    if (r.mismatch) ++(r.fault < 0 ? result.healthyMismatches : result.faultyMismatches);
 
   for (const auto& r : runs) {
     (r.fault < 0 ? result.healthyRuns : result.faultyRuns) += 1;
@@ -393,7 +435,8 @@ CalibrationResult monteCarlo(const std::vector<MonteCarloRun>& plan, const Diagn
   for (std::size_t k = 0; k < options.tests.size(); ++k) {
     TestCalibration tc;
     tc.test = options.tests[k];
-    const bool hypothesis = tc.test == DiagnosisTest::Hypothesis;
+    // The hypothesis and joint tests have one threshold for all their columns.
+    const bool hypothesis = tc.test == DiagnosisTest::Hypothesis || tc.test == DiagnosisTest::Joint;
     const std::size_t columns = runs.front().traces[k].columns.size();
     const double testBudget = calibration.targetFalseAlarmsPerHour /
                               static_cast<double>(options.decides(tc.test) ? std::max<std::size_t>(1, deciding) : 1);

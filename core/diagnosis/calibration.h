@@ -27,6 +27,10 @@
 namespace flexarm {
 
 struct CalibrationOptions {
+  static constexpr int kMaxRuns = 100000;
+  // The memory all runs of a calibration may hold together (their conditions and statistics):
+  // a request for more runs than fit is refused before any run is set up.
+  static constexpr double kMaxCalibrationBytes = 4.0e9;
   int healthyRuns = 40;      // fault-free runs
   int faultyRuns = 8;        // runs per monitored parameter with a fault stepping in
   double faultSize = 0.2;    // the monitored quantity (theta's form: J_a^-1) rises by this part
@@ -72,9 +76,15 @@ struct TestCalibration {
 struct CalibrationResult {
   Termination termination = Termination::Failed;
   std::string message;
+  // Failed because the request asks for more than the budget (too many runs for the log's
+  // length), not because a run failed.
+  bool badRequest = false;
   double seconds = 0.0;
   int healthyRuns = 0, faultyRuns = 0;  // completed
   double healthyHours = 0.0;            // simulated fault-free time after settling
+  // Runs the model check (model_check.h) called a mismatch: none should be, the simulated arm
+  // is the model's own structure.
+  int healthyMismatches = 0, faultyMismatches = 0;
   double noiseScale = 1.0;
   std::string conditions;               // what was simulated, in words
   std::vector<std::string> faults;      // the monitored parameters' model names

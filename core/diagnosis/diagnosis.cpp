@@ -19,8 +19,9 @@ std::string seconds2(double t) {
 }  // namespace
 
 DecisionStructure decisionStructure(DiagnosisTest test, const std::vector<std::string>& faults) {
-  return test == DiagnosisTest::Hypothesis ? DecisionStructure::hypothesis(faults)
-                                           : DecisionStructure::parameters(faults);
+  return test == DiagnosisTest::Hypothesis || test == DiagnosisTest::Joint
+             ? DecisionStructure::hypothesis(faults)
+             : DecisionStructure::parameters(faults);
 }
 
 TestOutcome evaluateTests(const std::vector<const TestTrace*>& traces,
@@ -80,7 +81,12 @@ TestOutcome evaluateTests(const std::vector<const TestTrace*>& traces,
 }
 
 std::string DiagnosisResult::verdictName() const {
+  if (modelCheck.mismatch) return "model_mismatch";
   return decision.verdict ? faults.at(*decision.verdict) : "none";
+}
+
+std::optional<double> DiagnosisResult::verdictTime() const {
+  return modelCheck.mismatch ? modelCheck.time : decision.verdictTime;
 }
 
 std::string DiagnosisResult::windowText() const {
@@ -110,7 +116,11 @@ std::size_t DiagnosisResult::sampleAt(double t) const {
 
 std::string DiagnosisResult::summary() const {
   std::string s;
-  if (decision.verdict)
+  if (modelCheck.mismatch)
+    s = "Verdict: the model no longer fits: " + modelCheck.what + " (established at " +
+        seconds2(*modelCheck.time) + ")" +
+        (decision.verdict ? "; the tests' " + faults.at(*decision.verdict) + " is not reported as a fault." : ".");
+  else if (decision.verdict)
     s = "Verdict: " + verdictName() + " changed, isolated at " + seconds2(*decision.verdictTime) + ".";
   else if (decision.detectionTime)
     s = "A fault was detected at " + seconds2(*decision.detectionTime) + " but not isolated.";
@@ -239,6 +249,9 @@ DiagnosisResult diagnoseSignals(const DiagnosisReference& reference, const Diagn
   for (DiagnosisTest t : r.decisionTests) deciding.push_back(r.trace(t));
   r.decision = evaluateTests(deciding, std::vector<std::vector<double>>(deciding.size(), {1.0}),
                              r.time, r.faults, options.confirmS, from);
+  if (options.checkModel && r.noiseVariance > 0.0 && !r.time.empty())
+    r.modelCheck = checkModel(r.time, r.estimates.epsilon, data.input, r.noiseVariance, 1.0,
+                              options.windowS, from, options.mismatchRatio, &r.fitRatio);
   if (ending == Termination::Converged) message = r.summary();
   return finish(ending, message);
 }
@@ -246,15 +259,26 @@ DiagnosisResult diagnoseSignals(const DiagnosisReference& reference, const Diagn
 DiagnosisResult diagnose(const DiagnosisReference& reference, const IdData& log,
                          const DiagnosisOptions& options, const ProgressCallback& progress) {
   std::string why;
-  // Read as the reference was: the two predictors settle on different values.
-  const auto data = diagnosisSignals(log, reference.predictor, &why);
-  if (!data) {
+  auto refuse = [&](const std::string& text) {
     DiagnosisResult r;
     r.options = options;
-    r.message = "the log cannot be diagnosed: " + why;
+    r.message = "the log cannot be diagnosed: " + text;
     return r;
-  }
-  return diagnoseSignals(reference, *data, options, progress);
+  };
+  // Read as the reference was: the two predictors settle on different values.
+  const auto data = diagnosisSignals(log, reference.predictor, &why);
+  if (!data) return refuse(why);
+  // f_m compared at the monitored log's temperature.
+  const LogTemperature monitored = logTemperature(log);
+  if (!monitored.problem.empty() && !options.monitoredTemperatureC) return refuse(monitored.problem);
+  DiagnosisReference ref = reference;
+  if (options.referenceTemperatureC) ref.temperatureC = options.referenceTemperatureC;
+  const TemperatureCorrection temperature = correctForTemperature(
+      ref, options.monitoredTemperatureC ? options.monitoredTemperatureC : monitored.celsius, options.friction);
+  DiagnosisResult r = diagnoseSignals(ref, *data, options, progress);
+  r.temperature = temperature;
+  if (r.termination == Termination::Converged) r.message += " Temperature: " + temperature.message + ".";
+  return r;
 }
 
 }  // namespace flexarm

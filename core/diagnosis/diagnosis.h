@@ -19,6 +19,8 @@
 #include "core/diagnosis/decision.h"
 #include "core/diagnosis/diagnosis_data.h"
 #include "core/diagnosis/diagnosis_options.h"
+#include "core/diagnosis/diagnosis_temperature.h"
+#include "core/diagnosis/model_check.h"
 #include "core/diagnosis/parameter_tests.h"
 #include "core/diagnosis/reference.h"
 #include "core/recursive/rpem.h"
@@ -78,9 +80,17 @@ struct DiagnosisResult {
   double windowS = 0.0;
   DiagnosisOptions options;                     // as run (thresholds, window)
   std::string referenceSource;
+  // Under-modelling: R(t) of the estimator of every parameter (model_check.h) and the check.
+  std::vector<double> fitRatio;
+  ModelCheck modelCheck;
+  // What the temperatures did to theta_0's f_m (diagnose() from a log; empty otherwise).
+  TemperatureCorrection temperature;
 
-  // "none" or the changed parameter's model name (k_T, J_a, f_m).
+  // "none", the changed parameter's model name (k_T, J_a, f_m), or "model_mismatch" when the
+  // model no longer fits the data (then no parameter is named).
   std::string verdictName() const;
+  // When the verdict was reached (the mismatch's time for model_mismatch), if it was.
+  std::optional<double> verdictTime() const;
   // "cumulative (from the first sample, as the seed)" or "sliding, the last 5 s".
   std::string windowText() const;
   // The trace and outcome of a test, or nullptr when it did not run.

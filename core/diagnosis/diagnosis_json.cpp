@@ -20,6 +20,8 @@ nlohmann::json thresholdsJson(DiagnosisTest t, const DiagnosisOptions& o) {
       return {{"k", o.robustK}, {"lambda", o.robustLambda}, {"factors", o.robustScales}};
     case DiagnosisTest::Cusum:
       return {{"alpha1", o.cusumAlpha1}, {"alpha2", o.cusumAlpha2}, {"factors", o.cusumScales}};
+    case DiagnosisTest::Joint:
+      return {{"k", o.jointK}, {"scale", o.jointScale}, {"lambda", o.robustLambda}};
     case DiagnosisTest::Hypothesis:
       return {{"threshold", o.hypothesisThreshold},
               {"window", toString(o.window)},
@@ -33,7 +35,30 @@ nlohmann::json thresholdsJson(DiagnosisTest t, const DiagnosisOptions& o) {
 nlohmann::json diagnosisResultJson(const DiagnosisResult& r) {
   nlohmann::json j;
   j["verdict"] = r.verdictName();
-  j["alarm_time_s"] = optionalTime(r.decision.verdictTime);
+  j["alarm_time_s"] = optionalTime(r.verdictTime());
+  // The tests' own verdict, which model_mismatch keeps from being reported as a fault.
+  j["tests_verdict"] = r.decision.verdict ? nlohmann::json(r.faults.at(*r.decision.verdict)) : nlohmann::json("none");
+  const ModelCheck& mc = r.modelCheck;
+  j["model_check"] = {{"checked", mc.checked},
+                      {"fits", !mc.mismatch},
+                      {"time_s", optionalTime(mc.time)},
+                      {"threshold", mc.threshold},
+                      {"median_ratio", mc.medianRatio},
+                      {"peak_ratio", mc.peakRatio},
+                      {"white", mc.residualsTested ? nlohmann::json(mc.residuals.white) : nlohmann::json()},
+                      {"independent", mc.residualsTested ? nlohmann::json(mc.residuals.independent) : nlohmann::json()},
+                      {"what", mc.what},
+                      {"message", mc.message}};
+  const TemperatureCorrection& tc = r.temperature;
+  j["temperature"] = {{"monitored_c", tc.monitoredC ? nlohmann::json(*tc.monitoredC) : nlohmann::json()},
+                      {"reference_c", tc.referenceC ? nlohmann::json(*tc.referenceC) : nlohmann::json()},
+                      {"alpha_per_c", tc.model.alpha},
+                      {"alpha_std_per_c", tc.model.alphaStd},
+                      {"alpha_logs", tc.model.logs},
+                      {"applied", tc.applied},
+                      {"f_m_reference", tc.fmReference},
+                      {"f_m_expected", tc.fmExpected},
+                      {"message", tc.message}};
   j["detection_time_s"] = optionalTime(r.decision.detectionTime);
   j["termination"] = toString(r.termination);
   j["message"] = r.message;

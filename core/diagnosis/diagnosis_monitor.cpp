@@ -18,6 +18,7 @@ struct DiagnosisMonitor::Impl {
   std::vector<RobustTest> robust;
   std::vector<CusumTest> cusum;
   std::unique_ptr<HypothesisStatistics> hypothesis;
+  std::unique_ptr<JointTest> joint;
   std::vector<std::vector<TestSample>> samples;
   std::vector<double> errors;
 };
@@ -64,6 +65,12 @@ DiagnosisMonitor::DiagnosisMonitor(const DiagnosisReference& reference,
           m.cusum.emplace_back(params[i].nominal, options.cusumAlpha1,
                                options.cusumAlpha2 * options.thresholdScale(t, i));
         break;
+      case DiagnosisTest::Joint: {
+        std::vector<double> theta0;
+        for (const auto& q : params) theta0.push_back(q.nominal);
+        m.joint = std::make_unique<JointTest>(theta0, sigma0, options.jointK, options.robustLambda);
+        break;
+      }
       case DiagnosisTest::Hypothesis: {
         m.nominal = std::make_unique<RecursiveEstimator>(estimator({}, {}));
         for (std::size_t i = 0; i < n; ++i)
@@ -77,7 +84,7 @@ DiagnosisMonitor::DiagnosisMonitor(const DiagnosisReference& reference,
         break;
       }
     }
-    m.samples.emplace_back(t == DiagnosisTest::Hypothesis ? n + 1 : n);
+    m.samples.emplace_back(t == DiagnosisTest::Hypothesis || t == DiagnosisTest::Joint ? n + 1 : n);
   }
 }
 
@@ -104,6 +111,16 @@ const RecursiveStep& DiagnosisMonitor::update(double u, double y) {
           out[i] = m.cusum[i].update(step.theta(static_cast<Eigen::Index>(i)),
                                      step.sigma(static_cast<Eigen::Index>(i)));
         break;
+      case DiagnosisTest::Joint: {
+        const auto& t = m.joint->update(step.theta, step.sigma, m.full->covariance());
+        for (std::size_t h = 0; h < out.size(); ++h) {
+          out[h] = t[h];
+          out[h].ratio /= m.options.jointScale;
+          out[h].threshold *= m.options.jointScale;
+          out[h].alarm = out[h].ratio > 1.0;
+        }
+        break;
+      }
       case DiagnosisTest::Hypothesis: {
         m.errors[0] = m.nominal->update(u, y).epsilon;  // (7.18)
         for (std::size_t i = 0; i < m.single.size(); ++i)
@@ -129,7 +146,7 @@ std::vector<std::vector<std::string>> DiagnosisMonitor::columns() const {
   for (const auto& p : impl_->full->parameters()) names.push_back(p.name);
   std::vector<std::vector<std::string>> out;
   for (DiagnosisTest t : impl_->options.tests) {
-    if (t != DiagnosisTest::Hypothesis) {
+    if (t != DiagnosisTest::Hypothesis && t != DiagnosisTest::Joint) {
       out.push_back(names);
       continue;
     }

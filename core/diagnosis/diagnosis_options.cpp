@@ -24,6 +24,7 @@ const char* toString(DiagnosisTest t) {
     case DiagnosisTest::Robust: return "robust";
     case DiagnosisTest::Cusum: return "cusum";
     case DiagnosisTest::Hypothesis: return "hypothesis";
+    case DiagnosisTest::Joint: return "joint";
   }
   return "classical";
 }
@@ -36,7 +37,8 @@ std::optional<DiagnosisTest> diagnosisTestFromString(std::string_view s) {
 
 const std::vector<DiagnosisTest>& allDiagnosisTests() {
   static const std::vector<DiagnosisTest> kAll = {DiagnosisTest::Classical, DiagnosisTest::Robust,
-                                                  DiagnosisTest::Cusum, DiagnosisTest::Hypothesis};
+                                                  DiagnosisTest::Cusum, DiagnosisTest::Hypothesis,
+                                                  DiagnosisTest::Joint};
   return kAll;
 }
 
@@ -50,7 +52,7 @@ std::optional<std::vector<DiagnosisTest>> diagnosisTestsFromList(std::string_vie
     const auto t = diagnosisTestFromString(word);
     if (!t) {
       if (why)
-        *why = "'" + std::string(word) + "' is not a test (classical, robust, cusum, hypothesis)";
+        *why = "'" + std::string(word) + "' is not a test (classical, robust, cusum, hypothesis, joint)";
       return std::nullopt;
     }
     if (std::find(tests.begin(), tests.end(), *t) == tests.end()) tests.push_back(*t);
@@ -106,7 +108,8 @@ std::vector<double>* DiagnosisOptions::scales(DiagnosisTest t) {
     case DiagnosisTest::Classical: return &classicalScales;
     case DiagnosisTest::Robust: return &robustScales;
     case DiagnosisTest::Cusum: return &cusumScales;
-    case DiagnosisTest::Hypothesis: return nullptr;
+    case DiagnosisTest::Hypothesis:
+    case DiagnosisTest::Joint: return nullptr;
   }
   return nullptr;
 }
@@ -148,6 +151,14 @@ bool DiagnosisOptions::isValid(std::string* why) const {
     return failWith(why, "CUSUM: alpha_1 >= 0 and alpha_2 > 0");
   if (!positive(hypothesisThreshold))
     return failWith(why, "the hypothesis tests' threshold must be > 0");
+  if (!positive(jointK) || !positive(jointScale))
+    return failWith(why, "the joint test's k and scale must be > 0");
+  if (!(mismatchRatio > 1.0) || !std::isfinite(mismatchRatio))
+    return failWith(why, "the model mismatch ratio must be a number > 1");
+  if (friction && !friction->isValid(why)) return false;
+  for (const auto& t : {monitoredTemperatureC, referenceTemperatureC})
+    if (t && !(std::isfinite(*t) && *t >= -50.0 && *t <= 250.0))
+      return failWith(why, "a temperature must lie between -50 and 250 degC");
   if (window == HypothesisWindow::Sliding && !positive(windowS))
     return failWith(why, "the sliding window must be longer than 0 s");
   for (const auto* v : {&classicalScales, &robustScales, &cusumScales}) {

@@ -8,6 +8,7 @@
 #include <string_view>
 #include <vector>
 
+#include "core/diagnosis/friction_temperature.h"
 #include "core/recursive/rpem.h"
 
 namespace flexarm {
@@ -20,8 +21,10 @@ namespace flexarm {
 //              and threshold h = alpha_2 theta_0,i ((7.15)-(7.17)).
 //  Hypothesis: a bank of predictors, one per fault hypothesis, and the normalised sums of
 //              squared prediction errors ((7.18)-(7.21)).
-enum class DiagnosisTest { Classical, Robust, Cusum, Hypothesis };
-const char* toString(DiagnosisTest t);  // "classical", "robust", "cusum", "hypothesis"
+//  Joint:      the change vector of every monitored parameter at once against its full
+//              covariance (chi-square), isolated by its direction (parameter_tests.h).
+enum class DiagnosisTest { Classical, Robust, Cusum, Hypothesis, Joint };
+const char* toString(DiagnosisTest t);  // "classical", "robust", "cusum", "hypothesis", "joint"
 std::optional<DiagnosisTest> diagnosisTestFromString(std::string_view s);
 const std::vector<DiagnosisTest>& allDiagnosisTests();
 // "classical,robust" -> the tests; nullopt with a sentence naming a word that is not a test.
@@ -72,6 +75,12 @@ struct DiagnosisOptions {
   double cusumAlpha1 = 3.0;    // (7.15) (seed: 3)
   double cusumAlpha2 = 20.0;   // (7.17) (seed: 20)
   double hypothesisThreshold = 1.12;  // the seed's 1, "a natural choice after normalisation"
+  // The joint test's k: its chi-square is compared with the quantile of p degrees of freedom
+  // at the probability of k sigma (JointTest), times jointScale, which bench/
+  // montecarlo_diagnosis calibrated for one false alarm per hour (1.86: the chi-square of the
+  // smoothed change is autocorrelated as the estimates are).
+  double jointK = 3.0;
+  double jointScale = 1.86;
   HypothesisWindow window = HypothesisWindow::Sliding;  // on-line use (seed: cumulative)
   double windowS = 5.0;        // length of the sliding window, s
   // Per-parameter factors on the thresholds of the classical, robust and CUSUM tests, one per
@@ -86,6 +95,18 @@ struct DiagnosisOptions {
   // No alarm is raised before this time: the start-up transient of the estimators and of the
   // hypothesis sums (the seed: "in the first few seconds there is a transient behavior"), s.
   double settleS = 2.0;
+
+  // Under-modelling (model_check.h): the verdict is model_mismatch, not a parameter, when the
+  // mean square over a second of the errors of the estimator of every monitored parameter
+  // stays above mismatchRatio times lambda_0 for windowS seconds.
+  bool checkModel = true;
+  double mismatchRatio = 2.0;
+
+  // Temperature (diagnosis_temperature.h): the friction model that carries theta_0's f_m to
+  // the monitored log's temperature (none: f_m is compared as fitted), and the temperatures
+  // of the monitored and the reference log when the logs do not state them.
+  std::optional<FrictionTemperatureModel> friction;
+  std::optional<double> monitoredTemperatureC, referenceTemperatureC;
 
   // The seed's design: the direct predictor, 3 sigma, the robust test's lambda 0.995, alpha_1 = 3,
   // alpha_2 = 20, the hypothesis level 1 over the cumulative window, every test in the decision

@@ -65,6 +65,10 @@ DiagnosisRun runDiagnosisRequest(const DiagnosisRequest& request, const IdData& 
     run.calibration = calibrate(run.reference, log, options, request.calibration,
                                 share(progress, referenceShare, referenceShare + calibrationShare));
     if (run.calibration->termination == Termination::Cancelled) return fail(Termination::Cancelled, "cancelled");
+    if (run.calibration->badRequest) {
+      run.badRequest = true;
+      return fail(Termination::Failed, "the calibration is refused: " + run.calibration->message);
+    }
     if (run.calibration->termination != Termination::Converged)
       return fail(Termination::Failed, "the calibration failed: " + run.calibration->message);
     options = run.calibration->calibrated;

@@ -31,6 +31,9 @@ struct DiagnosisRequest {
 struct DiagnosisRun {
   Termination termination = Termination::Failed;
   std::string message;  // a sentence: how it ended or what failed
+  // Failed because the request asks for more work than the budget allows for this log (too
+  // many calibration runs), not because the data or an estimator failed.
+  bool badRequest = false;
   DiagnosisReference reference;
   std::optional<CalibrationResult> calibration;
   DiagnosisResult result;  // with the calibrated options when calibrated

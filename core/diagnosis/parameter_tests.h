@@ -5,6 +5,9 @@
 // fault-free data) and its standard deviation sigma_0 (7.4).
 #include <cmath>
 #include <cstddef>
+#include <vector>
+
+#include <Eigen/Dense>
 
 namespace flexarm {
 
@@ -69,5 +72,49 @@ class CusumTest {
   bool reset_;
   double up_ = 0.0, down_ = 0.0;
 };
+
+// The joint test of the change vector (what the seed's 9.2 leaves open: the correlation
+// between the parameters). The change d = theta_bar(t) - theta_0 of every monitored parameter
+// at once, theta_bar the smoothed estimates of (7.12), is measured in the metric of its
+// covariance C: the spread of each estimate (7.13) (plus sigma_0^2 (7.4)) on the diagonal and
+// the correlations of the estimates from the full P(t) (6.13)/(6.18) off it,
+//   chi2(t) = d^T C^-1 d,
+// against q_p, the chi-square quantile of p degrees of freedom at the two-sided probability of
+// k sigma (p = 3, k = 3: 14.2, i.e. 3.77^2). Isolation is by the change's direction: a
+// fault in parameter i moves theta along e_i, which explains the part
+// a_i = (e_i^T C^-1 d)^2 / (e_i^T C^-1 e_i) of chi2 and leaves r_i = chi2 - a_i. The test
+// quantities follow the decision structure of the hypothesis tests (Section 7.5.2):
+//   T_NF = chi2 / q_p                   (NF rejected: a change is detected)
+//   T_i  = r_i / max(q_(p-1), kappa chi2) (F_i rejected: the change does not lie along
+//                                         e_i; kappa = 0.25 is 30 degrees in C's metric)
+// so S = {F_i} when a change is detected and only e_i explains its direction. Per-parameter
+// tests read each estimate alone, so that a change in one parameter that drags a correlated
+// estimate along can fire the wrong column; the direction sees the pair together.
+class JointTest {
+ public:
+  // theta0, sigma0: per monitored parameter (theta's form); k: the "3 sigma"; lambda: the
+  // smoothing (7.12)/(7.13); kappa: the isolation angle's cos^2 complement.
+  JointTest(std::vector<double> theta0, std::vector<double> sigma0, double k, double lambda,
+            double kappa = 0.25);
+  // theta, sigma: the estimates and sqrt(lambda_0 P_ii); P: the full P(t). Returns T_NF, then
+  // T_i per parameter.
+  const std::vector<TestSample>& update(const Eigen::VectorXd& theta, const Eigen::VectorXd& sigma,
+                                        const Eigen::MatrixXd& P);
+  double chiSquare() const { return chi2_; }
+  // Per parameter: the share of chi2 its direction explains, a_i / chi2 (0..1).
+  const std::vector<double>& alignment() const { return alignment_; }
+
+ private:
+  std::vector<double> theta0_, sigma0_;
+  double k_, kappa_, detect_, isolate_;
+  std::vector<RobustTest> smooth_;
+  std::vector<TestSample> out_;
+  std::vector<double> alignment_;
+  double chi2_ = 0.0;
+};
+
+// The chi-square quantile the joint test compares with for p parameters and k sigma: the
+// quantile at P(|z| < k) of p degrees of freedom (1 when p = 0).
+double jointQuantile(std::size_t p, double k);
 
 }  // namespace flexarm

@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <stdexcept>
 
+#include "core/diagnosis/diagnosis_temperature.h"
 #include "core/diagnosis/simulate_like.h"
 #include "core/ident/closed_loop_pem.h"
 #include "core/ident/pem.h"
@@ -88,6 +89,16 @@ NominalFit fitNominalModel(const PhysicalModel& start, const DiagnosisSignals& d
   fit.model = std::shared_ptr<const PhysicalModel>(plantOf(*r.model));
   fit.freeNames = r.freeNames;
   fit.covariance = r.covariance;
+  // The monitored parameters' sigma_0 and the thresholds come from this covariance: a fit
+  // whose Hessian is singular (data that cannot tell the parameters apart) has none to give.
+  if (fit.covariance.rows() != static_cast<Eigen::Index>(fit.freeNames.size()) ||
+      fit.covariance.cols() != fit.covariance.rows() || !fit.covariance.allFinite()) {
+    fit.termination = Termination::Failed;
+    fit.message = "the data cannot tell the parameters apart (the fit's Hessian is singular, so it gives "
+                  "no covariance for sigma_0); a log with more excitation is needed";
+    fit.model.reset();
+    return fit;
+  }
   fit.loss = outputErrors(*fit.model, data).squaredNorm() / static_cast<double>(data.size());
   if (!std::isfinite(fit.loss)) {
     fit.termination = Termination::Diverged;
@@ -236,6 +247,7 @@ DiagnosisReference referenceFromLog(const PhysicalModel& start, const IdData& he
     return ref;
   }
   DiagnosisReference ref = referenceFromSignals(start, *signals, options, referenceOptions, progress);
+  ref.temperatureC = logTemperature(healthy).celsius;
   if (ref.ok() || ref.termination == Termination::Cancelled || options.predictor != DiagnosisPredictor::Auto ||
       signals->predictor != DiagnosisPredictor::Loop)
     return ref;
@@ -245,6 +257,7 @@ DiagnosisReference referenceFromLog(const PhysicalModel& start, const IdData& he
   if (!direct) return ref;
   DiagnosisReference fallback = referenceFromSignals(start, *direct, options, referenceOptions, progress);
   if (!fallback.ok()) return ref;
+  fallback.temperatureC = ref.temperatureC;
   fallback.source += " (the loop predictor could not be fitted: " + ref.message + ")";
   fallback.message = fallback.source;
   return fallback;

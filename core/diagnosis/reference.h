@@ -17,6 +17,7 @@
 // controller and reference (diagnosis/simulate_like.h); without those, theta_0 is the model
 // itself and a sentence says that closed-loop bias then shows as a deviation.
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -52,6 +53,9 @@ struct DiagnosisReference {
   std::vector<double> p0;
   std::vector<double> p0Single;
   std::string source;  // one sentence: where theta_0 came from
+  // The fault-free log's temperature (its temperature_c channel or metadata; none when it
+  // says nothing, or the reference is a model), degC: what theta_0's f_m refers to.
+  std::optional<double> temperatureC;
 
   bool ok() const { return termination == Termination::Converged && nominal != nullptr; }
 };

@@ -28,6 +28,17 @@ std::optional<LogConditions> logConditions(const IdData& log, std::string* why) 
   }
   o.logRateHz = o.controller.rateHz / std::round(ratio);
   o.durationS = static_cast<double>(log.samples()) * log.sampleTime;
+  if (!(o.durationS <= SimulationOptions::kMaxDurationS)) {
+    if (why) {
+      char buf[200];
+      std::snprintf(buf, sizeof buf,
+                    "the log lasts %.4g s (a time step of %.4g s), longer than the %.0f s the simulator runs, "
+                    "so it cannot be simulated again",
+                    o.durationS, log.sampleTime, SimulationOptions::kMaxDurationS);
+      *why = buf;
+    }
+    return std::nullopt;
+  }
   if (log.samples() < 10) {
     if (why) *why = "the log is too short to be simulated again";
     return std::nullopt;

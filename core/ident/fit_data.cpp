@@ -5,6 +5,8 @@
 #include <cstdio>
 #include <stdexcept>
 
+#include "core/signal/excitation.h"
+
 namespace flexarm {
 
 bool FitDataOptions::isValid(std::string* why) const {
@@ -83,6 +85,9 @@ PreparedData prepareFitData(const IdData& data, const FitDataOptions& options) {
   if (!options.reference.empty() && !ref)
     return fail("the log has no channel '" + options.reference + "' for the reference");
   if (in == outCh) return fail("the input and the output are the same channel '" + in->name + "'");
+  // Dead data (a stuck encoder, a zero torque, values too large to square) are refused here,
+  // before any estimator or diagnosis runs on them.
+  if (std::string dead = deadDataProblem(data, {in->name, outCh->name}); !dead.empty()) return fail(dead);
   IdData d;
   d.sampleTime = data.sampleTime;
   d.startTime = data.startTime;

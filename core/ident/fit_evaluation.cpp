@@ -53,6 +53,13 @@ double controllerRateHz(const FitOptions& o, const FitResult& r) {
   return meta ? meta->rateHz : 0.0;
 }
 
+// A rate as a person writes it: "2000", "1e+300" (never a wrapped integer).
+std::string rateText(double hz) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.6g", hz);
+  return buf;
+}
+
 // Sentences beside the 99 % intervals of a physical fit where bench/bench_fit_closed_loop.cpp
 // measured them to promise too much (simulated two- and three-mass logs at the sample logs'
 // noise, 40 logs per case).
@@ -69,8 +76,7 @@ void intervalCaveats(const FitOptions& o, FitResult& r) {
                   "decimated by 10 only %s such intervals held the truth (J_m %s); fit the log at its own "
                   "rate, where every interval of the indirect fit held",
                   1.0 / d.sampleTime,
-                  slower ? (", below the " + std::to_string(static_cast<long>(std::lround(controllerHz))) +
-                            " Hz of the log's controller").c_str()
+                  slower ? (", below the " + rateText(controllerHz) + " Hz of the log's controller").c_str()
                          : " after decimation",
                   1e3 * d.sampleTime, controllerHz > 0.0 ? 1e3 / controllerHz : 1e3 * d.sampleTime / d.decimation,
                   kDecimatedCoverage, kDecimatedBias);

@@ -195,6 +195,9 @@ HeadStatus parseHead(std::string_view text, bool whole, const std::string& path,
                                    " metadata lines ('# key: value'); a FlexArm log has a few"));
         std::string key = io::trim(std::string_view(body).substr(0, colon));
         std::string value = io::trim(std::string_view(body).substr(colon + 1));
+        if (std::string bad = io::utf8Problem(key + ": " + value); !bad.empty())
+          return fails(failure(path, cursor.number(), 0, io::utf8Problem(key).empty() ? key : std::string(),
+                               "the metadata line is not UTF-8 text: " + bad));
         if (!key.empty()) h.data.setMeta(key, value);
         if (key == "sample_rate_hz") {
           double v = 0;
@@ -220,6 +223,9 @@ HeadStatus parseHead(std::string_view text, bool whole, const std::string& path,
       if (name.empty())
         return fails(failure(path, h.headerLine, static_cast<int>(i + 1), {},
                              "the header has an empty column name"));
+      if (std::string bad = io::utf8Problem(name); !bad.empty())
+        return fails(failure(path, h.headerLine, static_cast<int>(i + 1), {},
+                             "the column name is not UTF-8 text: " + bad));
       if (!seen.insert(name).second)
         return fails(failure(path, h.headerLine, static_cast<int>(i + 1), name,
                              "the column name appears twice in the header"));

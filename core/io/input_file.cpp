@@ -247,6 +247,11 @@ std::string textEncodingProblem(std::string_view head) {
       ++zeros;
       (i % 2 ? oddZeros : evenZeros)++;
     }
+  const std::string_view first = head.substr(0, n);
+  if (const std::size_t cr = first.find('\r');
+      zeros == 0 && cr != std::string_view::npos && cr + 1 < first.size() && first.find('\n') == std::string_view::npos)
+    return "the file's lines end in a carriage return alone (CR, as classic Mac OS wrote text), which FlexArm "
+           "does not read; save it with LF or CR LF line ends (e.g. tr '\\r' '\\n' < old > new)";
   if (zeros == 0) return {};
   if (n >= 4 && (oddZeros >= n / 2 - 1 || evenZeros >= n / 2 - 1) && zeros <= n / 2 + 1)
     return std::string("the file looks like UTF-16 text (every other byte is zero), which "

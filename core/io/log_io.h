@@ -92,10 +92,11 @@ LogReadResult readTableText(std::string_view text, const std::string& name,
 // file untouched. Returns false and fills error on failure.
 bool writeFlexArmCsv(const IdData& data, const std::string& path, ReadError* error = nullptr);
 
-// Writes text to path atomically: a temporary sibling, written, flushed to the disk and then
-// renamed over path. Refuses to replace anything but a regular file (a device such as
-// /dev/full, a pipe, a directory), and reports every write error (disk full, quota) with the
-// previous file left as it was.
+// Writes text to path atomically, the one way FlexArm writes any file: a temporary sibling
+// created exclusively (O_EXCL | O_NOFOLLOW) under an unpredictable name in path's folder,
+// written, flushed to the disk and then renamed over path. Refuses to replace anything but a
+// regular file (a symbolic link, a device such as /dev/full, a pipe, a directory), and
+// reports every write error (disk full, quota) with the previous file left as it was.
 bool writeFileAtomically(const std::string& path, const std::string& text, std::string* why);
 // The same with the text produced piecewise: produce(sink) calls sink(bytes) any number of
 // times, so a large file never has to be held in memory whole.

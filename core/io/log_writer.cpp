@@ -1,15 +1,17 @@
 // Writing files so that a failure never leaves a half-written or replaced file: a temporary
-// sibling, every write checked, flushed to the disk, then renamed over the target.
+// sibling made exclusively under an unpredictable name, every write checked, flushed to the
+// disk, then renamed over the target. Every file FlexArm writes goes through here.
 #include <fcntl.h>
+#include <sys/random.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
 #include <algorithm>
-#include <atomic>
 #include <cerrno>
 #include <charconv>
 #include <cstdio>
 #include <cstring>
+#include <random>
 
 #include "core/io/input_file.h"
 #include "core/io/log_io.h"
@@ -24,6 +26,26 @@ std::string writeProblem(const std::string& path, int error) {
   return s + "; the previous file, if any, is unchanged";
 }
 
+// A name no other process can guess: ".NAME.tmp-" and 16 random hex digits, in the target's
+// folder (a rename within one file system is atomic).
+std::string temporarySibling(const std::string& path) {
+  static const char* hex = "0123456789abcdef";
+  std::uint64_t bits = 0;
+  if (::getrandom(&bits, sizeof bits, 0) != static_cast<ssize_t>(sizeof bits)) {
+    std::random_device device;
+    bits = (static_cast<std::uint64_t>(device()) << 32) ^ device();
+  }
+  std::string suffix(16, '0');
+  for (char& c : suffix) {
+    c = hex[bits & 15u];
+    bits >>= 4;
+  }
+  const std::size_t slash = path.rfind('/');
+  const std::string folder = slash == std::string::npos ? std::string() : path.substr(0, slash + 1);
+  const std::string name = slash == std::string::npos ? path : path.substr(slash + 1);
+  return folder + "." + name + ".tmp-" + suffix;
+}
+
 }  // namespace
 
 bool writeFileAtomically(
@@ -34,15 +56,26 @@ bool writeFileAtomically(
     if (why) *why = std::move(text);
     return false;
   };
+  if (path.empty() || path.back() == '/') return fail("'" + path + "' names no file to write");
+  // The target is replaced, never written through: a link planted at its name (or anything but
+  // a regular file) is refused, and the temporary file is made afresh (O_EXCL) under a name no
+  // one can plant a link at first (O_NOFOLLOW as well).
   struct stat st {};
-  if (::stat(path.c_str(), &st) == 0 && !S_ISREG(st.st_mode))
+  if (::lstat(path.c_str(), &st) == 0 && !S_ISREG(st.st_mode)) {
+    if (S_ISLNK(st.st_mode))
+      return fail(path + " is a symbolic link; FlexArm writes only regular files and does not follow or "
+                         "replace a link");
     return fail(path + " is " + fileKind(st.st_mode) +
                 ", not a regular file; FlexArm writes only regular files and does not replace it");
-  static std::atomic<unsigned> counter{0};
-  const std::string tmp =
-      path + ".tmp-" + std::to_string(::getpid()) + "-" + std::to_string(counter++);
-  const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
-  if (fd < 0) return fail("cannot create " + tmp + ": " + std::strerror(errno));
+  }
+  std::string tmp;
+  int fd = -1;
+  for (int attempt = 0; attempt < 8 && fd < 0; ++attempt) {
+    tmp = temporarySibling(path);
+    fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC, 0666);
+    if (fd < 0 && errno != EEXIST) break;
+  }
+  if (fd < 0) return fail("cannot create a temporary file beside " + path + ": " + std::strerror(errno));
   int error = 0;
   auto sink = [&](std::string_view bytes) {
     while (!bytes.empty() && error == 0) {

@@ -2,10 +2,13 @@
 
 #include <zlib.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <cstring>
 #include <memory>
 #include <vector>
+
+#include "core/io/hdf5_check.h"
 
 namespace flexarm {
 namespace {
@@ -319,6 +322,23 @@ bool level4(const Byte* p, std::uint64_t n, std::string& problem) {
 
 }  // namespace
 
+namespace {
+
+// A v7.3 file is walked by hdf5_check before HDF5 opens it. Its compressed data may inflate to
+// 64 times the file's size (at least 64 MiB): a log of real signals compresses a few times,
+// and only a file made to exhaust memory asks for more.
+bool checkV73(std::string_view bytes, std::uint64_t inflateBudget, const MatLoad& load, MatCheck& r) {
+  Hdf5Limits limits;
+  limits.inflateBudget = std::min<std::uint64_t>(inflateBudget, std::max<std::uint64_t>(64u << 20, 64 * bytes.size()));
+  const Hdf5Check h = checkHdf5File(bytes, limits, load);
+  r.problem = h.problem;
+  for (const Hdf5Variable& v : h.variables)
+    if (!v.numeric) r.skipped.push_back(v.name + " (" + (v.matlabClass.empty() ? std::string(v.dataset ? "not numeric" : "a group") : v.matlabClass) + ")");
+  return h.ok;
+}
+
+}  // namespace
+
 MatCheck checkMatFile(std::string_view bytes, std::uint64_t inflateBudget, const MatLoad& load) {
   MatCheck r;
   const auto* p = reinterpret_cast<const Byte*>(bytes.data());
@@ -333,7 +353,7 @@ MatCheck checkMatFile(std::string_view bytes, std::uint64_t inflateBudget, const
     const unsigned version = swap ? (p[124] << 8 | p[125]) : (p[125] << 8 | p[124]);
     if (version == 0x0200) {
       r.kind = MatKind::V73;
-      r.ok = true;
+      r.ok = checkV73(bytes, inflateBudget, load, r);
       return r;
     }
     if (version == 0x0100) {

@@ -40,6 +40,9 @@ struct MatCheck {
   bool swapBytes = false;  // the file was written in the other byte order
   std::vector<MatVariable> variables;
   std::vector<std::unique_ptr<unsigned char[]>> inflated;  // bodies of compressed variables
+  // v7.3: variables the walk found but FlexArm cannot read (structs, cells, objects), named
+  // with their MATLAB class, for the reader's note.
+  std::vector<std::string> skipped;
 };
 
 // Bytes per element of a level-5 data type; 0 when the type holds no numbers.
@@ -49,8 +52,8 @@ std::uint64_t matTypeSize(std::uint32_t type);
 // walks; false when they cannot be read.
 using MatLoad = std::function<bool(std::uint64_t offset, std::uint64_t n)>;
 
-// Checks the bytes of a whole .mat file (level 4, level 5 / v7, or the HDF5-based v7.3 whose
-// variables are bounded later from their dimensions). inflateBudget bounds the bytes the
+// Checks the bytes of a whole .mat file (level 4, level 5 / v7, or the HDF5-based v7.3, walked
+// by checkHdf5File in core/io/hdf5_check.h before HDF5 opens it). inflateBudget bounds the bytes the
 // compressed variables of a v7 file may inflate to, all together. For a level-5 file the
 // result lists its variables, pointing into `bytes` (which must outlive their use).
 // With load, `bytes` is memory of the file's size that holds only what load brought in: the

@@ -413,6 +413,11 @@ LogReadResult io::readMatFile(const InputFile& file, const std::string& path, co
     data.setRole(columns::kMotorVelocity, ChannelRole::Output);
   data.setMeta("source", std::filesystem::path(path).filename().string());
   data.setMeta("format", "MATLAB .mat");
+  if (!check.skipped.empty()) {  // v7.3 variables that are not numeric arrays, named and ignored
+    std::string list;
+    for (const auto& v : check.skipped) list += (list.empty() ? "" : ", ") + v;
+    data.setMeta("skipped_variables", list);
+  }
   LogReadResult ok;
   ok.ok = true;
   ok.data = std::move(data);

@@ -24,6 +24,23 @@ std::string trim(std::string_view s) {
   return std::string(s.substr(b, e - b));
 }
 
+std::string utf8Problem(std::string_view s) {
+  for (std::size_t i = 0; i < s.size();) {
+    const auto c = static_cast<unsigned char>(s[i]);
+    const std::size_t length = c < 0x80 ? 1 : (c >> 5) == 0x6 ? 2 : (c >> 4) == 0xE ? 3 : (c >> 3) == 0x1E ? 4 : 0;
+    bool ok = length > 0 && i + length <= s.size() && !(c == 0xC0 || c == 0xC1 || c > 0xF4);
+    for (std::size_t k = 1; ok && k < length; ++k) ok = (static_cast<unsigned char>(s[i + k]) & 0xC0) == 0x80;
+    if (!ok) {
+      char buf[120];
+      std::snprintf(buf, sizeof buf, "byte 0x%02x at character %zu is not UTF-8 (Latin-1 text? save the file as UTF-8)",
+                    static_cast<unsigned>(c), i + 1);
+      return buf;
+    }
+    i += length;
+  }
+  return {};
+}
+
 bool isBlank(std::string_view s) {
   return std::all_of(s.begin(), s.end(), [](char c) { return c == ' ' || c == '\t' || c == '\r'; });
 }
@@ -170,6 +187,15 @@ long long firstTimeProblem(const std::vector<double>& t, double jitter, std::str
                   "the time step %.3g s is shorter than %.0e s, the finest step FlexArm "
                   "reads (its logs hold time with 9 decimals)",
                   dt, IdData::kMinSampleTime);
+    problem = buf;
+    return 1;
+  }
+  // Stamps of +-1.7e308 overflow their difference: a step of inf (a sample rate of 0 Hz).
+  if (!(dt <= 1e6)) {
+    std::snprintf(buf, sizeof buf,
+                  "the time stamps run from %.9g s to %.9g s, a time step of %.3g s, longer than the 1e+06 s "
+                  "FlexArm reads (the time column is damaged or not in seconds)",
+                  t[0], t[n - 1], dt);
     problem = buf;
     return 1;
   }

@@ -36,6 +36,9 @@ LogReadResult failure(const std::string& file, int line, int column, std::string
 
 std::string trim(std::string_view s);
 bool isBlank(std::string_view s);
+// Empty when s is UTF-8 text; otherwise where it is not, e.g. "byte 0xe9 at character 7 is
+// not UTF-8 (Latin-1 text?)": names and metadata reach JSON, which holds only UTF-8.
+std::string utf8Problem(std::string_view s);
 
 // One decimal number at [first, last): the end of what was read, or nullptr when nothing
 // there is a number. Every reader parses through this one primitive (fast_float when the

@@ -18,11 +18,11 @@ void CovarianceUpdate::regularise(Eigen::MatrixXd& P) const {
 }
 
 bool CovarianceUpdate::operator()(const Eigen::VectorXd& psi, Eigen::MatrixXd& P,
-                                  Eigen::VectorXd& K) {
+                                  Eigen::VectorXd& K, double lambda) {
   const bool forgetting = algorithm_ == RecursiveAlgorithm::ForgettingFactor;
   prior_ = P;
   if (forgetting) {
-    prior_ /= lambda_;
+    prior_ /= lambda > 0.0 ? lambda : lambda_;
     regularise(prior_);
   }
   Ppsi_.noalias() = prior_ * psi;

@@ -19,7 +19,9 @@ class CovarianceUpdate {
                    double mu);
   // Updates P in place and sets K. False when psi^T P psi + (1 or R2) is not a positive
   // finite number (P is then left as it was).
-  bool operator()(const Eigen::VectorXd& psi, Eigen::MatrixXd& P, Eigen::VectorXd& K);
+  // lambda > 0 replaces the forgetting factor for this update (variable forgetting).
+  bool operator()(const Eigen::VectorXd& psi, Eigen::MatrixXd& P, Eigen::VectorXd& K,
+                  double lambda = 0.0);
 
  private:
   // P (I + mu P)^{-1} (6.9), in place.

@@ -1,4 +1,5 @@
 // The recursive estimator of chapter 6, one sample at a time.
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 
@@ -28,6 +29,31 @@ class OwnedModel {
 
  private:
   std::unique_ptr<ParametricModel> p_;
+};
+
+// A copy of an estimator's state owned by value (a hypothesis of the bank); copies are deep,
+// so that a copied estimator's bank continues on its own.
+class ImplCopy {
+ public:
+  explicit ImplCopy(std::unique_ptr<RecursiveEstimator::Impl> p);
+  ImplCopy(const ImplCopy& o);
+  ImplCopy& operator=(const ImplCopy& o);
+  ImplCopy(ImplCopy&&) noexcept = default;
+  ImplCopy& operator=(ImplCopy&&) noexcept = default;
+  ~ImplCopy();
+  RecursiveEstimator::Impl& operator*() const { return *p_; }
+  RecursiveEstimator::Impl* operator->() const { return p_.get(); }
+
+ private:
+  std::unique_ptr<RecursiveEstimator::Impl> p_;
+};
+
+// An estimator of the bank: started at `start` (s), with the sums of squared prediction errors
+// since then of its own and of the running estimate.
+struct Hypothesis {
+  double start = 0.0;
+  ImplCopy estimator;
+  double own = 0.0, running = 0.0;
 };
 
 struct RecursiveEstimator::Impl {
@@ -80,6 +106,19 @@ struct RecursiveEstimator::Impl {
   bool good = true;
   std::string message;
   double lambda0 = 0.0;
+  // The noise variance the tracking compares with: options.noiseVariance, else estimated with
+  // the prediction errors clipped at 3 sigma once one memory has passed, so that the errors
+  // after a change do not raise it.
+  double trackingVariance = 0.0;
+  // The bank of hypothesised change times (RecursiveTracking::Bank).
+  std::vector<Hypothesis> bank;
+  std::size_t nextHypothesis = 0;
+  // The weight of one sample in the bank's sums: T / designSampleTime, so that they count per
+  // design sample (5 ms) and the threshold means the same at any rate (the prediction errors
+  // of a faster log are no more independent per second).
+  double sampleWeight = 1.0;
+  std::size_t changes = 0;  // accepted so far
+  double lastChange = 0.0;  // the hypothesised time of the last one, s
 
   Impl(const ParametricModel& nominal, double sampleTime, const RecursiveOptions& o, double t0)
       : model(nominal),
@@ -250,6 +289,12 @@ struct RecursiveEstimator::Impl {
       zoh.advance(A, B, dA, dB, T, u, x, X);
     else
       zoh.advance(A, B, noDerivatives, noInputDerivatives, T, u, x, noSensitivities);
+    if (zoh.tooLongSubsteps() > 0.0) {
+      stop("The sample time of " + formatNumber(T) + " s is far longer than the model's fastest time scale: " +
+           "one sample would take " + formatNumber(zoh.tooLongSubsteps()) + " integration steps (at most " +
+           formatNumber(ExtendedZoh::kMaxSubsteps) + "); check the log's time column or resample it.");
+      return false;
+    }
     if (!x.allFinite() || !X.allFinite()) {
       stop("The predictor's state is no longer finite at t = " + formatNumber(t) +
            " s: the model at the estimate is unstable.");
@@ -306,6 +351,10 @@ struct RecursiveEstimator::Impl {
     good = true;
     message = "No sample processed yet.";
     lambda0 = options.noiseVariance;
+    trackingVariance = options.noiseVariance;
+    bank.clear();
+    nextHypothesis = bankSpacing();
+    changes = 0;
     std::string why;
     if (!setTheta(theta, &why)) throw std::invalid_argument("theta(0) is refused: " + why);
     evaluate(options.gradient == RecursiveGradient::Sensitivity, C, D);
@@ -348,13 +397,18 @@ struct RecursiveEstimator::Impl {
       }
     }
     const double eps = y - yhat;  // (6.12)/(6.17)
+    const double forgetting = forgettingFactor(eps);
     if (options.noiseVariance == 0.0) {
       const double w = std::max(1.0 / static_cast<double>(count + 1), 1.0 - options.lambda);
       lambda0 += w * (eps * eps - lambda0);
+      const bool warm = static_cast<double>(count) * (1.0 - options.lambda) > 1.0;
+      const double e2 = warm ? std::min(eps * eps, 9.0 * trackingVariance) : eps * eps;
+      const double slow = std::max(1.0 / static_cast<double>(count + 1), 0.1 * (1.0 - options.lambda));
+      trackingVariance += slow * (e2 - trackingVariance);
     }
     if (p > 0) {
       Pnew = P;
-      if (!update(psi, Pnew, gain)) {
+      if (!update(psi, Pnew, gain, forgetting)) {
         stop("The gain cannot be formed at t = " + formatNumber(t) +
              " s: psi^T P psi is no longer a finite number.");
         return step;
@@ -403,12 +457,93 @@ struct RecursiveEstimator::Impl {
     step.theta = theta;
     step.psi = psi;
     step.gain = gain;
+    step.lambda = options.algorithm == RecursiveAlgorithm::ForgettingFactor ? forgetting : 1.0;
+    step.change = false;
     fillSigma();
     propagate(u);
     ++count;
+    if (options.tracking == RecursiveTracking::Bank && good && p > 0) followBank(u, y, eps);
     return step;
   }
+
+  // The forgetting factor of this sample: lambda, or with variable forgetting Fortescue's
+  // lambda(t) = 1 - eps^2 (1 - lambda) / (sigma^2 (1 + psi^T P(t-1) psi)), within
+  // [lambdaMin, 1].
+  double forgettingFactor(double eps) const {
+    if (options.tracking != RecursiveTracking::Variable || p == 0 || !(trackingVariance > 0.0))
+      return options.lambda;
+    const double s = 1.0 + psi.dot(P * psi);
+    const double lambda = 1.0 - eps * eps * (1.0 - options.lambda) / (trackingVariance * s);
+    return std::clamp(lambda, options.lambdaMin, 1.0);
+  }
+
+  std::size_t bankSpacing() const {
+    return std::max<std::size_t>(1, static_cast<std::size_t>(std::llround(options.bankSpacingS / T)));
+  }
+
+  // The bank (RecursiveTracking::Bank) after the running estimate processed a sample with
+  // prediction error eps: every hypothesis processes it too; the one that explains the data
+  // since its start best, by more than bankThreshold noise variances, becomes the running
+  // estimate; then a new hypothesis starts at the next sample when one is due.
+  void followBank(double u, double y, double eps) {
+    Hypothesis* best = nullptr;
+    double bestGain = options.bankThreshold * trackingVariance;
+    for (auto it = bank.begin(); it != bank.end();) {
+      const RecursiveStep& s = (*it->estimator).process(u, y);
+      if (!s.ok) {
+        it = bank.erase(it);
+        continue;
+      }
+      it->own += sampleWeight * s.epsilon * s.epsilon;
+      it->running += sampleWeight * eps * eps;
+      const bool ripe = timeOf(count) - it->start >= options.bankMinAgeS - 1e-12;
+      if (ripe && it->running - it->own > bestGain) {
+        bestGain = it->running - it->own;
+        best = &*it;
+      }
+      ++it;
+    }
+    if (best) {
+      const double changeTime = best->start;
+      Impl chosen = *best->estimator;
+      const RecursiveOptions mine = options;
+      const std::size_t next = nextHypothesis;
+      const std::size_t held = heldTotal;
+      const std::string first = firstHeld;
+      const std::size_t accepted = changes + 1;
+      bank.clear();
+      *this = std::move(chosen);
+      options = mine;
+      changes = accepted;
+      lastChange = changeTime;
+      heldTotal += held;
+      if (firstHeld.empty()) firstHeld = first;
+      nextHypothesis = next;
+      step.change = true;
+      step.changeTime = changeTime;
+    }
+    if (count < nextHypothesis) return;
+    nextHypothesis = count + bankSpacing();
+    std::vector<Hypothesis> kept = std::move(bank);
+    bank.clear();
+    auto h = std::make_unique<Impl>(*this);
+    bank = std::move(kept);
+    h->options.tracking = RecursiveTracking::Fixed;
+    h->P = P0 * options.bankCovarianceScale;
+    h->heldRun = h->heldTotal = 0;
+    h->firstHeld.clear();
+    bank.push_back(Hypothesis{timeOf(count), ImplCopy(std::move(h)), 0.0, 0.0});
+    if (bank.size() > static_cast<std::size_t>(options.bankSize)) bank.erase(bank.begin());
+  }
 };
+
+ImplCopy::ImplCopy(std::unique_ptr<RecursiveEstimator::Impl> p) : p_(std::move(p)) {}
+ImplCopy::ImplCopy(const ImplCopy& o) : p_(std::make_unique<RecursiveEstimator::Impl>(*o.p_)) {}
+ImplCopy& ImplCopy::operator=(const ImplCopy& o) {
+  if (this != &o) p_ = std::make_unique<RecursiveEstimator::Impl>(*o.p_);
+  return *this;
+}
+ImplCopy::~ImplCopy() = default;
 
 RecursiveEstimator::RecursiveEstimator(const ParametricModel& nominal, double sampleTime,
                                        const RecursiveOptions& options, double startTime) {
@@ -425,8 +560,10 @@ RecursiveEstimator::RecursiveEstimator(const ParametricModel& nominal, double sa
   m.params = resolveParameters(nominal, options);
   m.p = static_cast<Eigen::Index>(m.params.size());
   m.n = ss.states();
-  m.update = CovarianceUpdate(options.algorithm, options.lambda, kalmanR1(m.params, options),
-                              options.r2, options.mu);
+  m.options = perSample(options, sampleTime, m.params);
+  m.sampleWeight = options.designSampleTime > 0.0 ? sampleTime / options.designSampleTime : 1.0;
+  m.update = CovarianceUpdate(m.options.algorithm, m.options.lambda, kalmanR1(m.params, m.options),
+                              m.options.r2, m.options.mu);
   m.theta0.resize(m.p);
   for (Eigen::Index i = 0; i < m.p; ++i) {
     const RecursiveParameter& q = m.params[static_cast<std::size_t>(i)];
@@ -499,6 +636,10 @@ const std::string& RecursiveEstimator::message() const {
       impl_->message += "the update was held back at the bounds in " +
                         std::to_string(impl_->heldTotal) + " of them (first: " +
                         impl_->firstHeld + ").";
+    if (impl_->changes > 0)
+      impl_->message += " The bank accepted " + std::to_string(impl_->changes) + " change" +
+                        (impl_->changes == 1 ? "" : "s") + " (the last at t = " +
+                        formatNumber(impl_->lastChange) + " s).";
   }
   return impl_->message;
 }

@@ -149,7 +149,13 @@ void ExtendedZoh::advance(const Eigen::MatrixXd& A, const Eigen::VectorXd& B,
     nu = std::max(nu, row / stateScale_[i]);
   }
   nu *= T;
+  tooLong_ = 0.0;
   if (!std::isfinite(nu)) {
+    x.setConstant(std::numeric_limits<double>::quiet_NaN());
+    return;
+  }
+  if (nu / kMaxStepNorm > kMaxSubsteps) {
+    tooLong_ = std::ceil(nu / kMaxStepNorm);
     x.setConstant(std::numeric_limits<double>::quiet_NaN());
     return;
   }

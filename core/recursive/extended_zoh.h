@@ -35,10 +35,17 @@ class ExtendedZoh {
   // Terms of the series summed in the last advance() (for tests and the bench).
   int lastTerms() const { return lastTerms_; }
 
+  // Sub-steps one sample may take. A sample time far longer than the model's fastest time
+  // scale (a log with a time step of 1e6 s) would need billions: advance() then leaves x NaN
+  // and tooLongSubsteps() says how many it would have needed (0 otherwise).
+  static constexpr double kMaxSubsteps = 1e5;
+  double tooLongSubsteps() const { return tooLong_; }
+
  private:
   Eigen::VectorXd stateScale_, blockScale_;
   Eigen::MatrixXd weight_;  // of x and each X_j, one column each
   int lastTerms_ = 0;
+  double tooLong_ = 0.0;
 };
 
 }  // namespace flexarm

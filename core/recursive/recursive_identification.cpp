@@ -79,12 +79,13 @@ void assessSigma(RecursiveResult& r) {
 
 InitialCovariance steadyStateCovariance(const ParametricModel& nominal, const Eigen::VectorXd& u,
                                         const Eigen::VectorXd& y, double T,
-                                        const RecursiveOptions& options) {
+                                        const RecursiveOptions& design) {
   if (u.size() != y.size())
     throw std::invalid_argument("recursive identification: input and output must have the same "
                                 "number of samples");
   InitialCovariance r;
   // psi at the nominal theta: the estimator with theta held (P does not matter here).
+  const RecursiveOptions options = perSample(design, T, resolveParameters(nominal, design));
   RecursiveOptions pre = options;
   pre.updateParameters = false;
   pre.thetaStart.clear();
@@ -224,6 +225,7 @@ RecursiveResult finishRecursive(const RecursiveEstimator& est, RecursiveTrajecto
     r.estimates.push_back(e);
   }
   r.model = est.model();
+  r.asRun = est.options();
   assessSigma(r);
   if (!est.ok()) {
     r.termination = Termination::Diverged;

@@ -10,7 +10,11 @@ namespace flexarm {
 
 bool RecursiveDataOptions::isValid(std::string* why) const {
   if (decimation < 0) {
-    if (why) *why = "the decimation factor must not be negative (0: to 200 Hz)";
+    if (why) *why = "the decimation factor must not be negative (0: the log's rate up to the highest rate)";
+    return false;
+  }
+  if (!(maxRateHz > 0.0) || !std::isfinite(maxRateHz)) {
+    if (why) *why = "the highest rate must be a positive number of Hz";
     return false;
   }
   if (range && !(range->start < range->end)) {
@@ -20,9 +24,9 @@ bool RecursiveDataOptions::isValid(std::string* why) const {
   return true;
 }
 
-int recursiveDecimation(int decimation, double sampleRateHz) {
+int recursiveDecimation(int decimation, double sampleRateHz, double maxRateHz) {
   if (decimation > 0) return decimation;
-  return std::max(1, static_cast<int>(std::floor(sampleRateHz / 200.0 + 1e-9)));
+  return std::max(1, static_cast<int>(std::ceil(sampleRateHz / maxRateHz - 1e-9)));
 }
 
 PreparedData prepareRecursiveData(const IdData& log, const RecursiveDataOptions& options) {
@@ -43,7 +47,8 @@ PreparedData prepareRecursiveData(const IdData& log, const RecursiveDataOptions&
   f.input = options.input;
   f.output = options.output;
   f.velocityOutput = true;
-  f.decimation = recursiveDecimation(options.decimation, log.sampleRateHz());
+  f.decimation = recursiveDecimation(options.decimation, log.sampleRateHz(), options.maxRateHz);
+  f.decimatedInput = FitDataOptions::DecimatedInput::HeldMean;
   f.estimation = options.range;
   f.removeMeans = true;
   return prepareFitData(used, f);

@@ -42,6 +42,26 @@ enum class RecursiveGradient { Sensitivity, Difference };
 const char* toString(RecursiveGradient g);  // "sensitivity", "difference"
 std::optional<RecursiveGradient> recursiveGradientFromString(std::string_view s);
 
+// How the estimator follows parameters that change (the seed's 9.2 names the two beside the
+// fixed design of Algorithms 6.1/6.2):
+//  Fixed:    lambda (6.13) or R1 (6.18) as designed, the seed's.
+//  Variable: information-constant forgetting (Fortescue, Kershenbaum and Ydstie, 1981): the
+//            forgetting factor of each sample is chosen so that the information the estimate
+//            rests on stays constant, lambda(t) = 1 - eps(t)^2 / (Sigma_0 (1 + psi^T P psi)),
+//            Sigma_0 = sigma^2 / (1 - lambda): lambda on average while the model fits, lower
+//            (down to lambdaMin) when the prediction errors grow after a change. Forgetting
+//            factor algorithm only.
+//  Bank:     estimators started at hypothesised change times (every bankSpacingS seconds, the
+//            last bankSize of them kept), each from the running estimate with P(0) as if the
+//            data before its start were not known; when one predicts the data since its start
+//            better than the running estimate by more than bankThreshold noise variances (a
+//            likelihood ratio of the change hypothesis, its squared errors summed per design
+//            sample), once it has run bankMinAgeS, the change is accepted: the running
+//            estimate becomes that estimator's and the change time is reported.
+enum class RecursiveTracking { Fixed, Variable, Bank };
+const char* toString(RecursiveTracking t);  // "fixed", "variable", "bank"
+std::optional<RecursiveTracking> recursiveTrackingFromString(std::string_view s);
+
 struct RecursiveOptions {
   // Model parameters in theta, by the model's names. A name written "NAME^-1" puts the inverse
   // of NAME in theta (the seed's J_a^-1); so does listing NAME in `inverted`. Empty: nothing is
@@ -55,7 +75,27 @@ struct RecursiveOptions {
   // diag R1 of (6.18), one value per theta entry. Empty: the seed's (6.54), 1e-8 * (5, 50, 500)
   // for k_T, J_a^-1, f_m (a parameter without a seed value then needs r1 given).
   std::vector<double> r1;
+  // The sample time lambda and R1 are designed for, s. The seed designs them per sample at
+  // 200 Hz (0.005 s): a memory 1 / (1 - lambda) of 200 samples, one second, and a random walk
+  // of variance R1 per 5 ms. Run at another sample time T, the estimator keeps that memory and
+  // that random walk per second: lambda^(T / designSampleTime) and R1 T / designSampleTime
+  // (perSample()). 0: lambda and R1 are per sample at whatever rate the data have.
+  double designSampleTime = 0.005;
   double r2 = 1.0;  // R2 of (6.18) (the seed normalises it to 1)
+
+  RecursiveTracking tracking = RecursiveTracking::Fixed;
+  // Variable: the lowest forgetting factor a sample may use (per design sample, as lambda).
+  double lambdaMin = 0.95;
+  // Bank: a hypothesised change time every bankSpacingS seconds, the last bankSize kept (they
+  // cover bankSize * bankSpacingS seconds back), accepted at bankThreshold noise variances.
+  double bankSpacingS = 0.25;
+  int bankSize = 6;
+  double bankThreshold = 40.0;
+  // Bank: a hypothesis is accepted only once it has run this long (s): an estimator started on
+  // a short stretch of data fits its noise, which would be read as a change.
+  double bankMinAgeS = 0.5;
+  // Bank: P(0) of an estimator started at a hypothesised change, as a multiple of P(0).
+  double bankCovarianceScale = 100.0;
   double mu = 0.0;  // regularisation (6.8)/(6.9), >= 0 (seed: 0, the excitation is good)
 
   RecursiveGradient gradient = RecursiveGradient::Sensitivity;
@@ -106,6 +146,16 @@ struct RecursiveParameter {
   double sigmaToModel(double v, double s) const { return inverted ? s / (v * v) : s; }
 };
 
+// The options as the estimator runs them on data sampled every sampleTime: lambda and R1 of a
+// design for designSampleTime carried over to sampleTime (the same memory and random walk per
+// second), R1 filled with the seed's (6.54) where it was empty and the Kalman gain runs, and
+// designSampleTime 0 (the values are then per sample). params: theta's entries (for R1's seed
+// values). Throws std::invalid_argument as kalmanR1 does.
+RecursiveOptions perSample(const RecursiveOptions& options, double sampleTime,
+                           const std::vector<RecursiveParameter>& params);
+// What lambda and R1 are given per, in words: "per 200 Hz sample" (or "per sample").
+std::string designRateText(const RecursiveOptions& options);
+
 // What one sample of the recursion produced.
 struct RecursiveStep {
   std::size_t index = 0;  // sample number, 0 for the first sample given
@@ -119,6 +169,10 @@ struct RecursiveStep {
   Eigen::VectorXd psi;        // psi(t), the gradient of yhat(t) in theta
   Eigen::VectorXd gain;       // K(t) of (6.14)/(6.19)
   double noiseVariance = 0.0; // lambda_0 used for sigma
+  double lambda = 1.0;        // the forgetting factor this sample used (Variable: lambda(t))
+  // Bank: a change was accepted at this sample; it happened at changeTime (s).
+  bool change = false;
+  double changeTime = 0.0;
   bool held = false;          // the update would have left the bounds and was held back
   bool ok = true;             // false once the estimate left its bounds or P blew up
 };
@@ -176,12 +230,15 @@ class RecursiveEstimator {
 
  private:
   struct Impl;
+  friend class ImplCopy;
   std::unique_ptr<Impl> impl_;
 };
 
 // The trajectory of a run, one entry per sample, in columns ready to plot.
 struct RecursiveTrajectory {
-  std::vector<double> time, y, yhat, epsilon, noiseVariance;
+  std::vector<double> time, y, yhat, epsilon, noiseVariance, lambda;
+  // Bank: the changes accepted, when (detected) and at which hypothesised time.
+  std::vector<double> changeDetected, changeTime;
   std::vector<std::vector<double>> theta, pDiagonal, sigma;  // [parameter][sample]
 
   std::size_t size() const { return time.size(); }
@@ -237,6 +294,8 @@ struct RecursiveResult {
   // the estimates varied more than sigma says (empty otherwise).
   std::string caveat;
   std::shared_ptr<const ParametricModel> model;  // the model at the final estimate
+  // The options as the estimator ran them (perSample: lambda and R1 per sample of the data).
+  RecursiveOptions asRun;
 };
 
 // The two halves of recursiveIdentification, for a caller that feeds the samples itself (a

@@ -2,6 +2,7 @@
 #include <cmath>
 
 #include "core/recursive/rpem.h"
+#include "core/recursive/theta.h"
 
 namespace flexarm {
 
@@ -23,6 +24,19 @@ std::optional<RecursiveGradient> recursiveGradientFromString(std::string_view s)
   return std::nullopt;
 }
 
+const char* toString(RecursiveTracking t) {
+  switch (t) {
+    case RecursiveTracking::Variable: return "variable";
+    case RecursiveTracking::Bank: return "bank";
+    default: return "fixed";
+  }
+}
+std::optional<RecursiveTracking> recursiveTrackingFromString(std::string_view s) {
+  for (auto t : {RecursiveTracking::Fixed, RecursiveTracking::Variable, RecursiveTracking::Bank})
+    if (s == toString(t)) return t;
+  return std::nullopt;
+}
+
 bool RecursiveOptions::isValid(std::string* why) const {
   auto fail = [&](const std::string& text) {
     if (why) *why = text;
@@ -38,6 +52,22 @@ bool RecursiveOptions::isValid(std::string* why) const {
     if (!(v >= 0.0) || !std::isfinite(v)) return fail("R1's diagonal must not be negative");
   if (!r1.empty() && r1.size() != estimate.size())
     return fail("R1 needs one value per estimated parameter");
+  if (!(designSampleTime >= 0.0) || !std::isfinite(designSampleTime))
+    return fail("the design sample time must not be negative (0: per sample)");
+  if (!(lambdaMin > 0.0 && lambdaMin <= lambda))
+    return fail("the lowest forgetting factor must lie in (0, lambda]");
+  if (tracking == RecursiveTracking::Variable && algorithm != RecursiveAlgorithm::ForgettingFactor)
+    return fail("variable forgetting needs the forgetting-factor algorithm");
+  if (!(bankSpacingS > 0.0) || !std::isfinite(bankSpacingS))
+    return fail("the spacing of the hypothesised change times must be positive");
+  if (bankSize < 1 || bankSize > 64) return fail("the bank holds 1 to 64 estimators");
+  if (!(bankMinAgeS >= 0.0) || !std::isfinite(bankMinAgeS) ||
+      bankMinAgeS >= bankSpacingS * static_cast<double>(bankSize))
+    return fail("the bank's hypotheses must ripen (bankMinAgeS) before they drop out of the bank");
+  if (!(bankThreshold > 0.0) || !std::isfinite(bankThreshold))
+    return fail("the bank's threshold must be positive");
+  if (!(bankCovarianceScale >= 1.0) || !std::isfinite(bankCovarianceScale))
+    return fail("the bank's P(0) scale must be at least 1");
   if (!(mu >= 0.0) || !std::isfinite(mu)) return fail("the regularisation mu must not be negative");
   if (!(differenceStep > 0.0) || !std::isfinite(differenceStep))
     return fail("the difference step must be positive");
@@ -58,8 +88,30 @@ bool RecursiveOptions::isValid(std::string* why) const {
   return true;
 }
 
+RecursiveOptions perSample(const RecursiveOptions& options, double sampleTime,
+                           const std::vector<RecursiveParameter>& params) {
+  RecursiveOptions o = options;
+  if (o.algorithm == RecursiveAlgorithm::Kalman) {
+    const Eigen::VectorXd r1 = kalmanR1(params, options);
+    o.r1.assign(r1.data(), r1.data() + r1.size());
+  }
+  if (options.designSampleTime > 0.0 && sampleTime > 0.0 && sampleTime != options.designSampleTime) {
+    const double ratio = sampleTime / options.designSampleTime;
+    o.lambda = std::pow(options.lambda, ratio);
+    o.lambdaMin = std::pow(options.lambdaMin, ratio);
+    for (double& v : o.r1) v *= ratio;
+  }
+  o.designSampleTime = 0.0;
+  return o;
+}
+
+std::string designRateText(const RecursiveOptions& options) {
+  if (!(options.designSampleTime > 0.0)) return "per sample";
+  return "per " + formatNumber(1.0 / options.designSampleTime) + " Hz sample";
+}
+
 void RecursiveTrajectory::reserve(std::size_t samples, std::size_t parameters) {
-  for (auto* v : {&time, &y, &yhat, &epsilon, &noiseVariance}) v->reserve(samples);
+  for (auto* v : {&time, &y, &yhat, &epsilon, &noiseVariance, &lambda}) v->reserve(samples);
   for (auto* m : {&theta, &pDiagonal, &sigma}) {
     m->resize(parameters);
     for (auto& v : *m) v.reserve(samples);
@@ -75,6 +127,11 @@ void RecursiveTrajectory::append(const RecursiveStep& s) {
   yhat.push_back(s.yhat);
   epsilon.push_back(s.epsilon);
   noiseVariance.push_back(s.noiseVariance);
+  lambda.push_back(s.lambda);
+  if (s.change) {
+    changeDetected.push_back(s.time);
+    changeTime.push_back(s.changeTime);
+  }
   for (std::size_t i = 0; i < p; ++i) {
     const auto k = static_cast<Eigen::Index>(i);
     theta[i].push_back(s.theta[k]);
@@ -84,7 +141,8 @@ void RecursiveTrajectory::append(const RecursiveStep& s) {
 }
 
 void RecursiveTrajectory::clear() {
-  for (auto* v : {&time, &y, &yhat, &epsilon, &noiseVariance}) v->clear();
+  for (auto* v : {&time, &y, &yhat, &epsilon, &noiseVariance, &lambda, &changeDetected, &changeTime})
+    v->clear();
   for (auto* m : {&theta, &pDiagonal, &sigma}) m->clear();
 }
 

@@ -1,6 +1,7 @@
 #include "core/session/diagnosis_part.h"
 
 #include <algorithm>
+#include <cmath>
 
 #include "core/diagnosis/diagnosis_json.h"
 #include "core/session/json_fields.h"
@@ -96,6 +97,7 @@ class DiagnosisPart : public SessionPart {
     if (!stored) return;  // validated on load
     const IdData* monitored = nullptr;
     auto fail = [&report](const std::string& text) {
+      report.warnings.push_back("diagnosis: could not run: " + text);  // e.g. a log the session lacks
       ReportSection s;
       s.title = "Diagnosis";
       s.paragraphs.push_back("The diagnosis could not run: " + text + ".");
@@ -168,7 +170,15 @@ json diagnosisOptionsToJson(const DiagnosisOptions& o) {
           {"robust_factors", o.robustScales},
           {"cusum_factors", o.cusumScales},
           {"confirm_s", o.confirmS},
-          {"settle_s", o.settleS}};
+          {"settle_s", o.settleS},
+          {"joint_k", o.jointK},
+          {"joint_scale", o.jointScale},
+          {"check_model", o.checkModel},
+          {"mismatch_ratio", o.mismatchRatio},
+          {"friction_alpha", o.friction ? json(o.friction->alpha) : json(nullptr)},
+          {"friction_reference_c", o.friction ? json(o.friction->referenceC) : json(nullptr)},
+          {"monitored_temperature_c", o.monitoredTemperatureC ? json(*o.monitoredTemperatureC) : json(nullptr)},
+          {"reference_temperature_c", o.referenceTemperatureC ? json(*o.referenceTemperatureC) : json(nullptr)}};
 }
 
 std::optional<DiagnosisOptions> diagnosisOptionsFromJson(const json& j, std::string* why) {
@@ -198,8 +208,27 @@ std::optional<DiagnosisOptions> diagnosisOptionsFromJson(const json& j, std::str
       !readNumbers(j, "robust_factors", o.robustScales, why, where) ||
       !readNumbers(j, "cusum_factors", o.cusumScales, why, where) ||
       !readNumber(j, "confirm_s", o.confirmS, false, why, where) ||
-      !readNumber(j, "settle_s", o.settleS, false, why, where))
+      !readNumber(j, "settle_s", o.settleS, false, why, where) ||
+      !readNumber(j, "joint_k", o.jointK, false, why, where) ||
+      !readNumber(j, "joint_scale", o.jointScale, false, why, where) ||
+      !readFlag(j, "check_model", o.checkModel, why, where) ||
+      !readNumber(j, "mismatch_ratio", o.mismatchRatio, false, why, where))
     return std::nullopt;
+  // Optional numbers, null when not set.
+  double alpha = NAN, referenceC = NAN, monitoredC = NAN, logReferenceC = NAN;
+  if (!readNumber(j, "friction_alpha", alpha, false, why, where) ||
+      !readNumber(j, "friction_reference_c", referenceC, false, why, where) ||
+      !readNumber(j, "monitored_temperature_c", monitoredC, false, why, where) ||
+      !readNumber(j, "reference_temperature_c", logReferenceC, false, why, where))
+    return std::nullopt;
+  if (std::isfinite(alpha)) {
+    FrictionTemperatureModel f;
+    f.alpha = alpha;
+    if (std::isfinite(referenceC)) f.referenceC = referenceC;
+    o.friction = f;
+  }
+  if (std::isfinite(monitoredC)) o.monitoredTemperatureC = monitoredC;
+  if (std::isfinite(logReferenceC)) o.referenceTemperatureC = logReferenceC;
   const auto p = diagnosisPredictorFromString(predictor);
   const auto w = hypothesisWindowFromString(window);
   const auto a = recursiveAlgorithmFromString(algorithm);

@@ -32,6 +32,9 @@ std::string thresholdText(const DiagnosisResult& r, DiagnosisTest t, std::size_t
     case DiagnosisTest::Cusum:
       return "h = " + formatSignificant(o.cusumAlpha2 * o.thresholdScale(t, column), 3) + " theta_0";
     case DiagnosisTest::Hypothesis: return formatSignificant(o.hypothesisThreshold, 4);
+    case DiagnosisTest::Joint:
+      return formatSignificant(o.jointScale, 3) + " x chi2 quantile (" +
+             formatSignificant(o.jointK, 3) + " sigma)";
   }
   return "";
 }

@@ -223,6 +223,7 @@ class DiscoveryPart : public SessionPart {
                            "it is confirmed when a second test, specific to the effect, agrees on held-out data.");
     s.values = {{"base_model", baseName}};
     auto fail = [&](const std::string& text) {
+      report.warnings.push_back("discovery: could not run: " + text);  // e.g. a log the session lacks
       s.paragraphs.push_back("Discovery could not run: " + text + ".");
       s.values["effect"] = nullptr;
       s.values["message"] = text;

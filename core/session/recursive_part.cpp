@@ -132,10 +132,13 @@ class RecursivePart : public SessionPart {
         "The recursive prediction-error method of chapter 6 (" +
         std::string(o.algorithm == RecursiveAlgorithm::Kalman
                         ? "Algorithm 6.2, the Kalman gain with R1 = diag(" +
-                              (o.r1.empty() ? std::string("(6.54)") : list(o.r1)) + "), R2 = " +
-                              formatSignificant(o.r2, 3)
-                        : "Algorithm 6.1, forgetting factor " + formatSignificant(o.lambda, 6)) +
-        (o.mu > 0.0 ? ", regularisation mu = " + formatSignificant(o.mu, 3) : "") + "), psi from " +
+                              (o.r1.empty() ? std::string("(6.54)") : list(o.r1)) + ") " +
+                              designRateText(o) + ", R2 = " + formatSignificant(o.r2, 3)
+                        : "Algorithm 6.1, forgetting factor " + formatSignificant(o.lambda, 6) +
+                              " " + designRateText(o)) +
+        (o.mu > 0.0 ? ", regularisation mu = " + formatSignificant(o.mu, 3) : "") +
+        (o.tracking != RecursiveTracking::Fixed ? std::string(", tracking ") + toString(o.tracking) : "") +
+        "), psi from " +
         (o.gradient == RecursiveGradient::Sensitivity ? "the sampled sensitivity system (6.27)"
                                                        : "the differences (6.33)") +
         ". Model " + (q.model.empty() ? q.structure + " (nominal defaults)" : q.model) +
@@ -148,6 +151,8 @@ class RecursivePart : public SessionPart {
     s.paragraphs.push_back(design);
     s.values = {{"label", q.label}, {"algorithm", toString(o.algorithm)}};
     auto fail = [&](const std::string& text) {
+      report.warnings.push_back("recursive identification" + (q.label.empty() ? std::string() : " " + q.label) +
+                                ": could not run: " + text);  // e.g. a log the session lacks
       s.paragraphs.push_back("The recursive identification could not run: " + text + ".");
       s.values["termination"] = "failed";
       s.values["message"] = text;
@@ -258,12 +263,19 @@ json recursiveRequestToJson(const RecursiveRequest& q) {
           {"structure", q.structure},
           {"log", q.log},
           {"decimation", q.data.decimation},
+          {"max_rate_hz", q.data.maxRateHz},
           {"range_s", secondsRangeToJson(q.data.range)},
           {"estimate", o.estimate},
           {"inverted", o.inverted},
           {"algorithm", toString(o.algorithm)},
           {"lambda", o.lambda},
           {"r1", numbers(o.r1)},
+          {"design_sample_time_s", o.designSampleTime},
+          {"tracking", toString(o.tracking)},
+          {"lambda_min", o.lambdaMin},
+          {"bank_spacing_s", o.bankSpacingS},
+          {"bank_size", o.bankSize},
+          {"bank_threshold", o.bankThreshold},
           {"r2", o.r2},
           {"mu", o.mu},
           {"gradient", toString(o.gradient)},
@@ -282,10 +294,22 @@ std::optional<RecursiveRequest> recursiveRequestFromJson(const json& j, std::str
   RecursiveRequest q;
   RecursiveOptions& o = q.options;
   double decimation = 0.0;
-  std::string algorithm = toString(o.algorithm), gradient = toString(o.gradient);
+  // Sessions written before the estimator ran at the log's rate decimated to 200 Hz and gave
+  // lambda and R1 per sample.
+  q.data.maxRateHz = 200.0;
+  o.designSampleTime = 0.0;
+  std::string algorithm = toString(o.algorithm), gradient = toString(o.gradient),
+              tracking = toString(o.tracking);
+  double bankSize = o.bankSize;
   if (!readText(j, "label", q.label, &reason) || !readText(j, "model", q.model, &reason) ||
       !readText(j, "structure", q.structure, &reason) || !readText(j, "log", q.log, &reason) ||
       !readNumber(j, "decimation", decimation, &reason) ||
+      !readNumber(j, "max_rate_hz", q.data.maxRateHz, &reason) ||
+      !readNumber(j, "design_sample_time_s", o.designSampleTime, &reason) ||
+      !readText(j, "tracking", tracking, &reason) || !readNumber(j, "lambda_min", o.lambdaMin, &reason) ||
+      !readNumber(j, "bank_spacing_s", o.bankSpacingS, &reason) ||
+      !readNumber(j, "bank_size", bankSize, &reason) ||
+      !readNumber(j, "bank_threshold", o.bankThreshold, &reason) ||
       !readSecondsRange(j, "range_s", q.data.range, &reason) ||
       !readNames(j, "estimate", o.estimate, &reason) || !readNames(j, "inverted", o.inverted, &reason) ||
       !readText(j, "algorithm", algorithm, &reason) || !readNumber(j, "lambda", o.lambda, &reason) ||
@@ -295,11 +319,17 @@ std::optional<RecursiveRequest> recursiveRequestFromJson(const json& j, std::str
       !readNumber(j, "start_scale", o.startScale, &reason) || !readNumbers(j, "p0", o.p0, &reason))
     return fail(reason);
   if (decimation != std::floor(decimation) || decimation < 0.0 || decimation > 1e6)
-    return fail("decimation must be 0 (to 200 Hz) or a positive whole number");
+    return fail("decimation must be 0 (to the highest rate) or a positive whole number");
   q.data.decimation = static_cast<int>(decimation);
   const auto a = recursiveAlgorithmFromString(algorithm);
   if (!a) return fail("algorithm must be forgetting or kalman, not '" + algorithm + "'");
   o.algorithm = *a;
+  const auto t = recursiveTrackingFromString(tracking);
+  if (!t) return fail("tracking must be fixed, variable or bank, not '" + tracking + "'");
+  o.tracking = *t;
+  if (bankSize != std::floor(bankSize) || bankSize < 1.0 || bankSize > 64.0)
+    return fail("bank_size must be a whole number from 1 to 64");
+  o.bankSize = static_cast<int>(bankSize);
   const auto g = recursiveGradientFromString(gradient);
   if (!g) return fail("gradient must be sensitivity or difference, not '" + gradient + "'");
   o.gradient = *g;

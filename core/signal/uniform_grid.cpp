@@ -109,6 +109,28 @@ UniformGridResult resampleToUniform(const std::vector<const IdData*>& logs, cons
   };
   auto cancelled = [&](double fraction, const char* stage) { return reportProgress(progress, fraction, stage); };
 
+  // The budget, before any work: the new grid over the first log's span, for every channel of
+  // every log, must fit the memory FlexArm gives one resampled log.
+  if (o.rateHz > 0.0) {
+    const IdData& first = *logs.front();
+    const double span = first.isUniform() ? first.duration()
+                                          : first.timeStamps.back() - first.timeStamps.front();
+    std::size_t channels = 0;
+    for (const IdData* l : logs) channels += l->channels.size();
+    const double points = std::floor(span * o.rateHz) + 1.0;
+    const double bytes = points * static_cast<double>(channels) * sizeof(double);
+    if (!(bytes <= kMaxResampledBytes)) {
+      char buf[400];
+      std::snprintf(buf, sizeof buf,
+                    "resampling to %.6g Hz would make %.4g samples a channel over the log's %.6g s, %.3g GB for "
+                    "its %zu channels, more than the %.3g GB FlexArm gives a resampled log; the highest rate "
+                    "that fits is %.4g Hz",
+                    o.rateHz, points, span, bytes / 1e9, channels, kMaxResampledBytes / 1e9,
+                    kMaxResampledBytes / (static_cast<double>(channels) * sizeof(double)) / std::max(span, 1e-300));
+      return finish(Termination::Failed, buf);
+    }
+  }
+
   // 1. Groups of channels sharing their instants, each on its own uniform grid.
   std::vector<Source> sources;
   std::vector<std::vector<std::size_t>> groupChannels;  // channel indices in their log

@@ -19,6 +19,10 @@
 
 namespace flexarm {
 
+// The memory a resampled log may take (its samples, every channel): a rate that would make
+// more is refused before any work.
+inline constexpr double kMaxResampledBytes = 1073741824.0;  // 1 GiB
+
 struct UniformGridOptions {
   double rateHz = 0.0;  // the new sample rate; 0 keeps the first log's own (nominal) rate
   InterpolationMethod method = InterpolationMethod::BandLimited;  // for irregular time stamps

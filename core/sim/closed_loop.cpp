@@ -44,7 +44,7 @@ bool DisturbanceOptions::isValid(std::string* why) const {
 bool SimulationOptions::isValid(std::string* why) const {
   if (!controller.isValid(why) || !disturbance.isValid(why) || !excitation.isValid(why))
     return false;
-  if (!finitePositive(durationS) || durationS > 1e5)
+  if (!finitePositive(durationS) || durationS > kMaxDurationS)
     return failWith(why, "duration must be in (0, 1e5] s");
   if (!finitePositive(logRateHz)) return failWith(why, "log rate must be > 0");
   const double ratio = controller.rateHz / logRateHz;
@@ -298,6 +298,17 @@ std::optional<ControllerOptions> controllerFromMetadata(const IdData& data, std:
                (text.empty() ? " is missing" : " is not a number") +
                " (logs written by flexarm simulate carry controller_rate_hz, controller_kp, "
                "controller_kv and controller_ti)";
+      return std::nullopt;
+    }
+    // Beyond any controller: a 10 MHz loop, gains of 1e12 (the simulation would overflow).
+    const double limit = target == &c.rateHz ? 1e7 : 1e12;
+    if (std::abs(v) > limit) {
+      if (why) {
+        char buf[200];
+        std::snprintf(buf, sizeof buf, "the log's metadata key %s is %.6g, beyond any controller (at most %.0g)", key,
+                      v, limit);
+        *why = buf;
+      }
       return std::nullopt;
     }
     *target = v;

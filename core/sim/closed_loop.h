@@ -55,6 +55,7 @@ struct SimulationOptions {
   ExcitationOptions excitation;
   static constexpr double kMaxSamples = 4e6;   // of the log (33 min at 2 kHz)
   static constexpr double kMaxTicks = 2e7;     // controller periods
+  static constexpr double kMaxDurationS = 1e5;  // seconds of one simulation
   double durationS = 20.0;
   double logRateHz = 2000.0;        // must divide the controller rate
   double referenceVelocity = 0.0;   // rad/s of the motor: phi_ref = v t + excitation

@@ -115,3 +115,34 @@ TEST(CliDiagnose, SimulateWritesTheStep) {
   EXPECT_DOUBLE_EQ(truth["parameter_steps"][0]["value_before"].get<double>(), 0.0355);
   EXPECT_DOUBLE_EQ(truth["parameter_steps"][0]["time_s"].get<double>(), 1.0);
 }
+
+// The model check, the joint test and the temperature in the JSON: a healthy log fits; stated
+// on the command line 15 degC warmer than its reference, with alpha = 1 %/degC theta_0's f_m
+// is carried 15 % up, so the unchanged friction of this log now reads as an f_m fault (the
+// correction is in effect); alpha and the logs' temperatures are checked with sentences.
+TEST(CliDiagnose, ModelCheckJointTestAndTemperatureInTheJson) {
+  const json plain = diagnose("diagnosis_step_none.csv");
+  EXPECT_EQ(plain["verdict"], "none") << plain["summary"];
+  EXPECT_EQ(plain["temperature"]["applied"], false);
+  const json j = diagnose("diagnosis_step_none.csv", {"--friction-alpha", "0.01", "--temperature", "40",
+                                                      "--reference-temperature", "25"});
+  EXPECT_EQ(j["verdict"], "f_m") << j["summary"];
+  EXPECT_EQ(j["model_check"]["fits"], true) << j["model_check"]["message"];
+  EXPECT_EQ(j["model_check"]["checked"], true);
+  EXPECT_LT(j["model_check"]["median_ratio"].get<double>(), 1.5);
+  ASSERT_TRUE(j["tests"].contains("joint"));
+  EXPECT_TRUE(j["tests"]["joint"]["thresholds"].contains("scale"));
+  EXPECT_EQ(j["temperature"]["applied"], true) << j["temperature"]["message"];
+  EXPECT_DOUBLE_EQ(j["temperature"]["monitored_c"].get<double>(), 40.0);
+  EXPECT_DOUBLE_EQ(j["temperature"]["alpha_per_c"].get<double>(), 0.01);
+  EXPECT_GT(j["temperature"]["f_m_expected"].get<double>(), j["temperature"]["f_m_reference"].get<double>());
+  EXPECT_EQ(j["tests_verdict"], "f_m");
+  auto r = runFlexarm({"diagnose", sample("diagnosis_step_none.csv"), "--reference-log",
+                       sample("diagnosis_no_fault.csv"), "--friction-alpha", "0.5"});
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("friction"), std::string::npos) << r.err;
+  r = runFlexarm({"diagnose", sample("diagnosis_step_none.csv"), "--reference-log",
+                  sample("diagnosis_no_fault.csv"), "--temperature-logs", sample("diagnosis_step_none.csv")});
+  EXPECT_EQ(r.code, 3);
+  EXPECT_NE(r.err.find("temperature"), std::string::npos) << r.err;
+}

@@ -11,7 +11,6 @@
 
 #include "cli_test_support.h"
 
-using flexarm::test::kUnderAddressSanitizer;
 using flexarm::test::MeasuredRun;
 using flexarm::test::runFlexarmMeasured;
 namespace fs = std::filesystem;
@@ -25,18 +24,12 @@ std::string hostile(const std::string& name) {
   return std::string(FLEXARM_TEST_DATA_DIR) + "/hostile/" + name;
 }
 
-// Peak memory allowed for a run that should stay near the given size in a Release build;
-// the sanitizers add their shadow memory and quarantine.
-long ceilingMb(long mb) { return kUnderAddressSanitizer ? 3 * mb + 400 : mb; }
+using flexarm::test::ceilingMb;
 
-// A large hostile file, made by scripts/make_hostile_data.py in this test's scratch folder.
 std::string bigFile(const std::string& name, const std::string& extension) {
-  const fs::path d = flexarm::test::scratchDir() / "hostile_big";
-  fs::create_directories(d);
-  const std::string cmd = "python3 '" + std::string(FLEXARM_SOURCE_DIR) +
-                          "/scripts/make_hostile_data.py' --big '" + d.string() + "' " + name;
-  if (std::system(cmd.c_str()) != 0) ADD_FAILURE() << "could not run " << cmd;
-  return (d / (name + extension)).string();
+  std::string file = flexarm::test::bigHostileFile(name, extension);
+  if (file.empty()) ADD_FAILURE() << "scripts/make_hostile_data.py --big could not make " << name;
+  return file;
 }
 
 void expectRefused(const MeasuredRun& r, int code, const std::string& needle, long memoryMb) {

@@ -267,7 +267,8 @@ TEST(CliIdent, BadRequestsExitWithUsageBadInputOrNumericalCodes) {
   EXPECT_EQ(r.code, 3);
   EXPECT_NE(r.err.find("needs a reference channel"), std::string::npos) << r.err;
 
-  // 4: numerical failure. A log whose input is constant zero carries no information.
+  // 3 again: a log whose input is constant zero carries no information, and is refused as
+  // bad input naming the channel before any estimator runs (core/signal/excitation.h).
   const std::string flat = (scratchDir() / "flat.dat").string();
   {
     std::ofstream f(flat);
@@ -275,8 +276,9 @@ TEST(CliIdent, BadRequestsExitWithUsageBadInputOrNumericalCodes) {
   }
   r = runFlexarm({"fit", flat, "--input-column", "1", "--output-column", "2", "--model",
                   "oe:2,2,1"});
-  EXPECT_EQ(r.code, 4) << r.out << r.err;
-  EXPECT_NE(r.err.find("fit failed"), std::string::npos) << r.err;
+  EXPECT_EQ(r.code, 3) << r.out << r.err;
+  EXPECT_NE(r.err.find("flat.dat: the channel u carries no signal: it is constant (every sample is 0)"),
+            std::string::npos) << r.err;
 }
 
 // The indirect method closes the log's controller (from its metadata) around the model and

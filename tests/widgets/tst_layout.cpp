@@ -58,7 +58,7 @@ namespace {
 const QString kSampleLog = QString(FLEXARM_SAMPLE_DIR) + "/three_mass_estimation_chirp.csv";
 const char* const kDocks[] = {"preprocessDock", "armDock",       "modelDock",     "fitDock",
                               "bodeDock",       "compareDock",   "residualsDock", "lqgDock",
-                              "discoveryDock",  "diagnosisDock", "recursiveDock"};
+                              "discoveryDock",  "diagnosisDock", "recursiveDock", "fleetDock"};
 
 QString describe(const QWidget* w) {
   return QString("%1 %2").arg(w->metaObject()->className(), w->objectName());

@@ -10,6 +10,8 @@
 #include <QTimer>
 #include <cmath>
 
+#include "widgets/file_output.h"
+
 namespace flexarm {
 namespace {
 constexpr std::size_t kMaxFrames = 100000;
@@ -71,8 +73,9 @@ void FrameExporter::writeNext() {
   }
   const QImage image = render_(times_[next_]);
   const QString path = QString("%1/frame_%2.png").arg(folder_).arg(next_, 5, 10, QChar('0'));
-  if (image.isNull() || !image.save(path)) {
-    finish(false, tr("Cannot write %1.").arg(path));
+  QString problem;
+  if (!saveImageFile(image, path, "PNG", &problem)) {
+    finish(false, tr("Cannot write %1: %2").arg(path, problem));
     return;
   }
   ++next_;
@@ -82,12 +85,14 @@ void FrameExporter::writeNext() {
     return;
   }
   const QString command = ffmpegCommand(folder_, fps_);
-  QFile file(folder_ + "/ffmpeg.txt");
-  if (file.open(QIODevice::WriteOnly | QIODevice::Text)) {
-    QTextStream out(&file);
+  {
+    QString text;
+    QTextStream out(&text);
     out << "# " << times_.size() << " frames at " << fps_ << " frames a second, log time "
         << times_.front() << " - " << times_.back() << " s. Join them into arm.mp4 with:\n"
         << command << "\n";
+    out.flush();
+    writeFileBytes(folder_ + "/ffmpeg.txt", text.toUtf8());
   }
   QString message = tr("Wrote %1 frames to %2. Make a video with: %3")
                         .arg(times_.size())

@@ -2,16 +2,20 @@
 
 #include <QAction>
 #include <QApplication>
+#include <QBuffer>
 #include <QClipboard>
 #include <QFile>
 #include <QFileDialog>
 #include <QFileInfo>
 #include <QMenu>
 #include <QMessageBox>
+#include <QPdfWriter>
 #include <QSvgGenerator>
 #include <QTextStream>
 #include <cmath>
 #include <qcustomplot.h>
+
+#include "widgets/file_output.h"
 
 namespace flexarm {
 namespace {
@@ -134,33 +138,48 @@ QString PlotTools::dataAsCsv() const {
 bool PlotTools::exportTo(const QString& path, QString* why) const {
   const QString ext = QFileInfo(path).suffix().toLower();
   const int w = std::max(plot_->width(), 800), h = std::max(plot_->height(), 600);
+  // Drawn or encoded in memory, then written as every file is (widgets/file_output.h).
+  QByteArray bytes;
+  QBuffer buffer(&bytes);
+  buffer.open(QIODevice::WriteOnly);
+  auto draw = [&](QPaintDevice* device) {
+    QCPPainter painter;
+    if (!painter.begin(device)) return false;
+    painter.setMode(QCPPainter::pmVectorized);
+    painter.setMode(QCPPainter::pmNoCaching);
+    plot_->toPainter(&painter, w, h);
+    return painter.end();
+  };
   bool ok = false;
   if (ext == "png") {
-    ok = plot_->savePng(path, w, h);
+    ok = plot_->toPixmap(w, h).toImage().save(&buffer, "PNG");
   } else if (ext == "pdf") {
-    ok = plot_->savePdf(path, w, h);
+    QPdfWriter pdf(&buffer);
+    pdf.setCreator("FlexArm plot");
+    pdf.setResolution(72);
+    pdf.setPageLayout(QPageLayout(QPageSize(QSize(w, h), QString(), QPageSize::ExactMatch),
+                                  QPageLayout::Portrait, QMarginsF(0, 0, 0, 0)));
+    ok = draw(&pdf);
   } else if (ext == "svg") {
     QSvgGenerator svg;
-    svg.setFileName(path);
+    svg.setOutputDevice(&buffer);
     svg.setSize(QSize(w, h));
     svg.setViewBox(QRect(0, 0, w, h));
     svg.setTitle("FlexArm plot");
-    QCPPainter painter;
-    ok = painter.begin(&svg);
-    if (ok) {
-      plot_->toPainter(&painter, w, h);
-      painter.end();
-    }
+    ok = draw(&svg);
   } else if (ext == "csv") {
-    QFile f(path);
-    ok = f.open(QIODevice::WriteOnly | QIODevice::Truncate | QIODevice::Text);
-    if (ok) ok = f.write(dataAsCsv().toUtf8()) >= 0;
+    bytes = dataAsCsv().toUtf8();
+    ok = true;
   } else {
     if (why) *why = tr("unknown format '%1': use .png, .svg, .pdf or .csv").arg(ext);
     return false;
   }
-  if (!ok && why) *why = tr("could not write %1").arg(path);
-  return ok;
+  buffer.close();
+  if (!ok) {
+    if (why) *why = tr("could not draw the plot for %1").arg(path);
+    return false;
+  }
+  return writeFileBytes(path, bytes, why);
 }
 
 void PlotTools::exportDialog() {

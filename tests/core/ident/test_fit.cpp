@@ -186,10 +186,13 @@ TEST(Fit, DataFailuresAreSentencesAndMisuseThrows) {
   const auto log = twoMassLog(2.0, 27);
   auto flat = std::make_shared<IdData>(*log);
   std::fill(flat->channel(columns::kTorqueRef)->values.begin(), flat->channel(columns::kTorqueRef)->values.end(), 0.3);
+  // Dead data are refused by the data preparation, as bad data naming the channel.
   FitResult r = fitModel(physicalFit(flat));
   EXPECT_EQ(r.termination, Termination::Failed);
-  EXPECT_FALSE(r.badData);
-  EXPECT_NE(r.message.find("the input is constant"), std::string::npos) << r.message;
+  EXPECT_TRUE(r.badData);
+  EXPECT_NE(r.message.find("the channel torque_ref_nm carries no signal: it is constant (every sample is 0.3)"),
+            std::string::npos)
+      << r.message;
   r = fitModel(physicalFit(log, SecondsRange{5.0, 9.0}));
   EXPECT_EQ(r.termination, Termination::Failed);
   EXPECT_TRUE(r.badData);

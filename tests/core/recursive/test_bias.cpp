@@ -44,11 +44,16 @@ TEST(RecursiveBias, KtAndJaWithinHalfAPercentOnALongLowNoiseClosedLoopLog) {
     o.algorithm = algorithm;
     o.startScale = 1.2;
     // The seed's design variables are per sample at 200 Hz: at ten times the rate the same
-    // memory (1 s) and the same random walk per second need lambda^(1/10) and R1 / 10.
-    o.lambda = std::pow(0.995, 0.1);
-    o.r1 = {5e-9, 5e-8, 5e-7};
+    // memory (1 s) and the same random walk per second are lambda^(1/10) and R1 / 10.
     const RecursiveResult r = recursiveIdentification(*truth, u, y, d.sampleTime, o);
     ASSERT_EQ(r.termination, Termination::Converged) << r.message;
+    if (algorithm == RecursiveAlgorithm::Kalman) {
+      ASSERT_EQ(r.asRun.r1.size(), 3u);
+      EXPECT_NEAR(r.asRun.r1[0], 5e-9, 1e-20);
+      EXPECT_NEAR(r.asRun.r1[2], 5e-7, 1e-18);
+    } else {
+      EXPECT_NEAR(r.asRun.lambda, std::pow(0.995, 0.1), 1e-15);
+    }
     const double kT = secondHalfMean(r.trajectory.theta[0]);
     const double Ja = 1.0 / secondHalfMean(r.trajectory.theta[1]);
     EXPECT_NEAR(kT / 1.0, 1.0, 0.005) << toString(algorithm);

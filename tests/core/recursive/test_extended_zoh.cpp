@@ -100,5 +100,23 @@ TEST(ExtendedZoh, WithoutParametersItIsTheZeroOrderHoldOfTheModel) {
   EXPECT_LT(relativeError(x, expected), 1e-11);
 }
 
+TEST(ExtendedZoh, ASampleFarLongerThanTheModelsTimeScaleIsRefusedNotIntegrated) {
+  // A log with a time step of 1e6 s: at 4 sub-steps a unit of the weighted norm of h A, one
+  // sample needed billions of sub-steps (and overflowed their int count).
+  const auto m = testing::threeMassP6();
+  const StateSpace ss = m->stateSpace();
+  Eigen::VectorXd x = Eigen::VectorXd::Zero(5);
+  Eigen::MatrixXd none(5, 0);
+  ExtendedZoh zoh;
+  zoh.advance(ss.A, ss.B.col(0), {}, {}, 1e6, 1.0, x, none);
+  EXPECT_GT(zoh.tooLongSubsteps(), ExtendedZoh::kMaxSubsteps);
+  EXPECT_FALSE(x.allFinite());
+  // The log's own rate stays well inside the budget.
+  x.setZero();
+  zoh.advance(ss.A, ss.B.col(0), {}, {}, 0.005, 1.0, x, none);
+  EXPECT_EQ(zoh.tooLongSubsteps(), 0.0);
+  EXPECT_TRUE(x.allFinite());
+}
+
 }  // namespace
 }  // namespace flexarm

@@ -1,7 +1,8 @@
 // The seed's recursive-identification experiments (Section 6.6) on the chapter-6/7 sample logs,
 // which FlexArm's simulator made from the three-mass truth (Table 5.7 p6) in the closed loop of
 // Figure 5.1 with the multisine (6.50): prepared as the command line does (motor velocity from
-// the angle, decimated to 200 Hz) and estimated from 20 % above the truth.
+// the angle; the seed's figures decimated to its 200 Hz, the default at the log's 2 kHz) and
+// estimated from 20 % above the truth.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -59,17 +60,15 @@ struct LogRun {
   }
 };
 
-LogRun run(RecursiveAlgorithm algorithm, int decimation = 0, const std::string& log = "diagnosis_no_fault",
-        double start = 1.2) {
-  RecursiveOptions o;  // the seed's: k_T, J_a^-1, f_m; lambda 0.995; R1 (6.54); mu = 0
+// The seed's experiment at its 200 Hz: decimation 10 of the 2 kHz logs.
+constexpr int kSeedRate = 10;
+
+LogRun run(RecursiveAlgorithm algorithm, int decimation = kSeedRate,
+           const std::string& log = "diagnosis_no_fault", double start = 1.2) {
+  // The seed's: k_T, J_a^-1, f_m; lambda 0.995 and R1 (6.54) per 200 Hz sample; mu = 0.
+  RecursiveOptions o;
   o.algorithm = algorithm;
   o.startScale = start;
-  if (decimation == 1) {
-    // At the log's 2 kHz the seed's per-sample design variables mean ten times the memory in
-    // samples: the same 1 s memory and random walk per second.
-    o.lambda = std::pow(0.995, 0.1);
-    o.r1 = {5e-9, 5e-8, 5e-7};
-  }
   RecursiveDataOptions d;
   d.decimation = decimation;
   LogRun out{recursiveIdentification(sampleLog(log), *testing::threeMassP6(), d, o)};
@@ -79,12 +78,19 @@ LogRun run(RecursiveAlgorithm algorithm, int decimation = 0, const std::string& 
 
 constexpr std::size_t kT = 0, Jinv = 1, fm = 2;
 
-TEST(RecursiveSampleLogs, TheDefaultPreparationRunsTheSeedsRateOnTheTwoKilohertzLog) {
-  const LogRun f = run(RecursiveAlgorithm::ForgettingFactor);
-  EXPECT_EQ(f.log.decimation, 10);
-  EXPECT_DOUBLE_EQ(f.log.sampleTime, 0.005);
-  EXPECT_EQ(f.r().samples, 4800u);  // 24 s at 200 Hz
+TEST(RecursiveSampleLogs, TheDefaultRunsAtTheTwoKilohertzLogsOwnRate) {
+  const LogRun f = run(RecursiveAlgorithm::ForgettingFactor, 0);
+  EXPECT_EQ(f.log.decimation, 1);
+  EXPECT_DOUBLE_EQ(f.log.sampleTime, 0.0005);
+  EXPECT_EQ(f.r().samples, 48000u);  // 24 s at 2 kHz
   EXPECT_NE(f.log.preparation.find("motor velocity from the angle"), std::string::npos);
+  // The seed's lambda per 200 Hz sample keeps its one-second memory: 0.995^(1/10).
+  EXPECT_NEAR(f.r().asRun.lambda, std::pow(0.995, 0.1), 1e-15);
+  const LogRun seed = run(RecursiveAlgorithm::ForgettingFactor);
+  EXPECT_EQ(seed.log.decimation, 10);
+  EXPECT_DOUBLE_EQ(seed.r().asRun.lambda, 0.995);
+  // Decimated, the torque is held as its mean over each new period.
+  EXPECT_NE(seed.log.preparation.find("mean"), std::string::npos) << seed.log.preparation;
 }
 
 // Figure 6.4 with (6.49): the variance of psi is highest for f_m, less for J_a^-1 and lowest
@@ -98,11 +104,11 @@ TEST(RecursiveSampleLogs, Figure64PsiVarianceOrdering) {
 
 // Figures 6.5 and 6.6: with the forgetting factor all three estimates converge from +20 %, k_T
 // fastest; P's diagonal elements differ by orders of magnitude. At 200 Hz the zero-order hold
-// of the decimated torque (the controller changes it ten times per sample) lowers k_T by about
-// 6 %; J_a^-1 and f_m stay within a few percent.
+// of the torque held as its mean over each period (the controller changes it ten times per
+// sample) still lowers k_T by about 2 %; J_a^-1 and f_m stay within a few percent.
 TEST(RecursiveSampleLogs, Figures65And66ForgettingFactor) {
   const LogRun f = run(RecursiveAlgorithm::ForgettingFactor);
-  EXPECT_NEAR(f.mean(kT) / f.truth(kT), 1.0, 0.08);
+  EXPECT_NEAR(f.mean(kT) / f.truth(kT), 1.0, 0.04);
   EXPECT_NEAR(f.mean(Jinv) / f.truth(Jinv), 1.0, 0.03);
   EXPECT_NEAR(f.mean(fm) / f.truth(fm), 1.0, 0.12);
   EXPECT_LT(f.convergenceTime(kT), f.convergenceTime(Jinv));
@@ -112,24 +118,26 @@ TEST(RecursiveSampleLogs, Figures65And66ForgettingFactor) {
 }
 
 // Figures 6.7 and 6.8: with the Kalman gain and R1 of (6.54) P's diagonal elements have one
-// magnitude; k_T converges more slowly than with the forgetting factor and has the lowest
-// variance of the three, f_m the highest (higher than with the forgetting factor).
+// magnitude; k_T converges more slowly and with a lower variance than with the forgetting
+// factor, f_m's variance is the highest of the three (higher than with the forgetting factor).
 TEST(RecursiveSampleLogs, Figures67And68KalmanGain) {
   const LogRun f = run(RecursiveAlgorithm::ForgettingFactor);
   const LogRun k = run(RecursiveAlgorithm::Kalman);
   const double p[3] = {k.meanP(kT), k.meanP(Jinv), k.meanP(fm)};
   EXPECT_LT(*std::max_element(p, p + 3) / *std::min_element(p, p + 3), 10.0);
   EXPECT_GT(k.convergenceTime(kT), 2.0 * f.convergenceTime(kT));
-  EXPECT_LT(k.relativeStd(kT), k.relativeStd(Jinv));
+  EXPECT_LT(k.relativeStd(kT), f.relativeStd(kT));
+  EXPECT_LT(k.relativeStd(Jinv), k.relativeStd(fm));
   EXPECT_LT(k.relativeStd(kT), k.relativeStd(fm));
   EXPECT_GT(k.relativeStd(fm), 2.0 * f.relativeStd(fm));
   EXPECT_NEAR(k.mean(Jinv) / k.truth(Jinv), 1.0, 0.05);
 }
 
-// At the log's own rate the zero-order hold of the torque is exact: the estimates settle on
-// the truth (f_m, which the load noise fed back in closed loop pushes up most, within 10 %).
+// At the log's own rate, the default, the zero-order hold of the torque is exact: the estimates
+// settle on the truth (f_m, which the load noise fed back in closed loop pushes up most, within
+// 10 %).
 TEST(RecursiveSampleLogs, AtTheControllersRateTheyConvergeToTheTruth) {
-  const LogRun f = run(RecursiveAlgorithm::ForgettingFactor, 1);
+  const LogRun f = run(RecursiveAlgorithm::ForgettingFactor, 0);
   EXPECT_NEAR(f.mean(kT) / f.truth(kT), 1.0, 0.01);
   EXPECT_NEAR(f.mean(Jinv) / f.truth(Jinv), 1.0, 0.01);
   EXPECT_NEAR(f.mean(fm) / f.truth(fm), 1.0, 0.10);
