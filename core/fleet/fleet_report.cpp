@@ -60,7 +60,6 @@ ReportPlot fleetTrendPlot(const FleetAxisReport& a, const ParameterSeries& s, do
     }
   const double span = std::max(top - bottom, 1.0);
   p.yRange = std::make_pair(bottom - 0.9 * span, top + 0.05 * span);
-  p.legendBottomLeft = true;
   return p;
 }
 
