@@ -28,6 +28,7 @@
 #include <vector>
 
 #include <nlohmann/json.hpp>
+#include <sys/resource.h>
 
 namespace flexarm::bench {
 
@@ -56,6 +57,15 @@ inline double now(bool cpu) {
     return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
   }
   return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+
+// CPU seconds (user + system) of the child processes waited for so far: a whole process's
+// work, measured apart from how much of the machine it was given.
+inline double childCpuSeconds() {
+  rusage u{};
+  getrusage(RUSAGE_CHILDREN, &u);
+  return static_cast<double>(u.ru_utime.tv_sec + u.ru_stime.tv_sec) +
+         1e-6 * static_cast<double>(u.ru_utime.tv_usec + u.ru_stime.tv_usec);
 }
 
 // Median time of `repeats` calls of work(i), i = 0..repeats-1 (parallel: wall clock always).

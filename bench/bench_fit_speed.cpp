@@ -33,13 +33,6 @@ namespace {
 const char* kFree[] = {"J_m", "J_a", "f_m", "k_a", "d_a"};
 const double kFactors[] = {1.15, 1.3, 0.8, 0.85, 1.2};
 
-double childCpuSeconds() {
-  rusage u{};
-  getrusage(RUSAGE_CHILDREN, &u);
-  return static_cast<double>(u.ru_utime.tv_sec + u.ru_stime.tv_sec) +
-         1e-6 * static_cast<double>(u.ru_utime.tv_usec + u.ru_stime.tv_usec);
-}
-
 // Runs a whole process with its output to outPath: the median of its wall-clock seconds, or
 // of its CPU seconds (user + system) with FLEXARM_BENCH_CLOCK=cpu.
 double timeProcess(const std::string& command, const std::string& outPath, int runs) {

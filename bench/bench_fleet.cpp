@@ -26,13 +26,6 @@ using namespace flexarm::bench;
 
 namespace {
 
-double childCpuSeconds() {
-  rusage u{};
-  getrusage(RUSAGE_CHILDREN, &u);
-  return static_cast<double>(u.ru_utime.tv_sec + u.ru_stime.tv_sec) +
-         1e-6 * static_cast<double>(u.ru_utime.tv_usec + u.ru_stime.tv_usec);
-}
-
 double wallNow() { return now(false); }
 
 // The manifest's entries of robots R01..Rk, with absolute paths.

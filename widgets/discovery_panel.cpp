@@ -13,6 +13,7 @@
 #include <QtConcurrent>
 #include <algorithm>
 #include <cmath>
+#include <vector>
 #include <qcustomplot.h>
 
 #include "core/signal/preprocess.h"
@@ -547,11 +548,19 @@ void DiscoveryPanel::showStep() {
   where_->setText(QString::fromStdString(round ? round->disagreement.summary : r.disagreement.summary));
 
   table_->setRowCount(static_cast<int>(candidates.size()));
-  for (std::size_t i = 0; i < candidates.size(); ++i) {
+  // The named effect's row first, where the table opens; the others in the candidates' order.
+  std::vector<std::size_t> order;
+  if (best >= 0 && best < static_cast<int>(candidates.size())) order.push_back(static_cast<std::size_t>(best));
+  for (std::size_t i = 0; i < candidates.size(); ++i)
+    if (static_cast<int>(i) != best) order.push_back(i);
+  for (std::size_t row0 = 0; row0 < order.size(); ++row0) {
+    const std::size_t i = order[row0];
     const CandidateFit& c = candidates[i];
-    const int row = static_cast<int>(i);
-    QString why = QString::fromStdString(c.reason);
-    if (c.confirmation.ran) why += " — " + QString::fromStdString(c.confirmation.text);
+    const int row = static_cast<int>(row0);
+    // The confirmation's numbers are in the evidence above and in the tooltip: in the cell
+    // they made the named effect's row taller than the table.
+    const QString why = QString::fromStdString(c.reason);
+    const QString whyWhole = c.confirmation.ran ? why + " — " + QString::fromStdString(c.confirmation.text) : why;
     const QStringList cells = {
         toString(c.kind),
         num(c.lossEst, 4),
@@ -564,8 +573,8 @@ void DiscoveryPanel::showStep() {
         why};
     for (int col = 0; col < cells.size(); ++col) {
       auto* item = new QTableWidgetItem(cells[col]);
-      item->setToolTip(cells[col]);  // the whole text, also when the column wraps it
-      if (row == best) {
+      item->setToolTip(col == cells.size() - 1 ? whyWhole : cells[col]);  // the whole text
+      if (static_cast<int>(i) == best) {
         QFont f = item->font();
         f.setBold(true);
         item->setFont(f);
@@ -582,7 +591,7 @@ void DiscoveryPanel::showStep() {
   for (int col = 0; col < whyCol; ++col) others += table_->columnWidth(col);
   table_->setColumnWidth(whyCol, std::max(220, table_->viewport()->width() - others));
   table_->resizeRowsToContents();
-  if (best >= 0 && best < table_->rowCount()) table_->scrollToItem(table_->item(best, 0));
+  table_->scrollToTop();
 
   // The step's residual before it in time and frequency, the model's resonances marked (a
   // stored summary has no traces).

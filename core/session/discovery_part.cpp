@@ -634,6 +634,9 @@ std::optional<DiscoveryResult> discoveryResultFromJson(const json& j, std::strin
     if (why) *why = where + "best must index a candidate (or be -1)";
     return std::nullopt;
   }
+  // The named candidate's confirmation is the first effect's, stored with it.
+  if (r.best >= 0 && !r.found.empty() && r.found.front().kind == r.candidates[static_cast<std::size_t>(r.best)].kind)
+    r.candidates[static_cast<std::size_t>(r.best)].confirmation = r.found.front().confirmation;
   return r;
 }
 

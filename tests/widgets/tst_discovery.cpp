@@ -134,6 +134,21 @@ class DiscoveryPanelTest : public QObject {
     const QSize size = panel_->size();
     panel_->resize(1366, 768);
     QTest::qWait(100);
+    panel_->selectStep(0);  // the table laid out at this size
+    QTest::qWait(50);
+    // The named effect's row comes first and fits in the table: its cell gives the reason,
+    // the confirmation's numbers are in its tooltip (and in the evidence above).
+    QTableWidget* t = panel_->candidatesTable();
+    bool seen = false;
+    for (int row = 0; row < t->rowCount(); ++row) {
+      if (t->item(row, 0)->text() != "torque_ripple") continue;
+      seen = true;
+      QCOMPARE(row, 0);
+      QVERIFY2(t->rowHeight(row) < t->viewport()->height(),
+               qPrintable(QString("row %1 px, table %2 px").arg(t->rowHeight(row)).arg(t->viewport()->height())));
+      QVERIFY2(t->item(row, 6)->toolTip().contains("onfirmed on"), qPrintable(t->item(row, 6)->toolTip()));
+    }
+    QVERIFY(seen);
     flexarm::test::saveShot(panel_->grab().toImage(), "discovery_panel_ladder");
     panel_->resize(size);
   }

@@ -12,6 +12,7 @@
 
 #include "core/discovery/discovery.h"
 #include "tests/core/discovery/discovery_logs.h"
+#include "tests/test_scale.h"
 
 namespace flexarm {
 namespace {
@@ -119,6 +120,8 @@ const std::vector<Effect>& pairEffects() {
 class DiscoveryPair : public ::testing::TestWithParam<int> {};
 
 TEST_P(DiscoveryPair, NamesBothEffects) {
+  // Under the sanitizers (tests/test_scale.h) one pair of the ten.
+  if (test::reducedSizes() && GetParam() != 1) GTEST_SKIP() << "one pair under the sanitizers";
   int i = GetParam(), a = 0;
   while (i >= 4 - a) i -= 4 - a++;
   const int b = a + 1 + i;
@@ -147,6 +150,7 @@ INSTANTIATE_TEST_SUITE_P(EveryPair, DiscoveryPair, ::testing::Range(0, 10));
 class DiscoverySmall : public ::testing::TestWithParam<int> {};
 
 TEST_P(DiscoverySmall, FindsTheSmallEffectAlone) {
+  if (test::reducedSizes() && GetParam() != 4) GTEST_SKIP() << "one small effect under the sanitizers";
   const std::vector<Effect> small = {
       test::effectOf(EffectKind::CoulombFriction, 0.1), test::effectOf(EffectKind::Backlash, 1e-4),
       test::effectOf(EffectKind::NonlinearSpring, 0.4e6), test::effectOf(EffectKind::InputDelay, 1e-3),
@@ -172,6 +176,7 @@ TEST(DiscoveryLoop, FindsTheMissingMassAndTheFriction) {
 // Logs without an effect: nothing is named.
 TEST(DiscoveryLoop, CleanLogsNameNothing) {
   for (int seed : {5, 8}) {
+    if (test::reducedSizes() && seed != 5) continue;
     const LoopOutcome o = runLoop({{}, seed}, 1);
     print(o);
     EXPECT_TRUE(o.r.found.empty()) << "seed " << seed << ": " << names(foundKinds(o.r));

@@ -133,6 +133,9 @@ TEST(DiscoveryPart, RequestAndResultSurviveTheirJson) {
   EXPECT_EQ(rb->candidates[0].parameters[0].std, 1e-5);
   ASSERT_EQ(rb->found.size(), 1u);
   EXPECT_TRUE(rb->found[0].confirmation.confirmed);
+  // The named candidate says "yes, confirmed" again in the reopened panel.
+  EXPECT_TRUE(rb->candidates[0].confirmation.ran && rb->candidates[0].confirmation.confirmed);
+  EXPECT_EQ(rb->candidates[0].confirmation.text, f.confirmation.text);
   EXPECT_EQ(rb->found[0].after.rmsValidation, 0.1);
   EXPECT_EQ(rb->stopReason, r.stopReason);
 }
