@@ -142,7 +142,8 @@ DiscoveryPanel::DiscoveryPanel(Workspace* workspace, QWidget* parent)
   addCurve(overlay_, tr("base"), QColor(200, 40, 40));
   addCurve(overlay_, tr("augmented"), QColor(30, 90, 200));
   // The ladder: held-out residual RMS (bars, left) and fit % (line, right) per step.
-  ladder_->xAxis->setLabel(tr("step"));
+  ladder_->setObjectName("ladderPlot");
+  // The steps are named by their tick labels (base, + effect ...): the axis needs no title.
   ladder_->yAxis->setLabel(tr("RMS (rad/s)"));
   ladder_->yAxis2->setVisible(true);
   ladder_->yAxis2->setLabel(tr("fit (5.2) %"));
@@ -164,6 +165,7 @@ DiscoveryPanel::DiscoveryPanel(Workspace* workspace, QWidget* parent)
     ladder_->legend->setFont(QFont(ladder_->font().family(), 8));
     placeLegendAbove(ladder_);
     ladder_->setInteractions(QCP::iSelectPlottables);
+    PlotTools::install(ladder_);
     connect(ladder_, &QCustomPlot::plottableClick, this,
             [this](QCPAbstractPlottable*, int index, QMouseEvent*) { selectStep(index); });
   }
@@ -189,7 +191,8 @@ DiscoveryPanel::DiscoveryPanel(Workspace* workspace, QWidget* parent)
   rung->addWidget(table_);
   rung->setStretchFactor(0, 2);
   rung->setStretchFactor(1, 3);
-  for (QCustomPlot* p : {residualTime_, residualSpectrum_, overlay_}) p->setMinimumHeight(130);
+  // Tall enough that an axis title as long as "motor velocity (rad/s)" fits beside its axis.
+  for (QCustomPlot* p : {residualTime_, residualSpectrum_, overlay_}) p->setMinimumHeight(165);
   auto* plots = new QSplitter(Qt::Vertical, this);
   plots->addWidget(rung);
   plots->addWidget(residualTime_);

@@ -869,9 +869,11 @@ class Walker {
     if (o.type.cls != 7 || o.type.size != width) refuse(path + " holds references inside another type, which FlexArm does not follow");
     const std::uint64_t bytes = saturatingProduct(o.elements, width);
     if (bytes > kMaxReferenceBytes) refuse(path + " holds more references than FlexArm follows");
+    if (bytes == 0) return;  // no elements, no references
     std::vector<Byte> data(static_cast<std::size_t>(bytes), 0);
     const Layout& l = o.layout;
     if (l.cls == 0) {
+      if (l.size < bytes) refuse(path + " claims " + human(bytes) + " of references but holds " + human(l.size));
       std::memcpy(data.data(), l.compact, static_cast<std::size_t>(bytes));
     } else if (l.cls == 1) {
       if (l.address != kUndefined) std::memcpy(data.data(), atAddress(l.address, bytes, path), static_cast<std::size_t>(bytes));

@@ -111,7 +111,7 @@ std::string sampleTimeProblem(const RecursiveOptions& options, double sampleTime
   const std::string at = "The sample time of " + formatNumber(sampleTime) + " s";
   if (options.algorithm == RecursiveAlgorithm::ForgettingFactor && options.lambda < 1.0) {
     const double memory = options.designSampleTime / (1.0 - options.lambda);  // s, of (6.13)
-    if (sampleTime > memory)
+    if (sampleTime > memory * (1.0 + 1e-9))  // 1 - lambda is not exact in binary
       return at + " is longer than the recursive estimator's memory of " + formatNumber(memory) +
              " s (lambda " + formatNumber(options.lambda) + " " + designRateText(options) +
              "): each sample would forget every sample before it; the log needs a sample at least every " +

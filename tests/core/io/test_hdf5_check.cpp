@@ -7,6 +7,7 @@
 #include <fstream>
 #include <iterator>
 #include <string>
+#include <utility>
 
 #include "core/io/hdf5_check.h"
 
@@ -96,4 +97,22 @@ TEST(Hdf5Check, DamagedBytesEndInASentenceOrAFileThatStaysInside) {
     }
   }
   EXPECT_GT(refused, 100);  // the walk reads what it checks
+}
+
+TEST(Hdf5Check, FuzzFoundFilesAreRefusedWithTheirReason) {
+  // fuzz_mat73's findings: a file whose references were copied from a null pointer, and one
+  // HDF5 looped on. Each is refused by the walk, naming what is wrong.
+  const std::pair<const char*, const char*> cases[] = {
+      {"mat73_empty_compact_references.mat", "/torque_ref_nm points outside the file"},
+      {"mat73_timeout.mat", "reaches past its end or does not advance"},
+  };
+  for (const auto& [file, message] : cases) {
+    SCOPED_TRACE(file);
+    std::ifstream in(std::string(FLEXARM_TEST_DATA_DIR) + "/fuzz/" + file, std::ios::binary);
+    const std::string bytes{std::istreambuf_iterator<char>(in), {}};
+    ASSERT_GT(bytes.size(), 1000u);
+    const Hdf5Check c = walk(bytes);
+    EXPECT_FALSE(c.ok);
+    EXPECT_NE(c.problem.find(message), std::string::npos) << c.problem;
+  }
 }
