@@ -137,7 +137,8 @@ DiscoveryPanel::DiscoveryPanel(Workspace* workspace, QWidget* parent)
   residualSpectrum_->yAxis->setTicker(QSharedPointer<QCPAxisTickerLog>(new QCPAxisTickerLog));
   addCurve(residualSpectrum_, tr("base"), QColor(200, 40, 40));
   addCurve(residualSpectrum_, tr("augmented"), QColor(30, 90, 200));
-  setupPlot(overlay_, tr("time (s)"), tr("motor velocity (rad/s)"));
+  // The motor's velocity; the title short enough to fit beside the axis of a short plot.
+  setupPlot(overlay_, tr("time (s)"), tr("velocity (rad/s)"));
   addCurve(overlay_, tr("measured"), Qt::black);
   addCurve(overlay_, tr("base"), QColor(200, 40, 40));
   addCurve(overlay_, tr("augmented"), QColor(30, 90, 200));
@@ -191,8 +192,7 @@ DiscoveryPanel::DiscoveryPanel(Workspace* workspace, QWidget* parent)
   rung->addWidget(table_);
   rung->setStretchFactor(0, 2);
   rung->setStretchFactor(1, 3);
-  // Tall enough that an axis title as long as "motor velocity (rad/s)" fits beside its axis.
-  for (QCustomPlot* p : {residualTime_, residualSpectrum_, overlay_}) p->setMinimumHeight(165);
+  for (QCustomPlot* p : {residualTime_, residualSpectrum_, overlay_}) p->setMinimumHeight(136);
   auto* plots = new QSplitter(Qt::Vertical, this);
   plots->addWidget(rung);
   plots->addWidget(residualTime_);
