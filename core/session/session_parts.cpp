@@ -159,12 +159,13 @@ class ModelsPart : public SessionPart {
       const auto f = run.fitPercentOver(*range);
       if (!f) continue;
       fit.rows.push_back({name, std::to_string(range->size()), formatFixed(*f, 2)});
-      s.values[std::string("fit_") + name + "_percent"] = *f;
+      // The fit schema's names (core/ident/fit_json.h): fit_percent of the estimation range.
+      s.values[name == std::string("estimation") ? "fit_percent" : "fit_percent_validation"] = *f;
       plotRange = range;  // the validation range when there is one
     }
     if (fit.rows.empty()) {
       fit.rows.push_back({"whole log", std::to_string(data.samples()), formatFixed(run.fitPercent, 2)});
-      s.values["fit_whole_log_percent"] = run.fitPercent;
+      s.values["fit_percent_whole_log"] = run.fitPercent;
       plotRange = SampleRange{0, data.samples()};
     }
     s.tables.push_back(fit);
