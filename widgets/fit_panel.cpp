@@ -3,7 +3,6 @@
 #include <QCheckBox>
 #include <QComboBox>
 #include <QFileDialog>
-#include <QFileInfo>
 #include <QFormLayout>
 #include <QGridLayout>
 #include <QGroupBox>
@@ -25,6 +24,7 @@
 
 #include "core/ident/blackbox.h"
 #include "core/ident/fit_spec.h"
+#include "core/ident/fit_text.h"
 #include "core/ident/nonparametric.h"
 #include "core/models/physical_models.h"
 #include "core/session/fit_report.h"
@@ -34,11 +34,7 @@
 namespace flexarm {
 namespace {
 
-QString joined(const std::vector<double>& w) {
-  QStringList parts;
-  for (double x : w) parts << QString::number(x, 'f', 1);
-  return parts.isEmpty() ? QObject::tr("none") : parts.join(", ") + " rad/s";
-}
+QString joined(const std::vector<double>& w) { return QString::fromStdString(frequencyList(w)); }
 
 QString number(double v) { return QString::number(v, 'g', 5); }
 
@@ -649,72 +645,10 @@ void FitPanel::onFinished() {
     entry.polynomial = r.polynomial;
     entry.name = QString::fromStdString(r.polynomial->name());
   }
-  const auto& s = r.summary;
   QStringList lines;
-  lines << tr("%1: %2 after %3 iterations in %4 s (%5).")
-               .arg(entry.name)
-               .arg(toString(s.termination))
-               .arg(s.iterations)
-               .arg(r.seconds, 0, 'f', 2)
-               .arg(QString::fromStdString(r.data.note()));
-  if (r.method)
-    lines << tr("Closed loop: %1 (%2).")
-                 .arg(QString::fromStdString(r.methodDescription), QString::fromStdString(r.methodReason));
-  if (!r.controllerSource.empty()) lines << tr("Controller: %1.").arg(QString::fromStdString(r.controllerSource));
-  lines << tr("Loss %1, FPE %2, AIC %3.").arg(number(s.loss), number(s.fpe), number(s.aic));
-  // Both fit percentages, named: the seed's (5.2) and the NRMSE fit MATLAB's compare prints.
-  QString fits = r.fitEstimation ? tr("Fit %1 % (5.2), %2 % NRMSE on the estimation data")
-                                       .arg(*r.fitEstimation, 0, 'f', 1)
-                                       .arg(r.fitEstimationNrmse.value_or(NAN), 0, 'f', 1)
-                                 : tr("No fit % (the simulated output diverges)");
-  if (auto v = r.fitValidation())
-    fits += tr(", %1 % (5.2), %2 % NRMSE on the validation data.")
-                .arg(*v, 0, 'f', 1)
-                .arg(r.fitValidationNrmse().value_or(NAN), 0, 'f', 1);
-  else if (r.validation.empty()) fits += tr("; no validation range set.");
-  else fits += ".";
-  lines << fits;
-  // Each experiment's fit % when there are several of a kind, as `flexarm fit` lists them.
-  // Their files: the open log's, then the more experiments' in order.
-  const FitLogNames logs = fitLogNamesOf(*out.request, out.request->provenance->log);
-  auto listFits = [&](const QString& what, const std::vector<FitValidation>& list, bool validation) {
-    if (list.size() < 2) return;
-    for (std::size_t i = 0; i < list.size(); ++i) {
-      const PreparedData& d = list[i].data;
-      const SampleRange& range = validation ? d.validation : d.estimation;
-      const std::vector<std::string>& names = validation ? logs.validation : logs.estimation;
-      const QString where = tr("%1, %2-%3 s")
-                                .arg(i < names.size() ? QFileInfo(QString::fromStdString(names[i])).fileName()
-                                                      : QString())
-                                .arg(d.timeAt(range.begin))
-                                .arg(d.timeAt(range.end - 1));
-      lines << (list[i].fitPercent ? tr("%1 experiment %2 (%3): fit %4 % (5.2), %5 % NRMSE.")
-                                         .arg(what)
-                                         .arg(i + 1)
-                                         .arg(where)
-                                         .arg(*list[i].fitPercent, 0, 'f', 1)
-                                         .arg(list[i].fitPercentNrmse.value_or(NAN), 0, 'f', 1)
-                                   : tr("%1 experiment %2 (%3): no fit % (the simulated output diverges).")
-                                         .arg(what)
-                                         .arg(i + 1)
-                                         .arg(where));
-    }
-  };
-  listFits(tr("Estimation"), r.estimation, false);
-  listFits(tr("Validation"), r.validation, true);
-  lines << tr("Notches: %1. Peaks: %2. (rad/s: the minima and maxima of |G(i w)|, what a click on "
-              "the Bode plot reads, as flexarm model and the reports give them)")
-               .arg(joined(r.notches), joined(r.peaks));
-  if (r.deflection && r.deflection->fitPercent)
-    lines << tr("Deflection r phi_m - phi_a (arm encoder, %1 mrad RMS) predicted from the torque: %2 % (5.2), "
-                "%3 % NRMSE; encoder skew %4 ms.")
-                 .arg(1e3 * r.deflection->measuredRms, 0, 'g', 3)
-                 .arg(*r.deflection->fitPercent, 0, 'f', 1)
-                 .arg(r.deflection->fitPercentNrmse.value_or(NAN), 0, 'f', 1)
-                 .arg(1e3 * r.deflection->skewSeconds, 0, 'g', 3);
-  for (const auto& w : r.plausibility) lines << tr("Implausible: %1.").arg(QString::fromStdString(w));
-  if (!r.idimNote.empty()) lines << tr("Start: %1.").arg(QString::fromStdString(r.idimNote));
-  for (const auto& w : r.warnings) lines << tr("Note: %1.").arg(QString::fromStdString(w));
+  for (const auto& line : fitSummaryLines(r, entry.name.toStdString(),
+                                          fitLogNamesOf(*out.request, out.request->provenance->log)))
+    lines << QString::fromStdString(line);
   // The estimate joins the shared list under a name no other entry has, naming its data:
   // "three-mass estimate 2 (chirp.csv 0.5-12 s)".
   std::vector<std::string> taken;

@@ -190,7 +190,7 @@ bool ArgParser::integer(const std::string& name, int& out, int min, int max) {
 std::optional<int> parseArguments(ArgParser& args, const std::vector<std::string>& argv, const std::string& verb,
                                   std::ostream& out, std::ostream& err) {
   if (!args.parse(argv)) {
-    err << "flexarm " << verb << ": " << args.error() << "\n" << args.table().help();
+    err << "flexarm " << verb << ": " << args.error() << "\n(flexarm " << verb << " --help explains the options)\n";
     return kExitUsage;
   }
   if (args.flag("help")) {

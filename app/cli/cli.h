@@ -146,8 +146,8 @@ class ArgParser {
   std::string error_;
 };
 
-// Parses a verb's command line: a usage error prints "flexarm VERB: ..." and the help to err
-// and gives kExitUsage, --help prints the help to out and gives kExitOk; nullopt: go on.
+// Parses a verb's command line: a usage error prints "flexarm VERB: ..." and where the help is
+// to err and gives kExitUsage, --help prints the help to out and gives kExitOk; nullopt: go on.
 std::optional<int> parseArguments(ArgParser& args, const std::vector<std::string>& argv, const std::string& verb,
                                   std::ostream& out, std::ostream& err);
 // ------------------------------------------------------------------------------------------

@@ -1,6 +1,6 @@
 // flexarm fit LOG --model SPEC [options] [--json]: the command line of the fit pipeline. The
 // options are read into FitOptions, which core/ident checks (FitOptions::check) and runs
-// (fitModel); the result is written by fitResultJson or printFitText.
+// (fitModel); the result is written by fitResultJson or fitResultText.
 #include "app/cli/verb_fit.h"
 
 #include <ostream>
@@ -9,6 +9,7 @@
 #include "app/cli/progress_line.h"
 #include "core/ident/fit_experiments.h"
 #include "core/ident/fit_spec.h"
+#include "core/ident/fit_text.h"
 
 namespace flexarm::cli {
 
@@ -290,7 +291,7 @@ int runFit(const std::vector<std::string>& argv, std::ostream& out, std::ostream
   FitLogNames logs;
   if (const int rc = runFitPipeline(args, "fit", fit, err, false, &logs); rc != kExitOk) return rc;
   if (args.flag("json")) out << fitResultJson(fit, logs).dump(2) << "\n";
-  else printFitText(out, fit, logs);
+  else out << fitResultText(fit, logs);
   return kExitOk;
 }
 

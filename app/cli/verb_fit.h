@@ -22,9 +22,4 @@ std::vector<Option> fitOptionList(bool nonparametric);
 int runFitPipeline(ArgParser& args, const std::string& verb, FitResult& result, std::ostream& err,
                    bool allowNonparametric = false, FitLogNames* logs = nullptr);
 
-// The result as text: how it ended, the data, the method, the parameter table, loss, fit %
-// both ways (each experiment's when there are several), the deflection check, warnings,
-// notches and peaks.
-void printFitText(std::ostream& out, const FitResult& fit, const FitLogNames& logs);
-
 }  // namespace flexarm::cli
