@@ -5,7 +5,7 @@
 
 #include "app/cli/log_args.h"
 #include "app/cli/model_args.h"
-#include "core/document/session_models.h"
+#include "core/session/session_models.h"
 #include "core/session/replay.h"
 
 namespace flexarm::cli {

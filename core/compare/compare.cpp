@@ -78,9 +78,7 @@ std::string percent(double v) {
 }  // namespace
 
 std::string rangeLabel(DataRange kind, const PreparedData& d, SampleRange range) {
-  if (range.empty()) return toString(kind);
-  return std::string(toString(kind)) + " " + shortNumber(d.timeAt(range.begin)) + "-" +
-         shortNumber(d.timeAt(range.end - 1)) + " s";
+  return samplesLabel(toString(kind), d, range);
 }
 
 std::string CompareResult::rangeText() const {

@@ -10,7 +10,7 @@
 #include <vector>
 
 #include "core/compare/compare.h"
-#include "core/document/model_list.h"
+#include "core/session/model_list.h"
 #include "core/io/log_io.h"
 #include "core/session/provenance.h"
 #include "core/signal/id_data.h"

@@ -34,6 +34,20 @@ Eigen::VectorXd simulated(const FitOptions& o, const FitResult& r, const Prepare
   return y.ok() ? y.y : Eigen::VectorXd::Constant(static_cast<Eigen::Index>(range.size()), NAN);
 }
 
+// What an experiment's fit % is of: the estimate's output from `start` over range of d.
+FitBasis basisOf(const FitOptions& o, const FitResult& r, const PreparedData& d, SampleRange range, FitStart start,
+                 const char* kind) {
+  const EvaluatedModel m = evaluatedModel(o, r);
+  FitBasis b;
+  b.start = start;
+  b.observerHz = fitObserverHz(m, d);
+  b.effects = m.nonlinear();
+  b.meansRemoved = d.inputMean != 0.0 || d.outputMean != 0.0;
+  b.rateHz = 1.0 / d.sampleTime;
+  b.range = samplesLabel(kind, d, range);
+  return b;
+}
+
 // Prediction errors for the residual tests: output errors y - G u of a physical model (one-step
 // errors of its innovations form when K is estimated; with effects, of the nonlinear
 // simulation), one-step errors (4.5) of a black-box one.
@@ -139,6 +153,7 @@ void evaluate(const FitOptions& o, FitResult& r) {
       const FitPercents fe = fitPercents(yEst, ySim);
       const SampleRange whole{0, static_cast<std::size_t>(e.data.u.size())};
       e.simulated = simulated(o, r, e.data, whole);  // from the log's first sample
+      e.basis = basisOf(o, r, e.data, e.data.estimation, FitStart::RangeStart, "estimation");
       if (std::isfinite(fe.seed52)) {
         e.fitPercent = fe.seed52;
         e.fitPercentNrmse = fe.nrmse;
@@ -157,6 +172,7 @@ void evaluate(const FitOptions& o, FitResult& r) {
     }
     for (auto& v : r.validation) {
       v.simulated = simulated(o, r, v.data, SampleRange{0, static_cast<std::size_t>(v.data.u.size())});
+      v.basis = basisOf(o, r, v.data, v.data.validation, FitStart::LogStart, "validation");
       const FitPercents fv = fitPercents(v.data.y, v.simulated, static_cast<Eigen::Index>(v.data.validation.begin),
                                          static_cast<Eigen::Index>(v.data.validation.end));
       if (std::isfinite(fv.seed52)) {

@@ -44,6 +44,11 @@ std::string fitBasisText(const FitBasis& b) {
   return s;
 }
 
+std::string samplesLabel(const std::string& kind, const PreparedData& d, SampleRange range) {
+  if (range.empty()) return kind;
+  return kind + " " + shortNumber(d.timeAt(range.begin)) + "-" + shortNumber(d.timeAt(range.end - 1)) + " s";
+}
+
 bool EvaluatedModel::isValid(std::string* why) const {
   auto fail = [why](const char* text) {
     if (why) *why = text;

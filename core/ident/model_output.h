@@ -55,6 +55,10 @@ std::string fitBasisText(const FitBasis& basis);
 // "simulation", "3-step prediction", "one-step prediction through the 4 Hz load observer".
 std::string fitKindText(const FitBasis& basis);
 
+// Which samples a figure is of, for FitBasis::range: "validation 9-17.5 s" (kind, then the
+// times of the range's first and last sample of d).
+std::string samplesLabel(const std::string& kind, const PreparedData& d, SampleRange range);
+
 // One fit figure: the number both ways and what it is of.
 struct FitFigure {
   FitPercents percent;

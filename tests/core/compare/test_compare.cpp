@@ -76,11 +76,19 @@ TEST(Compare, GivesTheFitsOwnFitPercentOnBothRanges) {
   EXPECT_DOUBLE_EQ(onValidation.models.front().fit->percent.nrmse, *fit.fitValidationNrmse());
   EXPECT_EQ(onValidation.models.front().fit->basis.start, FitStart::LogStart);
   EXPECT_DOUBLE_EQ(onValidation.models.front().fit->basis.rateHz, 200.0);
+  // And it is the same thing: the fit's figure has the same basis (the fit names no file).
+  FitBasis named = fit.validation.front().basis;
+  named.data = "simulated.csv";
+  EXPECT_EQ(named, onValidation.models.front().fit->basis) << fitBasisText(named) << " / "
+                                                           << fitBasisText(onValidation.models.front().fit->basis);
   c.range = DataRange::Estimation;
   const CompareResult onEstimation = runCompare(c);
   ASSERT_TRUE(onEstimation.models.front().fit);
   EXPECT_DOUBLE_EQ(onEstimation.models.front().fit->percent.seed52, *fit.fitEstimation);
   EXPECT_EQ(onEstimation.models.front().fit->basis.start, FitStart::RangeStart);
+  named = fit.estimation.front().basis;
+  named.data = "simulated.csv";
+  EXPECT_EQ(named, onEstimation.models.front().fit->basis);
   // The same estimate taken at the log's 2 kHz is another figure (a noisier velocity from the
   // angle), and says so.
   c.range = DataRange::Validation;
@@ -109,6 +117,7 @@ TEST(Compare, AModelWithEffectsIsComparedThroughItsFitsObserverUnlessAsked) {
   ASSERT_TRUE(autoObserver.models.front().fit) << autoObserver.models.front().message;
   const FitFigure& predicted = *autoObserver.models.front().fit;
   EXPECT_DOUBLE_EQ(predicted.percent.seed52, *fit.fitValidation());
+  EXPECT_DOUBLE_EQ(fit.validation.front().basis.observerHz, kClosedLoopObserverHz);
   EXPECT_DOUBLE_EQ(predicted.basis.observerHz, kClosedLoopObserverHz);
   EXPECT_TRUE(predicted.basis.effects);
   EXPECT_FALSE(predicted.basis.meansRemoved);  // friction acts on the real velocity

@@ -4,7 +4,7 @@
 // (its rate, ranges and data), and the black-box estimates stored with their requests. The
 // window's session restore and the command line's evaluations (`flexarm compare --session`)
 // read the list the same way.
-#include "core/document/model_list.h"
+#include "core/session/model_list.h"
 #include "core/session/session.h"
 
 namespace flexarm {

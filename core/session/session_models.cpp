@@ -1,4 +1,4 @@
-#include "core/document/session_models.h"
+#include "core/session/session_models.h"
 
 #include "core/session/fit_request.h"
 #include "core/session/model_json.h"

@@ -1,4 +1,4 @@
-#include "core/document/model_entry.h"
+#include "core/session/model_entry.h"
 
 #include "core/session/fit_request.h"
 

@@ -1,4 +1,4 @@
-#include "core/document/model_list.h"
+#include "core/session/model_list.h"
 
 #include <stdexcept>
 #include <utility>

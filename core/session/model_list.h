@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "core/document/model_entry.h"
+#include "core/session/model_entry.h"
 
 namespace flexarm {
 
