@@ -168,5 +168,8 @@ int runDiscover(const std::vector<std::string>& args, std::ostream& out, std::os
 int runRecursive(const std::vector<std::string>& args, std::ostream& out, std::ostream& err);
 int runDiagnose(const std::vector<std::string>& args, std::ostream& out, std::ostream& err);
 int runFleet(const std::vector<std::string>& args, std::ostream& out, std::ostream& err);
+int runCompare(const std::vector<std::string>& args, std::ostream& out, std::ostream& err);
+int runResiduals(const std::vector<std::string>& args, std::ostream& out, std::ostream& err);
+int runSensitivity(const std::vector<std::string>& args, std::ostream& out, std::ostream& err);
 
 }  // namespace flexarm::cli

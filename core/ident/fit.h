@@ -31,6 +31,7 @@
 #include "core/ident/controller_ident.h"
 #include "core/ident/fit_data.h"
 #include "core/ident/idim.h"
+#include "core/ident/model_output.h"
 #include "core/ident/nonlinear_pem.h"
 #include "core/ident/nonparametric.h"
 #include "core/ident/pem.h"
@@ -240,6 +241,7 @@ struct FitValidation {
   PreparedData data;
   std::optional<double> fitPercent;       // the seed's (5.2)
   std::optional<double> fitPercentNrmse;  // MATLAB compare's NRMSE fit (evaluation.h)
+  FitBasis basis;  // what the fit % is of (model_output.h): the output, start, rate, samples
   Eigen::VectorXd simulated;  // the whole log, from its first sample
 };
 

@@ -10,26 +10,11 @@
 namespace flexarm::fit_detail {
 namespace {
 
-// The estimate's deflection over range of d, simulated from the range's first sample as the
-// output is (the linear model from zero state, a model with effects by its Runge-Kutta plant);
-// empty when the simulation blows up.
+// The estimate's deflection over range of d, from the range's first sample as the output is
+// (predictedDeflection, model_output.h); empty when the simulation blows up.
 Eigen::VectorXd predictedDeflection(const FitOptions& o, const FitResult& r, const PreparedData& d, SampleRange range) {
-  auto model = std::unique_ptr<PhysicalModel>(static_cast<PhysicalModel*>(r.physical->clone().release()));
-  model->setOptions(ModelOptions{});
-  const auto n = static_cast<Eigen::Index>(range.size());
-  if (o.model.nonlinear()) {
-    NonlinearPlant plant(*model, r.effects);
-    NonlinearSeries s = nonlinearSeries(r, d, range);
-    s.resetAngle = false;  // from the torque alone: no measured angle in the arm's gravity torque
-    const NonlinearPemOptions no = nonlinearOptions(o, r);
-    if (no.smoothingSpeed > 0.0) plant.setSmoothingSpeed(no.smoothingSpeed);
-    std::vector<double> yhat, arm;
-    const int substeps = no.substeps > 0 ? no.substeps : defaultSubsteps(s.Ts);
-    if (!predictOutput(plant, s, substeps, {}, PredictedOutput::MotorVelocity, yhat, nullptr, &arm)) return {};
-    return Eigen::Map<const Eigen::VectorXd>(arm.data(), static_cast<Eigen::Index>(arm.size()));
-  }
-  const Eigen::VectorXd y = simulateDeflection(*model, d.u.segment(static_cast<Eigen::Index>(range.begin), n), d.sampleTime);
-  return y.allFinite() ? y : Eigen::VectorXd();
+  const ModelSignal y = flexarm::predictedDeflection(evaluatedModel(o, r), d, range, FitStart::RangeStart);
+  return y.ok() ? y.y : Eigen::VectorXd();
 }
 
 Eigen::VectorXd aboutMean(const Eigen::VectorXd& x) { return x.array() - x.mean(); }

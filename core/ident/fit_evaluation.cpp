@@ -1,6 +1,7 @@
 // Step 5 of the fit pipeline: fit % (5.2) on the estimation and validation experiments,
 // residual tests, the frequency response with its band, notches and peaks (5.4), and the
 // sentences the user reads beside the numbers.
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <functional>
@@ -20,18 +21,31 @@ const char* const kDecimatedCoverage = "175 of 400";
 const char* const kDecimatedBias = "4-6 % low";
 const char* const kDirectCoverage = "8 of 30";
 
-// Output simulated over range of d: the ZOH simulation of a physical model (5.3) or B/(A F) u
-// of a black-box one from zero initial state; a physical model with effects by the nonlinear
-// estimator's simulation (from rigid-body motion at the range's first speed). Empty when the
-// nonlinear simulation blows up.
+// The estimate's output over range of d, from the range's first sample, as every evaluation
+// forms it (modelOutput, model_output.h): its predictor, the simulation, or for a model with
+// effects on a closed-loop log the one-step prediction through the load observer
+// (fitObserverHz). NaN where the simulation blows up.
 Eigen::VectorXd simulated(const FitOptions& o, const FitResult& r, const PreparedData& d, SampleRange range) {
-  const auto b = static_cast<Eigen::Index>(range.begin), n = static_cast<Eigen::Index>(range.size());
-  if (r.physical && o.model.nonlinear()) {
-    const Eigen::VectorXd y = simulateNonlinear(*r.physical, r.effects, nonlinearSeries(r, d, range), nonlinearOptions(o, r));
-    return y.size() ? y : Eigen::VectorXd::Constant(n, NAN);
-  }
-  const Eigen::VectorXd u = d.u.segment(b, n);
-  return r.physical ? simulate(*r.physical, u, r.data.sampleTime) : simulate(*r.polynomial, u);
+  const EvaluatedModel m = evaluatedModel(o, r);
+  FitBasis basis;
+  basis.start = FitStart::RangeStart;
+  basis.observerHz = fitObserverHz(m, d);
+  const ModelSignal y = modelOutput(m, d, range, basis);
+  return y.ok() ? y.y : Eigen::VectorXd::Constant(static_cast<Eigen::Index>(range.size()), NAN);
+}
+
+// What an experiment's fit % is of: the estimate's output from `start` over range of d.
+FitBasis basisOf(const FitOptions& o, const FitResult& r, const PreparedData& d, SampleRange range, FitStart start,
+                 const char* kind) {
+  const EvaluatedModel m = evaluatedModel(o, r);
+  FitBasis b;
+  b.start = start;
+  b.observerHz = fitObserverHz(m, d);
+  b.effects = m.nonlinear();
+  b.meansRemoved = d.inputMean != 0.0 || d.outputMean != 0.0;
+  b.rateHz = 1.0 / d.sampleTime;
+  b.range = samplesLabel(kind, d, range);
+  return b;
 }
 
 // Prediction errors for the residual tests: output errors y - G u of a physical model (one-step
@@ -90,6 +104,22 @@ void intervalCaveats(const FitOptions& o, FitResult& r) {
 
 namespace flexarm {
 
+namespace fit_detail {
+
+EvaluatedModel evaluatedModel(const FitOptions& o, const FitResult& r) {
+  EvaluatedModel m;
+  m.name = r.modelName();
+  m.physical = r.physical;
+  if (r.physical) m.effects = r.effects;
+  m.polynomial = r.physical ? nullptr : r.polynomial;
+  m.decimation = std::max(1, r.data.decimation);
+  m.smoothingSpeed = r.smoothingSpeed;
+  m.armOutput = o.model.armOutput;
+  return m;
+}
+
+}  // namespace fit_detail
+
 NotchesPeaks fitNotchesAndPeaks(const FitResult& r, const FrequencyResponse& response, double depthDb) {
   // FlexArm's one definition (core/models/analysis.h): extrema of |G(i w)|, refined on the
   // estimate's exact response, so a physical estimate gives what `flexarm model` gives.
@@ -123,6 +153,7 @@ void evaluate(const FitOptions& o, FitResult& r) {
       const FitPercents fe = fitPercents(yEst, ySim);
       const SampleRange whole{0, static_cast<std::size_t>(e.data.u.size())};
       e.simulated = simulated(o, r, e.data, whole);  // from the log's first sample
+      e.basis = basisOf(o, r, e.data, e.data.estimation, FitStart::RangeStart, "estimation");
       if (std::isfinite(fe.seed52)) {
         e.fitPercent = fe.seed52;
         e.fitPercentNrmse = fe.nrmse;
@@ -141,6 +172,7 @@ void evaluate(const FitOptions& o, FitResult& r) {
     }
     for (auto& v : r.validation) {
       v.simulated = simulated(o, r, v.data, SampleRange{0, static_cast<std::size_t>(v.data.u.size())});
+      v.basis = basisOf(o, r, v.data, v.data.validation, FitStart::LogStart, "validation");
       const FitPercents fv = fitPercents(v.data.y, v.simulated, static_cast<Eigen::Index>(v.data.validation.begin),
                                          static_cast<Eigen::Index>(v.data.validation.end));
       if (std::isfinite(fv.seed52)) {

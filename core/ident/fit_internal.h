@@ -1,6 +1,7 @@
 #pragma once
 // The steps of fitModel (fit.h) that live in their own files; not for use elsewhere.
 #include "core/ident/fit.h"
+#include "core/ident/model_output.h"
 
 namespace flexarm::fit_detail {
 
@@ -35,6 +36,10 @@ void keepNonlinear(NonlinearPemResult&& estimate, const FitOptions& options, con
 // the predicted angle differentiated as the logged one was).
 NonlinearSeries nonlinearSeries(const FitResult& result, const PreparedData& data, SampleRange range);
 NonlinearPemOptions nonlinearOptions(const FitOptions& options, const FitResult& result);
+
+// The estimate as the evaluations take it (model_output.h): model or black-box estimate,
+// effects, the fit's rate and smooth signs' speed.
+EvaluatedModel evaluatedModel(const FitOptions& options, const FitResult& result);
 
 // Steps 2-4 of method idim / idim-iv: the inverse-dynamics estimate of the rigid part on the
 // first estimation experiment (positions and torques with their means). False with

@@ -30,7 +30,7 @@ NonlinearPemOptions nonlinearOptions(const FitOptions& o, const FitResult& r) {
   // observer keeps the simulation on the measured operating point, as in discovery.
   // Not with the arm as an output: the deflection the arm encoder measures is to be predicted
   // from the logged torque alone, and an observer's torque would pass through the spring.
-  no.observerBandwidthHz = r.data.closedLoop && !o.model.armOutput ? kClosedLoopObserverHz : 0.0;
+  no.observerBandwidthHz = fitObserverHz(evaluatedModel(o, r), r.data);
   return no;
 }
 

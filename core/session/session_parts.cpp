@@ -9,6 +9,7 @@
 
 #include "core/models/analysis.h"
 #include "core/models/nonlinear_plant.h"
+#include "core/session/compare_part.h"
 #include "core/session/diagnosis_part.h"
 #include "core/session/discovery_part.h"
 #include "core/session/fit_request.h"
@@ -16,7 +17,7 @@
 #include "core/session/model_json.h"
 #include "core/session/recursive_part.h"
 #include "core/session/session_part.h"
-#include "core/sim/log_simulation.h"
+#include "core/compare/compare_json.h"
 
 namespace flexarm {
 
@@ -27,8 +28,8 @@ namespace {
 constexpr double kPi = 3.14159265358979323846;
 
 // The model list: each model's parameters (value, unit, free flag), effects, notch and peak
-// frequencies (5.4), Bode plot, and its simulation fit % (5.2) on the estimation and
-// validation ranges, simulated open loop from the log's torque reference with the effects.
+// frequencies (5.4), Bode plot, and its fit % (5.2) on the estimation and validation ranges as
+// Compare forms it (core/compare/compare.h), each figure with what it is of.
 // The data an estimate of the list was computed on, for its section.
 void estimatedOnNote(ReportSection& s, const Provenance& p) {
   s.paragraphs.insert(s.paragraphs.begin() + 1, "Estimated on " + longDescription(p) +
@@ -66,7 +67,7 @@ class ModelsPart : public SessionPart {
       std::string why;
       auto spec = modelFromJson(m, &why);
       if (!spec) continue;  // validated on load
-      report.sections.push_back(modelSection(*spec, context.data));
+      report.sections.push_back(modelSection(*spec, context));
       // An estimate made on other data: its values are as estimated, the fit % is of the
       // open log, and the report says so.
       const auto provenance = provenanceIn(m);
@@ -74,7 +75,7 @@ class ModelsPart : public SessionPart {
         ReportSection& s = report.sections.back();
         s.paragraphs.insert(s.paragraphs.begin() + 1,
                             "Estimated on other data: " + other +
-                                ". The simulation fit % below is of this model on the open log.");
+                                ". The fit % below is of this model on the open log.");
         s.values["estimated_on"] = provenanceToJson(*provenance);
       } else if (provenance) {
         estimatedOnNote(report.sections.back(), *provenance);
@@ -83,7 +84,7 @@ class ModelsPart : public SessionPart {
   }
 
  private:
-  static ReportSection modelSection(const ModelSpec& spec, const IdData& data) {
+  static ReportSection modelSection(const ModelSpec& spec, const ReplayContext& context) {
     const PhysicalModel& model = *spec.model;
     ReportSection s;
     s.title = "Model " + spec.name;
@@ -119,7 +120,7 @@ class ModelsPart : public SessionPart {
     s.values["notches_rad_s"] = notches;
     s.values["peaks_rad_s"] = peaks;
     s.plots = bodePlots(sys, spec.name);
-    addFit(spec, data, s);
+    addFit(spec, context, s);
     return s;
   }
 
@@ -141,45 +142,54 @@ class ModelsPart : public SessionPart {
             ReportPlot{"Bode phase, " + name, "frequency (rad/s)", "phase (deg)", true, false, {phase}}};
   }
 
-  // Simulation fit % (5.2) on the ranges, as the Model panel computes it for the whole log.
-  static void addFit(const ModelSpec& spec, const IdData& data, ReportSection& s) {
-    const LogSimulationResult run = simulateAgainstLog(*spec.model, spec.effects, data);
-    if (!run.ok()) {
-      s.paragraphs.push_back("No fit: " + run.message + ".");
-      return;
+  // Fit % (5.2) on the ranges, as Compare forms it (runCompare): the model at its fit's rate,
+  // simulated from the input (through its fit's load observer when it has effects and the log
+  // was recorded in closed loop), each figure with what it is of; the plot of the last range.
+  static void addFit(const ModelSpec& spec, const ReplayContext& context, ReportSection& s) {
+    CompareRequest r;
+    r.data = evaluationDataOf(context);
+    for (const auto& m : evaluatedModelsOf(context.session))
+      if (m.name == spec.name) r.models = {m};
+    if (r.models.empty()) return;
+    ReportTable fit{"Fit % (5.2) of the model's output", {"Range", "Samples", "Fit %", "NRMSE %", "What it is of"}, {}};
+    std::optional<CompareResult> shown;
+    const bool both = r.data.validation.has_value();
+    for (const DataRange range : {DataRange::Estimation, DataRange::Validation}) {
+      if (range == DataRange::Validation && !both) continue;
+      r.range = range;
+      CompareResult c = runCompare(r, context.progress);
+      if (!c.ok() || !c.models.front().fit) {
+        s.paragraphs.push_back("No fit % on the " + std::string(toString(range)) + " range: " +
+                               (c.ok() ? c.models.front().message : c.message) + ".");
+        continue;
+      }
+      const FitFigure& f = *c.models.front().fit;
+      const auto samples = static_cast<std::size_t>(c.models.front().output.size());
+      fit.rows.push_back({toString(range), std::to_string(samples), formatFixed(f.percent.seed52, 2),
+                          formatFixed(f.percent.nrmse, 2), fitBasisText(f.basis)});
+      // The fit schema's names (core/ident/fit_json.h): fit_percent of the estimation range,
+      // fit_percent_validation of the validation range, each with what it is of.
+      const std::string suffix = range == DataRange::Estimation ? "" : "_validation";
+      s.values["fit_percent" + suffix] = f.percent.seed52;
+      s.values["fit_basis" + suffix] = fitBasisJson(f.basis);
+      shown = std::move(c);
     }
-    const std::vector<double>& measured = run.measured;
-    const std::vector<double>& simulated = run.simulated;
-    ReportTable fit{"Simulation fit % (5.2), open loop from the torque reference",
-                    {"Range", "Samples", "Fit %"}, {}};
-    std::optional<SampleRange> plotRange;
-    for (const auto& [name, range] : {std::pair{"estimation", data.estimationRange},
-                                      std::pair{"validation", data.validationRange}}) {
-      if (!range) continue;
-      const auto f = run.fitPercentOver(*range);
-      if (!f) continue;
-      fit.rows.push_back({name, std::to_string(range->size()), formatFixed(*f, 2)});
-      // The fit schema's names (core/ident/fit_json.h): fit_percent of the estimation range.
-      s.values[name == std::string("estimation") ? "fit_percent" : "fit_percent_validation"] = *f;
-      plotRange = range;  // the validation range when there is one
-    }
-    if (fit.rows.empty()) {
-      fit.rows.push_back({"whole log", std::to_string(data.samples()), formatFixed(run.fitPercent, 2)});
-      s.values["fit_percent_whole_log"] = run.fitPercent;
-      plotRange = SampleRange{0, data.samples()};
-    }
+    if (fit.rows.empty()) return;
     s.tables.push_back(fit);
-    ReportSeries meas{"measured", {}, {}, false}, sim{"simulated " + spec.name, {}, {}, true};
-    for (std::size_t i = plotRange->begin; i < plotRange->end; ++i) {
-      meas.x.push_back(data.timeAt(i));
-      meas.y.push_back(measured[i]);
+    const CompareResult& c = *shown;
+    const ComparedModel& m = c.models.front();
+    ReportSeries meas{"measured", {}, {}, false}, sim{"model " + spec.name, {}, {}, true};
+    for (Eigen::Index i = 0; i < c.measured.size(); ++i) {
+      meas.x.push_back(c.startTime + static_cast<double>(i) * c.sampleTime);
+      meas.y.push_back(c.measured[i]);
     }
-    sim.x = meas.x;
-    sim.y.assign(simulated.begin() + static_cast<std::ptrdiff_t>(plotRange->begin),
-                 simulated.begin() + static_cast<std::ptrdiff_t>(plotRange->end));
+    for (Eigen::Index i = 0; i < m.output.size(); ++i) {
+      sim.x.push_back(m.startTime + static_cast<double>(i) * m.sampleTime);
+      sim.y.push_back(m.output[i]);
+    }
     thinSeries(meas.x, meas.y, 3000);
     thinSeries(sim.x, sim.y, 3000);
-    s.plots.push_back(ReportPlot{"Measured and simulated motor velocity, " + spec.name, "time (s)",
+    s.plots.push_back(ReportPlot{"Measured and model motor velocity, " + spec.name, "time (s)",
                                  "motor velocity (rad/s)", false, false, {meas, sim}});
   }
 };
@@ -203,6 +213,9 @@ const std::vector<std::shared_ptr<const SessionPart>>& sessionParts() {
   static const std::vector<std::shared_ptr<const SessionPart>> kParts = {
       std::make_shared<ModelsPart>(),
       makeFitsPart(),
+      makeComparePart(),
+      makeResidualsPart(),
+      makeSensitivityPart(),
       makeDiscoveryPart(),
       makeLqgPart(),
       makeRecursivePart(),
