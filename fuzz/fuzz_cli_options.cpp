@@ -9,6 +9,7 @@
 #include "app/cli/cli.h"
 #include "app/cli/log_args.h"
 #include "app/cli/verb_fit.h"
+#include "core/ident/fit_spec.h"
 #include "core/models/effects.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
@@ -18,20 +19,18 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     else args.back().push_back(static_cast<char>(data[i]));
   }
   using namespace flexarm::cli;
-  ArgParser parser(fitFlagNames(), fitValuedOptionNames());
+  OptionTable table("", "");
+  table.add(fitOptionList(true)).add(logReadOptionList());
+  ArgParser parser(table);
   if (!parser.parse(args)) return 0;
   std::ostringstream sink;
   (void)logReadOptions(parser, sink);
-  double x = 0;
-  int n = 0;
-  long l = 0;
-  (void)parser.number("range", x);
-  (void)parser.integer("max-iterations", n, 0, 100000);
-  (void)parser.integer("seed", l);
+  (void)parser.number("cutoff");
+  (void)parser.integer("max-iterations");
+  (void)parser.integer("seed");
   if (auto m = parser.value("model")) {
-    flexarm::FitModelSpec spec;
     std::string why;
-    (void)parseModelSpec(*m, spec, &why, true);
+    (void)flexarm::fitModelSpecFromText(*m, true, &why);
   }
   for (const auto& e : parser.values("fix")) {
     std::string why;

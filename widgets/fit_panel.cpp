@@ -3,7 +3,6 @@
 #include <QCheckBox>
 #include <QComboBox>
 #include <QFileDialog>
-#include <QFileInfo>
 #include <QFormLayout>
 #include <QGridLayout>
 #include <QGroupBox>
@@ -24,32 +23,23 @@
 #include <cmath>
 
 #include "core/ident/blackbox.h"
+#include "core/ident/fit_spec.h"
+#include "core/ident/fit_text.h"
 #include "core/ident/nonparametric.h"
 #include "core/models/physical_models.h"
+#include "core/session/fit_report.h"
 #include "core/session/fit_request.h"
 #include "widgets/ident_data.h"
 
 namespace flexarm {
 namespace {
 
-QString joined(const std::vector<double>& w) {
-  QStringList parts;
-  for (double x : w) parts << QString::number(x, 'f', 1);
-  return parts.isEmpty() ? QObject::tr("none") : parts.join(", ") + " rad/s";
-}
+QString joined(const std::vector<double>& w) { return QString::fromStdString(frequencyList(w)); }
 
 QString number(double v) { return QString::number(v, 'g', 5); }
 
-// An effect at its defaults (the first value free), with the start model's own values when
-// it carries the effect.
-FitEffect startEffect(EffectKind kind, const std::vector<Effect>& own) {
-  FitEffect f = FitEffect::defaults(kind);
-  for (const auto& e : own)
-    if (e.kind == kind) {
-      f.effect = e;
-      f.scaleSmoothing = false;  // the model's own v_s, e.g. the one discovery found
-    }
-  return f;
+QString labelOf(const std::string& name, EffectKind kind) {
+  return QString::fromStdString(fitParameterLabel(name, toString(kind)));
 }
 
 }  // namespace
@@ -72,18 +62,19 @@ FitPanel::FitPanel(Workspace* workspace, QWidget* parent)
   model_->setToolTip(tr("What to fit: a black box (4.8: ARX, ARMAX, OE, Box-Jenkins), a physical "
                         "model of the shared list from its values, or a structure (5.1, 5.3) from "
                         "its nominal values"));
-  const char* orderNames[] = {"na", "nb", "nc", "nd", "nf", "nk"};
-  QSpinBox* orders[] = {na_, nb_, nc_, nd_, nf_, nk_};
   const int defaults[] = {2, 4, 2, 2, 4, 1};
   auto* orderRow = new QGridLayout;  // two rows of three: the panel stays narrow
   orderRow->setContentsMargins(0, 0, 0, 0);
-  for (int i = 0; i < 6; ++i) {
-    orders[i]->setRange(0, 60);
-    orders[i]->setValue(defaults[i]);
-    orders[i]->setObjectName(QString("%1Spin").arg(orderNames[i]));
-    orders[i]->setToolTip(tr("Order %1 of (4.8)").arg(orderNames[i]));
-    orderRow->addWidget(new QLabel(orderNames[i], this), i / 3, 2 * (i % 3));
-    orderRow->addWidget(orders[i], i / 3, 2 * (i % 3) + 1);
+  int i = 0;
+  for (const auto& [order, spin] : orderSpins()) {
+    const QString name = toString(order);
+    spin->setRange(0, 60);
+    spin->setValue(defaults[i]);
+    spin->setObjectName(QString("%1Spin").arg(name));
+    spin->setToolTip(tr("Order %1 of (4.8)").arg(name));
+    orderRow->addWidget(new QLabel(name, this), i / 3, 2 * (i % 3));
+    orderRow->addWidget(spin, i / 3, 2 * (i % 3) + 1);
+    ++i;
   }
   // The named effects a physical model can carry in the fit (extra_mass is a larger
   // structure, chosen as the model).
@@ -317,12 +308,12 @@ bool FitPanel::setModelChoice(const QString& key) {
 QString FitPanel::modelChoice() const { return model_->currentData().toString(); }
 
 void FitPanel::setOrders(const PolyOrders& o) {
-  na_->setValue(o.na);
-  nb_->setValue(o.nb);
-  nc_->setValue(o.nc);
-  nd_->setValue(o.nd);
-  nf_->setValue(o.nf);
-  nk_->setValue(o.nk);
+  for (const auto& [order, spin] : orderSpins()) spin->setValue(o[order]);
+}
+
+std::vector<std::pair<PolyOrder, QSpinBox*>> FitPanel::orderSpins() const {
+  return {{PolyOrder::Na, na_}, {PolyOrder::Nb, nb_}, {PolyOrder::Nc, nc_},
+          {PolyOrder::Nd, nd_}, {PolyOrder::Nf, nf_}, {PolyOrder::Nk, nk_}};
 }
 
 void FitPanel::setFreeParameters(const QStringList& names) {
@@ -377,10 +368,9 @@ std::vector<FitEffect> FitPanel::chosenEffects() const {
   const QStringList ticked = freeParameters();
   for (const auto& [kind, box] : effectChecks_) {
     if (!box->isChecked()) continue;
-    FitEffect f = startEffect(kind, own);
+    FitEffect f = fitEffectFor(kind, own);
     const auto& info = effectParameters(kind);
-    for (std::size_t k = 0; k < info.size(); ++k)
-      f.free[k] = ticked.contains(QString("%1 (%2)").arg(QString::fromStdString(info[k].name), toString(kind)));
+    for (std::size_t k = 0; k < info.size(); ++k) f.free[k] = ticked.contains(labelOf(info[k].name, kind));
     out.push_back(f);
   }
   return out;
@@ -395,10 +385,10 @@ void FitPanel::refillEffectParameters() {
   const std::vector<Effect> own = startEffects();
   for (const auto& [kind, box] : effectChecks_) {
     if (!box->isChecked()) continue;
-    const FitEffect f = startEffect(kind, own);
+    const FitEffect f = fitEffectFor(kind, own);
     const auto& info = effectParameters(kind);
     for (std::size_t k = 0; k < info.size(); ++k) {
-      const QString label = QString("%1 (%2)").arg(QString::fromStdString(info[k].name), toString(kind));
+      const QString label = labelOf(info[k].name, kind);
       auto* item = new QListWidgetItem(label, free_);
       item->setData(Qt::UserRole, true);
       item->setFlags(Qt::ItemIsEnabled | Qt::ItemIsUserCheckable);
@@ -438,13 +428,7 @@ void FitPanel::refillParameters() {
 void FitPanel::updateControls() {
   const auto s = polyStructureFromString(modelChoice().toStdString());
   const bool busy = isBusy();
-  const bool used[4][5] = {{true, true, false, false, false},    // arx: na nb
-                           {true, true, true, false, false},     // armax: na nb nc
-                           {false, true, false, false, true},    // oe: nb nf
-                           {false, true, true, true, true}};     // bj: nb nc nd nf
-  QSpinBox* orders[] = {na_, nb_, nc_, nd_, nf_};
-  for (int i = 0; i < 5; ++i) orders[i]->setEnabled(s && used[static_cast<int>(*s)][i] && !busy);
-  nk_->setEnabled(s.has_value() && !busy);
+  for (const auto& [order, spin] : orderSpins()) spin->setEnabled(s && takesOrder(*s, order) && !busy);
   free_->setEnabled(!s && !busy);
   startsBounds_->setEnabled(!s && !busy);
   more_->setEnabled(!busy);
@@ -505,15 +489,8 @@ std::optional<FitOptions> FitPanel::options(QString* name, std::vector<Experimen
   if (auto s = polyStructureFromString(key.toStdString())) {
     o.model.kind = FitModelKind::BlackBox;
     o.model.structure = *s;
-    PolyOrders& q = o.model.orders;
-    const bool used[4][5] = {{true, true, false, false, false},
-                             {true, true, true, false, false},
-                             {false, true, false, false, true},
-                             {false, true, true, true, true}};
-    QSpinBox* spins[] = {na_, nb_, nc_, nd_, nf_};
-    int* fields[] = {&q.na, &q.nb, &q.nc, &q.nd, &q.nf};
-    for (int i = 0; i < 5; ++i) *fields[i] = used[static_cast<int>(*s)][i] ? spins[i]->value() : 0;
-    q.nk = nk_->value();
+    for (const auto& [order, spin] : orderSpins()) o.model.orders[order] = spin->value();
+    o.model.orders = o.model.orders.of(*s);
   } else {
     std::shared_ptr<const PhysicalModel> base;
     if (key.startsWith("list:")) {
@@ -527,16 +504,15 @@ std::optional<FitOptions> FitPanel::options(QString* name, std::vector<Experimen
       *name = key;
     }
     if (!base) return std::nullopt;
-    auto start = clonePhysical(*base);
-    const QStringList names = freeParameters();
-    if (names.isEmpty()) {
-      setSummary(tr("Check at least one parameter to estimate."));
+    o.model.kind = FitModelKind::Physical;
+    o.model.start = base;
+    o.model.effects = chosenEffects();
+    std::vector<std::string> names;
+    for (const auto& n : freeParameters()) names.push_back(n.toStdString());
+    if (std::string bad; !flexarm::setFreeParameters(o.model, names, &bad)) {
+      setSummary(tr("The fit cannot run: %1").arg(QString::fromStdString(bad)));
       return std::nullopt;
     }
-    for (const auto& p : base->parameters()) start->setFree(p.name, names.contains(QString::fromStdString(p.name)));
-    o.model.kind = FitModelKind::Physical;
-    o.model.start = start;
-    o.model.effects = chosenEffects();
     o.noiseModel = noise_->currentIndex() == 1 ? NoiseModel::Innovations : NoiseModel::OutputError;
     o.closedLoop = closedLoopChoiceFromString(closedLoop_->currentData().toString().toStdString())
                        .value_or(ClosedLoopChoice::Auto);
@@ -610,13 +586,7 @@ void FitPanel::chooseExperimentFiles() {
 
 void FitPanel::start(const FitOptions& o, const QString& name, const std::vector<ExperimentSource>& more) {
   // The request as a session stores it: the same options and ranges, without the data.
-  auto record = std::make_shared<FitRequest>();
-  record->options = o;
-  record->options.estimation.clear();
-  record->options.validation.clear();
-  record->estimation = o.estimation.front().range;
-  record->experiments = more;
-  if (!o.validation.empty()) record->validation = o.validation.front().range;
+  auto record = std::make_shared<FitRequest>(fitRequestOf(o, more));
   // The data it runs on, with the ranges the fit itself uses.
   record->provenance = workspace_->dataProvenance();
   record->provenance->estimation = record->estimation;
@@ -675,75 +645,10 @@ void FitPanel::onFinished() {
     entry.polynomial = r.polynomial;
     entry.name = QString::fromStdString(r.polynomial->name());
   }
-  const auto& s = r.summary;
   QStringList lines;
-  lines << tr("%1: %2 after %3 iterations in %4 s (%5).")
-               .arg(entry.name)
-               .arg(toString(s.termination))
-               .arg(s.iterations)
-               .arg(r.seconds, 0, 'f', 2)
-               .arg(QString::fromStdString(r.data.note()));
-  if (r.method)
-    lines << tr("Closed loop: %1 (%2).")
-                 .arg(QString::fromStdString(r.methodDescription), QString::fromStdString(r.methodReason));
-  if (!r.controllerSource.empty()) lines << tr("Controller: %1.").arg(QString::fromStdString(r.controllerSource));
-  lines << tr("Loss %1, FPE %2, AIC %3.").arg(number(s.loss), number(s.fpe), number(s.aic));
-  // Both fit percentages, named: the seed's (5.2) and the NRMSE fit MATLAB's compare prints.
-  QString fits = r.fitEstimation ? tr("Fit %1 % (5.2), %2 % NRMSE on the estimation data")
-                                       .arg(*r.fitEstimation, 0, 'f', 1)
-                                       .arg(r.fitEstimationNrmse.value_or(NAN), 0, 'f', 1)
-                                 : tr("No fit % (the simulated output diverges)");
-  if (auto v = r.fitValidation())
-    fits += tr(", %1 % (5.2), %2 % NRMSE on the validation data.")
-                .arg(*v, 0, 'f', 1)
-                .arg(r.fitValidationNrmse().value_or(NAN), 0, 'f', 1);
-  else if (r.validation.empty()) fits += tr("; no validation range set.");
-  else fits += ".";
-  lines << fits;
-  // Each experiment's fit % when there are several of a kind, as `flexarm fit` lists them.
-  // Their files: the open log's, then the more experiments' in order.
-  QStringList files[2];
-  files[0] << QString::fromStdString(out.request->provenance->log);
-  if (out.request->validation) files[1] << QString::fromStdString(out.request->provenance->log);
-  for (const auto& e : out.request->experiments)
-    files[e.validation ? 1 : 0] << QFileInfo(QString::fromStdString(e.path)).fileName();
-  auto listFits = [&](const QString& what, const std::vector<FitValidation>& list, bool validation) {
-    if (list.size() < 2) return;
-    for (std::size_t i = 0; i < list.size(); ++i) {
-      const PreparedData& d = list[i].data;
-      const SampleRange& range = validation ? d.validation : d.estimation;
-      const QStringList& names = files[validation ? 1 : 0];
-      const QString where = tr("%1, %2-%3 s")
-                                .arg(static_cast<int>(i) < names.size() ? names[static_cast<int>(i)] : QString())
-                                .arg(d.timeAt(range.begin))
-                                .arg(d.timeAt(range.end - 1));
-      lines << (list[i].fitPercent ? tr("%1 experiment %2 (%3): fit %4 % (5.2), %5 % NRMSE.")
-                                         .arg(what)
-                                         .arg(i + 1)
-                                         .arg(where)
-                                         .arg(*list[i].fitPercent, 0, 'f', 1)
-                                         .arg(list[i].fitPercentNrmse.value_or(NAN), 0, 'f', 1)
-                                   : tr("%1 experiment %2 (%3): no fit % (the simulated output diverges).")
-                                         .arg(what)
-                                         .arg(i + 1)
-                                         .arg(where));
-    }
-  };
-  listFits(tr("Estimation"), r.estimation, false);
-  listFits(tr("Validation"), r.validation, true);
-  lines << tr("Notches: %1. Peaks: %2. (rad/s: the minima and maxima of |G(i w)|, what a click on "
-              "the Bode plot reads, as flexarm model and the reports give them)")
-               .arg(joined(r.notches), joined(r.peaks));
-  if (r.deflection && r.deflection->fitPercent)
-    lines << tr("Deflection r phi_m - phi_a (arm encoder, %1 mrad RMS) predicted from the torque: %2 % (5.2), "
-                "%3 % NRMSE; encoder skew %4 ms.")
-                 .arg(1e3 * r.deflection->measuredRms, 0, 'g', 3)
-                 .arg(*r.deflection->fitPercent, 0, 'f', 1)
-                 .arg(r.deflection->fitPercentNrmse.value_or(NAN), 0, 'f', 1)
-                 .arg(1e3 * r.deflection->skewSeconds, 0, 'g', 3);
-  for (const auto& w : r.plausibility) lines << tr("Implausible: %1.").arg(QString::fromStdString(w));
-  if (!r.idimNote.empty()) lines << tr("Start: %1.").arg(QString::fromStdString(r.idimNote));
-  for (const auto& w : r.warnings) lines << tr("Note: %1.").arg(QString::fromStdString(w));
+  for (const auto& line : fitSummaryLines(r, entry.name.toStdString(),
+                                          fitLogNamesOf(*out.request, out.request->provenance->log)))
+    lines << QString::fromStdString(line);
   // The estimate joins the shared list under a name no other entry has, naming its data:
   // "three-mass estimate 2 (chirp.csv 0.5-12 s)".
   std::vector<std::string> taken;
@@ -768,10 +673,7 @@ void FitPanel::fillTable(const std::vector<FitParameter>& parameters) {
   table_->setRowCount(static_cast<int>(parameters.size()));
   for (int i = 0; i < static_cast<int>(parameters.size()); ++i) {
     const FitParameter& row = parameters[static_cast<std::size_t>(i)];
-    const QString label = row.effect.empty() ? QString::fromStdString(row.name)
-                                             : QString("%1 (%2)").arg(QString::fromStdString(row.name),
-                                                                      QString::fromStdString(row.effect));
-    const QStringList cells = {label,
+    const QStringList cells = {QString::fromStdString(fitParameterLabel(row)),
                                number(row.value),
                                row.free ? number(row.std) : tr("fixed"),
                                row.free ? number(row.lower) : QString(),
@@ -799,17 +701,9 @@ void FitPanel::setChoices(const FitRequest& request) {
   // was fitted with; its own start values are in the list's tooltips and the starts field.
   if (o.model.start) setModelChoice(QString::fromStdString(o.model.start->structureName()));
   QStringList effects, free;
-  for (const FitEffect& f : o.model.effects) {
-    effects << QString::fromStdString(toString(f.effect.kind));
-    const auto& info = effectParameters(f.effect.kind);
-    for (std::size_t k = 0; k < info.size() && k < f.free.size(); ++k)
-      if (f.free[k])
-        free << QString("%1 (%2)").arg(QString::fromStdString(info[k].name), toString(f.effect.kind));
-  }
+  for (const FitEffect& f : o.model.effects) effects << QString::fromStdString(toString(f.effect.kind));
   setEffects(effects);
-  if (o.model.start)
-    for (const auto& p : o.model.start->parameters())
-      if (p.free) free << QString::fromStdString(p.name);
+  for (const auto& label : freeParameterLabels(o.model)) free << QString::fromStdString(label);
   setFreeParameters(free);
   setNoiseModel(o.noiseModel);
   setClosedLoopMethod(o.closedLoop);

@@ -121,6 +121,8 @@ class FitPanel : public QWidget {
   // The start model's own effects (a list entry's), else none.
   std::vector<Effect> startEffects() const;
   void updateControls();
+  // The order spin boxes by the order of (4.8) they set.
+  std::vector<std::pair<PolyOrder, QSpinBox*>> orderSpins() const;
   void onFinished();
   void onStudyFinished();
   void fillTable(const std::vector<FitParameter>& parameters);

@@ -8,44 +8,52 @@
 
 namespace flexarm::cli {
 
+std::vector<Option> logReadOptionList() {
+  const long columns = LogReadOptions::kMaxColumns;
+  return {
+      textOption("format", "auto|flexarm-csv|table|mat", "how to read LOG (auto: by content)"),
+      integerOption("input-column", "N", 1, columns, "1", "headerless table: column of the input u"),
+      integerOption("output-column", "N", 1, columns, "2", "headerless table: column of the output y"),
+      integerOption("time-column", "N", 0, columns, "0", "headerless table: column of the time (0: none)"),
+      numberOption("sample-time", "T", 0.0, 1e308, "", "seconds between samples when the file stores no time; a "
+                                                      ".mat file without time_s (or a scalar Ts, dt) needs it, a "
+                                                      "table without a time column takes 1 s and says so"),
+      textOption("input-name", "NAME", "channel name for the input (default u; .mat: the variable's name, and a "
+                                       "variable NAME is the input)"),
+      textOption("output-name", "NAME", "channel name for the output (default y; .mat: the variable's name, and a "
+                                        "variable NAME is the output)"),
+      textOption("input-var", "EXPR", "the input: a .mat variable or MATLAB expression (rec.act_torque_abs_nm(1,:), "
+                                      "data(:,2)), a CSV header name (torque_motor_Nm) or a table's 'column N'"),
+      textOption("output-var", "EXPR", "the output, named the same ways"),
+      textOption("time-var", "EXPR", "the time in s, named the same ways (rec.time_cont, t_s)"),
+      textOption("arm-var", "EXPR", "the arm-side encoder, read as arm_angle_rad"),
+      textOption("ref-var", "EXPR", "a closed loop's position reference, in the output's unit and side: "
+                                    "angle_ref_rad (position_ref_m)"),
+      textOption("output-unit", "U", "the output's unit: rad, deg, rev (rad/s, deg/s, rpm for a velocity) or, for a "
+                                     "prismatic axis, m, mm (m/s, mm/s); converted, and named motor_angle_rad "
+                                     "(motor_velocity_rad_s, motor_position_m, motor_velocity_m_s)"),
+      textOption("arm-unit", "U", "the arm encoder's unit: rad, deg or rev"),
+      choiceOption("output-side", {"motor", "arm"}, "", "arm when a motor encoder is stored scaled to the arm side "
+                                                         "(motor angle = value / gear ratio)"),
+      textOption("gear-ratio", "R", "arm/motor as the log's gear_ratio, e.g. 1/256.86"),
+      numberOption("input-scale", "K", -1e308, 1e308, "", "the input times K is the torque in N m (force in N), "
+                                                         "e.g. 35.15 for a drive command in V at 35.15 N/V"),
+  };
+}
+
 std::vector<std::string> logReadOptionNames() {
-  return {"format",     "input-column", "output-column", "time-column", "sample-time",
-          "input-name", "output-name",  "input-var",     "output-var",  "time-var",
-          "arm-var",    "ref-var",      "output-unit",   "arm-unit",    "output-side",
-          "gear-ratio", "input-scale"};
+  std::vector<std::string> names;
+  for (const auto& o : logReadOptionList()) names.push_back(o.name);
+  return names;
 }
 
 const char* logReadOptionsHelp() {
-  return "Reading the log:\n"
-         "  --format auto|flexarm-csv|table|mat   how to read LOG (auto: by content)\n"
-         "  --input-column N      headerless table: column of the input u (default 1)\n"
-         "  --output-column N     headerless table: column of the output y (default 2)\n"
-         "  --time-column N       headerless table: column of the time (default none)\n"
-         "  --sample-time T       seconds between samples when the file stores no time; a\n"
-         "                        .mat file without time_s (or a scalar Ts, dt) needs it, a\n"
-         "                        table without a time column takes 1 s and says so\n"
-         "  --input-name NAME     channel name for the input (default u; .mat: the variable's\n"
-         "                        name, and a variable NAME is the input)\n"
-         "  --output-name NAME    channel name for the output (default y; .mat: the\n"
-         "                        variable's name, and a variable NAME is the output)\n"
-         "  --input-var EXPR      the input: a .mat variable or MATLAB expression\n"
-         "                        (rec.act_torque_abs_nm(1,:), data(:,2)), a CSV header\n"
-         "                        name (torque_motor_Nm) or a table's 'column N'\n"
-         "  --output-var EXPR     the output, named the same ways\n"
-         "  --time-var EXPR       the time in s, named the same ways (rec.time_cont, t_s)\n"
-         "  --arm-var EXPR        the arm-side encoder, read as arm_angle_rad\n"
-         "  --ref-var EXPR        a closed loop's position reference, in the output's unit\n"
-         "                        and side: angle_ref_rad (position_ref_m)\n"
-         "  --output-unit U       the output's unit: rad, deg, rev (rad/s, deg/s, rpm for\n"
-         "                        a velocity) or, for a prismatic axis, m, mm (m/s, mm/s);\n"
-         "                        converted, and named motor_angle_rad (motor_velocity_rad_s,\n"
-         "                        motor_position_m, motor_velocity_m_s)\n"
-         "  --arm-unit U          the arm encoder's unit: rad, deg or rev\n"
-         "  --output-side S       motor, or arm when a motor encoder is stored scaled to the\n"
-         "                        arm side (motor angle = value / gear ratio)\n"
-         "  --gear-ratio R        arm/motor as the log's gear_ratio, e.g. 1/256.86\n"
-         "  --input-scale K       the input times K is the torque in N m (force in N),\n"
-         "                        e.g. 35.15 for a drive command in V at 35.15 N/V\n";
+  static const std::string text = [] {
+    OptionTable t("", "");
+    t.group("Reading the log").add(logReadOptionList());
+    return t.help();
+  }();
+  return text.c_str();
 }
 
 std::optional<LogReadOptions> logReadOptions(ArgParser& args, std::ostream& err) {

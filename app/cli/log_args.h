@@ -11,9 +11,10 @@
 
 namespace flexarm::cli {
 
-// Option names the log reader understands (valued options), for ArgParser.
+// The options the log reader understands, for a verb's option table ("Reading the log").
+std::vector<Option> logReadOptionList();
+// Their names and help, for verbs not yet on an option table.
 std::vector<std::string> logReadOptionNames();
-// Help text for those options.
 const char* logReadOptionsHelp();
 
 // Builds reader options from parsed arguments; on a bad value prints to err and returns

@@ -10,25 +10,42 @@
 
 namespace flexarm::cli {
 
-std::vector<std::string> modelValuedOptions() { return {"model", "param", "free", "fixed", "output"}; }
-std::vector<std::string> modelFlagOptions() { return {"arm-accel"}; }
+std::vector<Option> modelOptionList() {
+  std::vector<std::string> structures = modelStructureNames();
+  return {
+      choiceOption("model", structures, "three-mass",
+                   "the structure; defaults are IRB-1400-like: two-mass Table 5.2, three-mass Table 5.7 p6, "
+                   "four-mass p6 plus a parallel mass J_p = 0.3 kg m^2 tuned to 280 rad/s"),
+      textOption("param", "NAME=VALUE", "set a parameter, e.g. --param J_a=10 --param k_T=1.2; names: J_m J_g J_a J_p "
+                                        "f_m k_g k_a k_p d_g d_a d_p r k_T (as the structure has them; SI units: kg "
+                                        "m^2, N m s/rad, N m/rad)",
+                 true),
+      textOption("free", "NAME", "mark a parameter free (r and k_T start fixed)", true),
+      textOption("fixed", "NAME", "mark a parameter fixed", true),
+      choiceOption("output", {"motor-velocity", "motor-angle"}, "motor-velocity",
+                   "the model output (motor-angle adds the state phi_m)"),
+      flagOption("arm-accel", "add the arm acceleration as a second output"),
+  };
+}
+
+std::vector<std::string> modelValuedOptions() {
+  std::vector<std::string> names;
+  for (const auto& o : modelOptionList())
+    if (o.kind != OptionKind::Flag) names.push_back(o.name);
+  return names;
+}
+
+std::vector<std::string> modelFlagOptions() {
+  std::vector<std::string> names;
+  for (const auto& o : modelOptionList())
+    if (o.kind == OptionKind::Flag) names.push_back(o.name);
+  return names;
+}
 
 std::string modelOptionsHelp() {
-  std::string names;
-  for (const auto& n : modelStructureNames()) names += (names.empty() ? "" : "|") + n;
-  return "  --model " + names +
-         "\n"
-         "                        the structure (default three-mass); defaults are IRB-1400-like:\n"
-         "                        two-mass Table 5.2, three-mass Table 5.7 p6, four-mass p6 plus\n"
-         "                        a parallel mass J_p = 0.3 kg m^2 tuned to 280 rad/s\n"
-         "  --param NAME=VALUE    set a parameter (repeatable), e.g. --param J_a=10 --param k_T=1.2\n"
-         "                        names: J_m J_g J_a J_p f_m k_g k_a k_p d_g d_a d_p r k_T (as the\n"
-         "                        structure has them; SI units: kg m^2, N m s/rad, N m/rad)\n"
-         "  --free NAME, --fixed NAME\n"
-         "                        mark a parameter free or fixed (repeatable; r and k_T start fixed)\n"
-         "  --output motor-velocity|motor-angle\n"
-         "                        the model output (motor-angle adds the state phi_m)\n"
-         "  --arm-accel           add the arm acceleration as a second output\n";
+  OptionTable t("", "");
+  t.add(modelOptionList());
+  return t.help();
 }
 
 std::unique_ptr<PhysicalModel> modelFromArgs(const ArgParser& args, const std::string& verb,

@@ -12,10 +12,12 @@
 
 namespace flexarm::cli {
 
-// Valued options (model, param, free, fixed, output) and flags (arm-accel) these helpers read.
+// The options these helpers read (model, param, free, fixed, output, arm-accel), for a verb's
+// option table.
+std::vector<Option> modelOptionList();
+// Their names and help, for verbs not yet on an option table.
 std::vector<std::string> modelValuedOptions();
 std::vector<std::string> modelFlagOptions();
-// Help lines for the options above.
 std::string modelOptionsHelp();
 
 // The model the options describe, or nullptr after printing "flexarm VERB: ..." to err.

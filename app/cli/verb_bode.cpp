@@ -13,61 +13,50 @@
 namespace flexarm::cli {
 namespace {
 
-const char* kBodeHelp =
-    "Usage: flexarm bode LOG --model SPEC --out bode.csv [options] [--json]\n\n"
-    "Fits a model as `flexarm fit` does (or estimates SPA/ETFE) and writes its frequency\n"
-    "response with confidence band limits to a CSV file: omega_rad_s, frequency_hz,\n"
-    "magnitude, magnitude_db, phase_deg, magnitude_lower, magnitude_upper, phase_lower_deg,\n"
-    "phase_upper_deg (band columns empty where there is no covariance, e.g. ETFE).\n\n"
-    "  --model spa[:M]       non-parametric SPA (4.28), Hann lag window of width M\n"
-    "                        (default: chosen from the data, 1 s of lags and at most N/10,\n"
-    "                        SITB's min(N/10, 30) when 1 s is under 30 samples; the note\n"
-    "                        and JSON message say which and why)\n"
-    "  --model etfe[:W]      ETFE (4.24) smoothed over W bins (4.25)\n"
-    "  --out FILE            the CSV file to write (required)\n"
-    "  --level P             confidence level of the bands (default 0.99)\n"
-    "  --points N            number of frequencies, logarithmically spaced (default 500);\n"
-    "                        SPA leaves out those where the input has no power (counted\n"
-    "                        as omitted_frequencies)\n"
-    "  --wmin W --wmax W     frequency range in rad/s (default 2 pi/(N T) .. pi/T)\n";
+OptionTable bodeTable() {
+  OptionTable t("flexarm bode LOG --model SPEC --out bode.csv [options] [--json]",
+                "Fits a model as `flexarm fit` does (or estimates SPA/ETFE) and writes its frequency response with "
+                "confidence band limits to a CSV file: omega_rad_s, frequency_hz, magnitude, magnitude_db, "
+                "phase_deg, magnitude_lower, magnitude_upper, phase_lower_deg, phase_upper_deg (band columns empty "
+                "where there is no covariance, e.g. ETFE).");
+  // The level and the frequencies lie strictly above 0 (the level below 1).
+  auto open = [](Option o) {
+    o.minOpen = true;
+    o.maxOpen = o.max < 1e308;
+    return o;
+  };
+  t.add(required(textOption("out", "FILE", "the CSV file to write")))
+      .add(open(numberOption("level", "P", 0.0, 1.0, "0.99", "confidence level of the bands")))
+      .add(integerOption("points", "N", 2, 1000000, "500",
+                         "number of frequencies, logarithmically spaced; SPA leaves out those where the input "
+                         "has no power (counted as omitted_frequencies)"))
+      .add(open(numberOption("wmin", "W", 0.0, 1e308, "", "lowest frequency in rad/s (default 2 pi/(N T))")))
+      .add(open(numberOption("wmax", "W", 0.0, 1e308, "", "highest frequency in rad/s (default pi/T)")))
+      .group("The fit")
+      .add(fitOptionList(true))
+      .group("Reading the log")
+      .add(logReadOptionList());
+  t.note("SPA's lag window is chosen from the data unless given: 1 s of lags and at most N/10, SITB's min(N/10, "
+         "30) when 1 s is under 30 samples; the note and the JSON message say which and why.");
+  return t;
+}
 
 }  // namespace
 
 int runBode(const std::vector<std::string>& argv, std::ostream& out, std::ostream& err) {
-  std::vector<std::string> valued = fitValuedOptionNames();
-  for (const char* n : {"out", "level", "points", "wmin", "wmax"}) valued.push_back(n);
-  ArgParser args(fitFlagNames(), valued);
-  if (!args.parse(argv)) {
-    err << "flexarm bode: " << args.error() << "\n" << kBodeHelp << fitOptionsHelp();
-    return kExitUsage;
-  }
-  if (args.flag("help")) {
-    out << kBodeHelp << fitOptionsHelp() << "\n" << logReadOptionsHelp();
-    return kExitOk;
-  }
-  auto outPath = args.value("out");
-  if (!outPath) {
-    err << "flexarm bode: --out bode.csv is required\n";
-    return kExitUsage;
-  }
-  double level = 0.99, wmin = 0.0, wmax = 0.0;
-  int points = 500;
-  if (!args.number("level", level) || !args.integer("points", points, 2, 1000000) ||
-      !args.number("wmin", wmin) || !args.number("wmax", wmax)) {
-    err << "flexarm bode: " << args.error() << "\n";
-    return kExitUsage;
-  }
-  if (!(level > 0.0 && level < 1.0) || points < 2) {
-    err << "flexarm bode: --level must lie strictly between 0 and 1 and --points be at least 2\n";
-    return kExitUsage;
-  }
+  ArgParser args(bodeTable());
+  if (auto rc = parseArguments(args, argv, "bode", out, err)) return *rc;
+  const std::string outPath = args.text("out");
+  const double level = args.number("level");
+  const long points = args.integer("points");
+  double wmin = args.number("wmin"), wmax = args.number("wmax");
   FitResult fit;
   if (const int rc = runFitPipeline(args, "bode", fit, err, true); rc != kExitOk) return rc;
   const double T = fit.data.sampleTime;
   if (!args.value("wmin")) wmin = 2.0 * M_PI / (static_cast<double>(fit.data.estimation.size()) * T);
   if (!args.value("wmax")) wmax = M_PI / T;
-  if (!(wmin > 0.0) || !(wmax > wmin)) {
-    err << "flexarm bode: need 0 < --wmin < --wmax\n";
+  if (!(wmax > wmin)) {
+    err << "flexarm bode: need --wmin < --wmax\n";
     return kExitUsage;
   }
   const auto fr = fitResponse(fit, logGrid(wmin, wmax, static_cast<int>(points)), level);
@@ -88,7 +77,7 @@ int runBode(const std::vector<std::string>& argv, std::ostream& out, std::ostrea
       csv << ",,,\n";
   }
   std::string why;
-  if (!writeFileAtomically(*outPath, csv.str(), &why)) {
+  if (!writeFileAtomically(outPath, csv.str(), &why)) {
     err << "flexarm bode: " << why << "\n";
     return kExitBadInput;
   }
@@ -97,7 +86,7 @@ int runBode(const std::vector<std::string>& argv, std::ostream& out, std::ostrea
   const auto np = fitNotchesAndPeaks(fit, fr, FitOptions{}.notchDepthDb);
   if (args.flag("json")) {
     nlohmann::json j = {{"model", name},
-                        {"output", *outPath},
+                        {"output", outPath},
                         {"points", fr.omega.size()},
                         {"level", level},
                         {"bands", fr.hasBands()},
@@ -110,7 +99,7 @@ int runBode(const std::vector<std::string>& argv, std::ostream& out, std::ostrea
                         {"omitted_frequencies", omitted}};
     out << j.dump(2) << "\n";
   } else {
-    out << "wrote " << *outPath << ": " << fr.omega.size() << " frequencies of " << name
+    out << "wrote " << outPath << ": " << fr.omega.size() << " frequencies of " << name
         << (fr.hasBands() ? " with bands" : "") << "\n";
     if (fit.model.kind == FitModelKind::Spa) out << "note: " << fit.summary.message << "\n";
     if (!fit.nonparametric.warning.empty())

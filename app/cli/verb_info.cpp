@@ -11,11 +11,13 @@
 namespace flexarm::cli {
 namespace {
 
-const char* kInfoHelp =
-    "Usage: flexarm info LOG [options] [--json]\n\n"
-    "Prints the channels (name, unit, role, min, max, mean), sample rate, length, metadata\n"
-    "and the estimation and validation ranges of LOG.\n\n"
-    "  --json                print JSON instead of text\n";
+OptionTable infoTable() {
+  OptionTable t("flexarm info LOG [options] [--json]",
+                "Prints the channels (name, unit, role, min, max, mean), sample rate, length, metadata and the "
+                "estimation and validation ranges of LOG.");
+  t.add(flagOption("json", "print JSON instead of text")).group("Reading the log").add(logReadOptionList());
+  return t;
+}
 
 nlohmann::json rangeJson(const IdData& d, const std::optional<SampleRange>& r) {
   if (!r) return nullptr;
@@ -29,18 +31,10 @@ nlohmann::json rangeJson(const IdData& d, const std::optional<SampleRange>& r) {
 }  // namespace
 
 int runInfo(const std::vector<std::string>& argv, std::ostream& out, std::ostream& err) {
-  std::vector<std::string> valued = logReadOptionNames();
-  ArgParser args({"json", "help"}, valued);
-  if (!args.parse(argv)) {
-    err << "flexarm info: " << args.error() << "\n" << kInfoHelp;
-    return kExitUsage;
-  }
-  if (args.flag("help")) {
-    out << kInfoHelp << "\n" << logReadOptionsHelp();
-    return kExitOk;
-  }
+  ArgParser args(infoTable());
+  if (auto rc = parseArguments(args, argv, "info", out, err)) return *rc;
   if (args.positional().size() != 1) {
-    err << "flexarm info: expected exactly one LOG\n" << kInfoHelp;
+    err << "flexarm info: expected exactly one LOG\n" << args.table().help();
     return kExitUsage;
   }
   auto options = logReadOptions(args, err);

@@ -11,38 +11,40 @@
 namespace flexarm::cli {
 namespace {
 
-const char* kLqgHelp =
-    "Usage: flexarm lqg [--model two-mass] [--param NAME=VALUE ...] [--q1 a,b,c,d,e]\n"
-    "                   [--q2 x] [--r1 a,b,c,d,e] [--r2 y[,z]] [--accel] [--json]\n\n"
-    "Designs the LQG regulator of the seed's chapter 8 for the two-mass arm and analyses it:\n"
-    "LQR gain L minimizing (8.17), Kalman gain K of (8.16), integral action by the state x5,\n"
-    "a constant load on the arm (Section 8.3), closed-loop and regulator poles, the Nyquist\n"
-    "curve of F_y G with its encirclements of -1, max |S|, Bode's integral (8.37) against\n"
-    "pi * sum Re(p_i), the disturbance steps of Figure 8.3 and the describing-function check.\n"
-    "Without options it designs the seed's case (i).\n\n"
-    "  --model two-mass      the plant (8.1)-(8.6); the only model of this verb (default)\n"
-    "  --param NAME=VALUE    change a parameter of Table 8.1: J_m, J_a (kg m^2), f_m, f_a,\n"
-    "                        d (N m s/rad), k (N m/rad); repeat for several\n"
-    "  --q1 LIST             diagonal state weight of (8.17), one entry per design state\n"
-    "                        (x1..x5; default 100,1,0,0,0; the fifth weights the\n"
-    "                        uncontrollable x5 and changes no gain)\n"
-    "  --q2 X                input weight of (8.17) (default 1)\n"
-    "  --r1 LIST             diagonal process noise covariance (default 0,0,0,0,1)\n"
-    "  --r2 Y[,Z]            measurement noise covariance: Y for phi_m, Z for the arm\n"
-    "                        acceleration with --accel (default 1e-6; 1e-8 is case (ii);\n"
-    "                        with --accel 1e-8,1e-1 as in Section 8.7)\n"
-    "  --accel               also measure the arm acceleration, (8.40)-(8.42)\n"
-    "  --no-integral         design on the four-state model without x5 (Q1, R1 take 4 entries)\n"
-    "  --saturation U        also simulate the steps with |u| <= U, without and with\n"
-    "                        anti-windup (8.31)-(8.32)\n"
-    "  --bandwidth W         bandwidth in rad/s of T_a for the Section 8.4 check (default 50)\n"
-    "  --json                print the results as JSON\n\n"
-    "JSON fields: L, K, lqr_residual, kalman_residual, closed_loop_poles, regulator_poles\n"
-    "(each [re, im]), rhp_regulator_poles, regulator_stability, encirclements (counter-\n"
-    "clockwise, of -1 by F_y G), expected_encirclements (P - Z), max_sensitivity and its\n"
-    "frequency, min_distance_to_minus_one, bode_integral, bode_prediction,\n"
-    "peak_arm_deviation, describing_function_crossings (F_y G and G_0), saturation,\n"
-    "bandwidth_criterion, seconds.\n";
+OptionTable lqgTable() {
+  OptionTable t("flexarm lqg [--model two-mass] [--param NAME=VALUE ...] [--q1 a,b,c,d,e] [--q2 x] [--r1 a,b,c,d,e] "
+                "[--r2 y[,z]] [--accel] [--json]",
+                "Designs the LQG regulator of the seed's chapter 8 for the two-mass arm and analyses it: LQR gain L "
+                "minimizing (8.17), Kalman gain K of (8.16), integral action by the state x5, a constant load on the "
+                "arm (Section 8.3), closed-loop and regulator poles, the Nyquist curve of F_y G with its "
+                "encirclements of -1, max |S|, Bode's integral (8.37) against pi * sum Re(p_i), the disturbance "
+                "steps of Figure 8.3 and the describing-function check. Without options it designs the seed's case "
+                "(i).");
+  const double any = 1e308;
+  t.add(textOption("model", "two-mass", "the plant (8.1)-(8.6); the only model of this verb (default)"))
+      .add(textOption("param", "NAME=VALUE", "change a parameter of Table 8.1: J_m, J_a (kg m^2), f_m, f_a, d (N m "
+                                             "s/rad), k (N m/rad)",
+                      true))
+      .add(textOption("q1", "LIST", "diagonal state weight of (8.17), one entry per design state (x1..x5; default "
+                                    "100,1,0,0,0; the fifth weights the uncontrollable x5 and changes no gain)"))
+      .add(numberOption("q2", "X", -any, any, "1", "input weight of (8.17)"))
+      .add(textOption("r1", "LIST", "diagonal process noise covariance (default 0,0,0,0,1)"))
+      .add(textOption("r2", "Y[,Z]", "measurement noise covariance: Y for phi_m, Z for the arm acceleration with "
+                                     "--accel (default 1e-6; 1e-8 is case (ii); with --accel 1e-8,1e-1 as in "
+                                     "Section 8.7)"))
+      .add(flagOption("accel", "also measure the arm acceleration, (8.40)-(8.42)"))
+      .add(flagOption("no-integral", "design on the four-state model without x5 (Q1, R1 take 4 entries)"))
+      .add(numberOption("saturation", "U", -any, any, "", "also simulate the steps with |u| <= U, without and with "
+                                                          "anti-windup (8.31)-(8.32)"))
+      .add(numberOption("bandwidth", "W", -any, any, "50", "bandwidth in rad/s of T_a for the Section 8.4 check"))
+      .add(flagOption("json", "print the results as JSON"));
+  t.note("JSON fields: L, K, lqr_residual, kalman_residual, closed_loop_poles, regulator_poles (each [re, im]), "
+         "rhp_regulator_poles, regulator_stability, encirclements (counter-clockwise, of -1 by F_y G), "
+         "expected_encirclements (P - Z), max_sensitivity and its frequency, min_distance_to_minus_one, "
+         "bode_integral, bode_prediction, peak_arm_deviation, describing_function_crossings (F_y G and G_0), "
+         "saturation, bandwidth_criterion, seconds.");
+  return t;
+}
 
 bool parseList(const std::string& text, Eigen::VectorXd& out, std::string& why) {
   std::vector<double> v;
@@ -98,15 +100,14 @@ nlohmann::json response(const DisturbanceResponse& r) {
 }  // namespace
 
 int runLqg(const std::vector<std::string>& argv, std::ostream& out, std::ostream& err) {
-  ArgParser args({"json", "help", "accel", "no-integral"},
-                 {"model", "param", "q1", "q2", "r1", "r2", "saturation", "bandwidth"});
+  ArgParser args(lqgTable());
   auto usage = [&err](const std::string& why) {
     err << "flexarm lqg: " << why << "\n(flexarm lqg --help explains the options)\n";
     return kExitUsage;
   };
   if (!args.parse(argv)) return usage(args.error());
   if (args.flag("help")) {
-    out << kLqgHelp;
+    out << args.table().help();
     return kExitOk;
   }
   if (!args.positional().empty())

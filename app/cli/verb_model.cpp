@@ -10,26 +10,26 @@
 namespace flexarm::cli {
 namespace {
 
-const char* kModelHelp =
-    "Usage: flexarm model [--model STRUCTURE] [--param NAME=VALUE ...] [options] [--json]\n\n"
-    "Builds a physical model of the seed's chapter 3 and prints its matrices A, B, C, D (seed\n"
-    "state coordinates), poles, transmission zeros, the transfer function, and the notch\n"
-    "and peak frequencies in rad/s.\n"
-    "Notches and peaks (JSON notches_rad_s, peaks_rad_s) are the frequencies of the local\n"
-    "minima and maxima of |G(i w)|, at least 1 dB deep: what a click on the Bode plot reads\n"
-    "and what `flexarm fit`, the panels and the reports print for the same model. For a\n"
-    "lightly damped pair they lie near the imaginary part of the zero (notch) or pole (peak),\n"
-    "which (5.4) approximates; those roots are listed apart (JSON lightly_damped_zeros,\n"
-    "lightly_damped_poles, with their damping ratios).\n\n";
-
-const char* kModelHelpTail =
-    "  --damping-limit Z     list a root pair as lightly damped when |damping ratio| < Z\n"
-    "                        (default 0.3)\n"
-    "  --discretize zoh|foh  also print the discrete model (needs --sample-time)\n"
-    "  --sample-time T       sample time in seconds for --discretize\n"
-    "  --bode W0:W1:N        frequency response at N log-spaced frequencies W0..W1 rad/s\n"
-    "  --json                print everything as JSON\n\n"
-    "Example: flexarm model --model two-mass --json   (Table 5.2: notch near 112 rad/s)\n";
+OptionTable modelTable() {
+  OptionTable t("flexarm model [--model STRUCTURE] [--param NAME=VALUE ...] [options] [--json]",
+                "Builds a physical model of the seed's chapter 3 and prints its matrices A, B, C, D (seed state "
+                "coordinates), poles, transmission zeros, the transfer function, and the notch and peak "
+                "frequencies in rad/s.");
+  t.add(modelOptionList())
+      .add(numberOption("damping-limit", "Z", 0.0, 1e308, "0.3", "list a root pair as lightly damped when |damping "
+                                                                 "ratio| < Z"))
+      .add(choiceOption("discretize", {"zoh", "foh"}, "", "also print the discrete model (needs --sample-time)"))
+      .add(numberOption("sample-time", "T", 0.0, 1e308, "", "sample time in seconds for --discretize"))
+      .add(textOption("bode", "W0:W1:N", "frequency response at N log-spaced frequencies W0..W1 rad/s"))
+      .add(flagOption("json", "print everything as JSON"));
+  t.note("Notches and peaks (JSON notches_rad_s, peaks_rad_s) are the frequencies of the local minima and maxima "
+         "of |G(i w)|, at least 1 dB deep: what a click on the Bode plot reads and what `flexarm fit`, the panels "
+         "and the reports print for the same model. For a lightly damped pair they lie near the imaginary part of "
+         "the zero (notch) or pole (peak), which (5.4) approximates; those roots are listed apart (JSON "
+         "lightly_damped_zeros, lightly_damped_poles, with their damping ratios).");
+  t.note("Example: flexarm model --model two-mass --json   (Table 5.2: notch near 112 rad/s)");
+  return t;
+}
 
 nlohmann::json matrixJson(const Eigen::MatrixXd& m) {
   nlohmann::json rows = nlohmann::json::array();
@@ -70,36 +70,16 @@ bool parseBode(const std::string& text, double& w0, double& w1, long& n) {
 }  // namespace
 
 int runModel(const std::vector<std::string>& argv, std::ostream& out, std::ostream& err) {
-  auto valued = modelValuedOptions();
-  for (const char* v : {"damping-limit", "discretize", "sample-time", "bode"}) valued.push_back(v);
-  auto flags = modelFlagOptions();
-  flags.push_back("json");
-  flags.push_back("help");
-  ArgParser args(flags, valued);
-  if (!args.parse(argv)) {
-    err << "flexarm model: " << args.error() << "\n" << kModelHelp << modelOptionsHelp() << kModelHelpTail;
-    return kExitUsage;
-  }
-  if (args.flag("help")) {
-    out << kModelHelp << modelOptionsHelp() << kModelHelpTail;
-    return kExitOk;
-  }
+  ArgParser args(modelTable());
+  if (auto rc = parseArguments(args, argv, "model", out, err)) return *rc;
   if (!args.positional().empty()) {
     err << "flexarm model: unexpected argument '" << args.positional()[0] << "'\n";
     return kExitUsage;
   }
-  double limit = 0.3, sampleTime = 0.0;
-  if (!args.number("damping-limit", limit) || !args.number("sample-time", sampleTime)) {
-    err << "flexarm model: " << args.error() << "\n";
-    return kExitUsage;
-  }
+  const double limit = args.number("damping-limit"), sampleTime = args.number("sample-time");
   std::optional<Discretization> method;
   if (auto d = args.value("discretize")) {
     method = discretizationFromString(*d);
-    if (!method) {
-      err << "flexarm model: --discretize must be zoh or foh, not '" << *d << "'\n";
-      return kExitUsage;
-    }
     if (!(sampleTime > 0.0)) {
       err << "flexarm model: --discretize needs --sample-time T > 0\n";
       return kExitUsage;

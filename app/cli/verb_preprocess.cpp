@@ -12,35 +12,42 @@
 namespace flexarm::cli {
 namespace {
 
-const char* kPreprocessHelp =
-    "Usage: flexarm preprocess LOG --out OUT.csv [options] [--json]\n\n"
-    "Prepares a log for identification as in the seed's Section 5.2 and writes a FlexArm CSV\n"
-    "log. Steps, in this order: resample, differentiate, cut to a range, decimate, detrend.\n\n"
-    "  --out FILE            the FlexArm CSV log to write (required)\n"
-    "  --resample RATE_HZ    put the log on a uniform grid at this rate first: irregular time\n"
-    "                        stamps (jitter, dropped samples, duplicates, reversals; refused\n"
-    "                        without this option) are reported and filled, and the rate is\n"
-    "                        changed by any rational factor (polyphase FIR, >= 80 dB from the\n"
-    "                        lower Nyquist frequency); empty fields mark channels not sampled\n"
-    "                        at that time (channels at different rates)\n"
-    "  --method linear|pchip|bandlimited\n"
-    "                        how irregular time stamps are filled onto the grid (default\n"
-    "                        bandlimited: exact for short gaps of a signal below 0.8 of the\n"
-    "                        log's Nyquist frequency)\n"
-    "  --max-gap S           longest gap to bridge, seconds (default: ten sample intervals);\n"
-    "                        a longer one is refused with its place\n"
-    "  --with LOG2           another log of the same experiment (same clock): its channels\n"
-    "                        join on LOG's time base (repeatable; needs --resample)\n"
-    "  --differentiate       add motor_velocity_rad_s = d/dt motor_angle_rad as the output\n"
-    "  --range A:B           keep only the samples from A to B seconds\n"
-    "  --decimate N          keep every N-th sample after the anti-alias filter (default 1)\n"
-    "  --filter fir|chebyshev|none\n"
-    "                        anti-alias filter: linear-phase FIR with >= 80 dB stopband from\n"
-    "                        the new Nyquist frequency (default), order-8 Chebyshev I run\n"
-    "                        forward and backward, or none (aliasing)\n"
-    "  --detrend             remove the means of input and output\n"
-    "  --detrend-linear      remove linear trends of input and output\n"
-    "  --json                print a JSON summary of the result\n";
+OptionTable preprocessTable() {
+  OptionTable t("flexarm preprocess LOG --out OUT.csv [options] [--json]",
+                "Prepares a log for identification as in the seed's Section 5.2 and writes a FlexArm CSV log. "
+                "Steps, in this order: resample, differentiate, cut to a range, decimate, detrend.");
+  auto above0 = [](Option o) {
+    o.minOpen = true;
+    return o;
+  };
+  t.add(required(textOption("out", "FILE", "the FlexArm CSV log to write")))
+      .add(above0(numberOption("resample", "RATE_HZ", 0.0, 1e308, "",
+                               "put the log on a uniform grid at this rate first: irregular time stamps (jitter, "
+                               "dropped samples, duplicates, reversals; refused without this option) are reported "
+                               "and filled, and the rate is changed by any rational factor (polyphase FIR, >= 80 dB "
+                               "from the lower Nyquist frequency); empty fields mark channels not sampled at that "
+                               "time (channels at different rates)")))
+      .add(choiceOption("method", {"linear", "pchip", "bandlimited"}, "bandlimited",
+                        "how irregular time stamps are filled onto the grid (bandlimited: exact for short gaps of a "
+                        "signal below 0.8 of the log's Nyquist frequency)"))
+      .add(above0(numberOption("max-gap", "S", 0.0, 1e308, "", "longest gap to bridge, seconds (default: ten sample "
+                                                              "intervals); a longer one is refused with its place")))
+      .add(textOption("with", "LOG2", "another log of the same experiment (same clock): its channels join on LOG's "
+                                      "time base (needs --resample)",
+                      true))
+      .add(flagOption("differentiate", "add motor_velocity_rad_s = d/dt motor_angle_rad as the output"))
+      .add(textOption("range", "A:B", "keep only the samples from A to B seconds"))
+      .add(integerOption("decimate", "N", 1, 1000000, "1", "keep every N-th sample after the anti-alias filter"))
+      .add(choiceOption("filter", {"fir", "chebyshev", "none"}, "fir",
+                        "anti-alias filter: linear-phase FIR with >= 80 dB stopband from the new Nyquist frequency, "
+                        "order-8 Chebyshev I run forward and backward, or none (aliasing)"))
+      .add(flagOption("detrend", "remove the means of input and output"))
+      .add(flagOption("detrend-linear", "remove linear trends of input and output"))
+      .add(flagOption("json", "print a JSON summary of the result"))
+      .group("Reading the log")
+      .add(logReadOptionList());
+  return t;
+}
 
 nlohmann::json timingJson(const ChannelGroup& g) {
   const TimingReport& t = g.timing;
@@ -95,38 +102,20 @@ nlohmann::json resampleJson(const UniformGridResult& r, const UniformGridOptions
 }  // namespace
 
 int runPreprocess(const std::vector<std::string>& argv, std::ostream& out, std::ostream& err) {
-  std::vector<std::string> valued = logReadOptionNames();
-  for (const char* v : {"out", "decimate", "filter", "range", "resample", "method", "max-gap", "with"})
-    valued.push_back(v);
-  ArgParser args({"json", "help", "detrend", "detrend-linear", "differentiate"}, valued);
-  if (!args.parse(argv)) {
-    err << "flexarm preprocess: " << args.error() << "\n" << kPreprocessHelp;
-    return kExitUsage;
-  }
-  if (args.flag("help")) {
-    out << kPreprocessHelp << "\n" << logReadOptionsHelp();
-    return kExitOk;
-  }
+  ArgParser args(preprocessTable());
+  if (auto rc = parseArguments(args, argv, "preprocess", out, err)) return *rc;
   if (args.positional().size() != 1) {
-    err << "flexarm preprocess: expected exactly one LOG\n" << kPreprocessHelp;
+    err << "flexarm preprocess: expected exactly one LOG\n" << args.table().help();
     return kExitUsage;
   }
-  auto outPath = args.value("out");
-  if (!outPath) {
-    err << "flexarm preprocess: --out OUT.csv is required\n";
-    return kExitUsage;
-  }
+  const std::string outPath = args.text("out");
   auto usage = [&](const std::string& why) {
     err << "flexarm preprocess: " << why << "\n";
     return kExitUsage;
   };
   PreprocessOptions p;
-  if (!args.integer("decimate", p.decimation.factor, 1, 1000000)) return usage(args.error());
-  if (auto f = args.value("filter")) {
-    auto parsed = antiAliasFilterFromString(*f);
-    if (!parsed) return usage("--filter must be fir, chebyshev or none, not '" + *f + "'");
-    p.decimation.filter = *parsed;
-  }
+  p.decimation.factor = static_cast<int>(args.integer("decimate"));
+  p.decimation.filter = *antiAliasFilterFromString(args.text("filter"));
   if (args.flag("detrend") && args.flag("detrend-linear")) return usage("give --detrend or --detrend-linear, not both");
   if (args.flag("detrend")) p.detrend = Detrend::Mean;
   if (args.flag("detrend-linear")) p.detrend = Detrend::Linear;
@@ -134,17 +123,9 @@ int runPreprocess(const std::vector<std::string>& argv, std::ostream& out, std::
   std::optional<UniformGridOptions> resample;
   if (args.value("resample")) {
     UniformGridOptions u;
-    if (!args.number("resample", u.rateHz)) return usage(args.error());
-    if (!(u.rateHz > 0.0)) return usage("--resample needs a rate above 0 Hz");
-    if (auto m = args.value("method")) {
-      auto parsed = interpolationMethodFromString(*m);
-      if (!parsed) return usage("--method must be linear, pchip or bandlimited, not '" + *m + "'");
-      u.method = *parsed;
-    }
-    if (args.value("max-gap")) {
-      if (!args.number("max-gap", u.maxGapSeconds)) return usage(args.error());
-      if (!(u.maxGapSeconds > 0.0)) return usage("--max-gap needs a duration above 0 s");
-    }
+    u.rateHz = args.number("resample");
+    u.method = *interpolationMethodFromString(args.text("method"));
+    if (args.value("max-gap")) u.maxGapSeconds = args.number("max-gap");
     resample = u;
   } else {
     for (const char* needs : {"method", "max-gap", "with"})
@@ -207,13 +188,13 @@ int runPreprocess(const std::vector<std::string>& argv, std::ostream& out, std::
   result.setMeta("preprocessed_from", path);
   storeRanges(result);
   ReadError werr;
-  if (!writeFlexArmCsv(result, *outPath, &werr)) {
+  if (!writeFlexArmCsv(result, outPath, &werr)) {
     err << "flexarm preprocess: " << werr.toString() << "\n";
     return kExitBadInput;
   }
   if (args.flag("json")) {
     nlohmann::json j = {{"input", path},
-                        {"output", *outPath},
+                        {"output", outPath},
                         {"samples_in", samplesIn},
                         {"samples_out", result.samples()},
                         {"sample_rate_hz", result.sampleRateHz()},
@@ -226,7 +207,7 @@ int runPreprocess(const std::vector<std::string>& argv, std::ostream& out, std::
     out << j.dump(2) << "\n";
   } else {
     if (report) out << "resampled: " << report->message << "\n";
-    out << "wrote " << *outPath << ": " << result.samples() << " samples at "
+    out << "wrote " << outPath << ": " << result.samples() << " samples at "
         << result.sampleRateHz() << " Hz\n";
   }
   return kExitOk;

@@ -17,70 +17,79 @@
 namespace flexarm::cli {
 namespace {
 
-const char* kRecursiveHelp =
-    "Usage: flexarm recursive LOG --model three-mass [--param NAME=V ...] --estimate k_T,J_a,f_m\n"
-    "                         [--algorithm forgetting|kalman] [--lambda 0.995] [--r1 a,b,c]\n"
-    "                         [--r2 v] [--start-scale 1.2] [--gradient sensitivity|difference]\n"
-    "                         [--decimate N] [--out trajectory.csv] [--json]\n\n"
-    "Estimates physical parameters recursively, sample by sample, as the seed's chapter 6 does:\n"
-    "the recursive prediction-error method on the continuous-time model sampled with a\n"
-    "zero-order hold at the current estimate every sample, its gradient from the sensitivity\n"
-    "system (6.27). The log is prepared as for a fit: the motor velocity from the motor angle\n"
-    "(central differences at the log's rate), means removed. The estimator runs at the log's\n"
-    "own rate up to 2 kHz, where the zero-order hold of the torque is what the controller did\n"
-    "(a faster log is decimated to 2 kHz or below, the torque held as its mean over each new\n"
-    "period). The seed's design variables are per 200 Hz sample and keep their memory and\n"
-    "random walk per second at any rate (lambda^(T/5 ms), R1 T/5 ms). P(0) is chosen as the\n"
-    "seed does (Section 6.6.2): the P update run at the nominal parameters, its diagonal\n"
-    "averaged.\n\n"
-    "  --model NAME          the structure (default three-mass); nominal values are its\n"
-    "                        defaults (three-mass: Table 5.7 p6) or a fit's (--nominal)\n"
-    "  --param NAME=VALUE    set a nominal parameter (repeatable)\n"
-    "  --nominal FILE.json   the nominal model from `flexarm fit --json` (or a session's\n"
-    "                        model): its structure and parameter values\n"
-    "  --estimate A,B,...    parameters to estimate (default k_T,J_a,f_m, the seed's); the\n"
-    "                        others stay at their nominal values. theta holds J_a as J_a^-1\n"
-    "                        as the seed does (see --invert); results use the model's names\n"
-    "  --invert A,B|none     parameters theta holds as inverses (default J_a); NAME^-1 in\n"
-    "                        --estimate does the same\n"
-    "  --algorithm NAME      forgetting (Algorithm 6.1, default) or kalman (Algorithm 6.2)\n"
-    "  --lambda L            forgetting factor per 200 Hz sample (default 0.995, the seed's:\n"
-    "                        a memory of one second at any rate)\n"
-    "  --r1 a,b,c            diag R1 of Algorithm 6.2 per 200 Hz sample, one per estimated\n"
-    "                        parameter (default (6.54): 5e-8, 5e-7, 5e-6 for k_T, J_a^-1, f_m)\n"
-    "  --per-sample          --lambda and --r1 are per sample at the rate the estimator runs\n"
-    "                        at, not per 200 Hz sample\n"
-    "  --tracking KIND       how changing parameters are followed (the seed's 9.2): fixed\n"
-    "                        (lambda or R1 as designed, default), variable (information-\n"
-    "                        constant forgetting: lambda(t) drops when the prediction errors\n"
-    "                        grow, down to --lambda-min, default 0.95 per 200 Hz sample;\n"
-    "                        forgetting algorithm), bank (estimators started at hypothesised\n"
-    "                        change times every --bank-spacing S (0.25), the last\n"
-    "                        --bank-size N (6) kept; a change is accepted when one predicts\n"
-    "                        the data since its start better by --bank-threshold (40) noise\n"
-    "                        variances)\n"
-    "  --r2 V                R2 of Algorithm 6.2 (default 1)\n"
-    "  --mu M                regularisation (6.9) (default 0)\n"
-    "  --start-scale S       theta(0) = S * nominal (the seed starts 20 % above: 1.2; default 1)\n"
-    "  --p0 a,b,c            diag P(0) (default: the seed's pre-run)\n"
-    "  --gradient KIND       sensitivity ((6.27), default) or difference ((6.33); can diverge\n"
-    "                        for an output-error model, Example 6.1)\n"
-    "  --decimate N          decimation factor (default: the log's rate up to 2 kHz; 10 on a\n"
-    "                        2 kHz log is the seed's 200 Hz, with the torque held as its mean\n"
-    "                        over each period)\n"
-    "  --range A:B           use the log from A to B seconds (default: all of it)\n"
-    "  --out FILE.csv        write the trajectory: time_s, theta, sigma per parameter, y, yhat,\n"
-    "                        epsilon\n"
-    "  --json                print the result as JSON\n\n"
-    "JSON fields: final and std (the model's names: J_a even when theta holds J_a^-1), theta\n"
-    "{name: {nominal, start, final, std}} (theta's names), nominal, start, termination, message,\n"
-    "caveat, samples, sample_time_s, decimation, preparation, algorithm, gradient, lambda and\n"
-    "r1 (as given), design_sample_time_s, lambda_per_sample and r1_per_sample (as run),\n"
-    "tracking, changes [{detected_s, time_s}] (bank), lambda_min_reached (variable), p0,\n"
-    "psi_variance (diag Q (6.53)), rms_prediction_error, seconds, out.\n"
-    "Exit status: 0 the estimates stayed within their bounds, 2 usage, 3 bad log, 4 the\n"
-    "estimate left its bounds or P blew up (the message says when; the trajectory up to there\n"
-    "is written).\n";
+OptionTable recursiveTable() {
+  OptionTable t("flexarm recursive LOG --model three-mass [--param NAME=V ...] --estimate k_T,J_a,f_m [options] "
+                "[--json]",
+                "Estimates physical parameters recursively, sample by sample, as the seed's chapter 6 does: the "
+                "recursive prediction-error method on the continuous-time model sampled with a zero-order hold at "
+                "the current estimate every sample, its gradient from the sensitivity system (6.27). The log is "
+                "prepared as for a fit: the motor velocity from the motor angle (central differences at the log's "
+                "rate), means removed. The estimator runs at the log's own rate up to 2 kHz, where the zero-order "
+                "hold of the torque is what the controller did (a faster log is decimated to 2 kHz or below, the "
+                "torque held as its mean over each new period). The seed's design variables are per 200 Hz sample "
+                "and keep their memory and random walk per second at any rate (lambda^(T/5 ms), R1 T/5 ms). P(0) "
+                "is chosen as the seed does (Section 6.6.2): the P update run at the nominal parameters, its "
+                "diagonal averaged.");
+  const double any = 1e308;
+  t.add(textOption("model", "NAME", "the structure (default three-mass); nominal values are its defaults "
+                                    "(three-mass: Table 5.7 p6) or a fit's (--nominal)"))
+      .add(textOption("param", "NAME=VALUE", "set a nominal parameter", true))
+      .add(textOption("nominal", "FILE.json", "the nominal model from `flexarm fit --json` (or a session's model): "
+                                              "its structure and parameter values"))
+      .add(textOption("estimate", "A,B,...", "parameters to estimate (default k_T,J_a,f_m, the seed's); the others "
+                                             "stay at their nominal values. theta holds J_a as J_a^-1 as the seed does "
+                                             "(see --invert); results use the model's names"))
+      .add(textOption("invert", "A,B|none", "parameters theta holds as inverses (default J_a); NAME^-1 in --estimate "
+                                            "does the same"))
+      .add(choiceOption("algorithm", {"forgetting", "kalman"}, "forgetting",
+                        "forgetting factor (Algorithm 6.1) or Kalman filter (Algorithm 6.2)"))
+      .add(numberOption("lambda", "L", -any, any, "0.995", "forgetting factor per 200 Hz sample (the seed's: a "
+                                                          "memory of one second at any rate)"))
+      .add(textOption("r1", "a,b,c", "diag R1 of Algorithm 6.2 per 200 Hz sample, one per estimated parameter "
+                                     "(default (6.54): 5e-8, 5e-7, 5e-6 for k_T, J_a^-1, f_m)"))
+      .add(flagOption("per-sample", "--lambda and --r1 are per sample at the rate the estimator runs at, not per "
+                                    "200 Hz sample"))
+      .add(choiceOption("tracking", {"fixed", "variable", "bank"}, "fixed",
+                        "how changing parameters are followed (the seed's 9.2): fixed (lambda or R1 as designed), "
+                        "variable (information-constant forgetting: lambda(t) drops when the prediction errors "
+                        "grow, down to --lambda-min; forgetting algorithm), bank (estimators started at "
+                        "hypothesised change times every --bank-spacing s, the last --bank-size kept; a change is "
+                        "accepted when one predicts the data since its start better by --bank-threshold noise "
+                        "variances)"))
+      .add(numberOption("lambda-min", "L", -any, any, "0.95", "variable tracking: the lowest lambda per 200 Hz "
+                                                             "sample"))
+      .add(numberOption("bank-spacing", "S", -any, any, "0.25", "bank tracking: seconds between hypothesised "
+                                                               "changes"))
+      .add(integerOption("bank-size", "N", -1, 1000, "6", "bank tracking: estimators kept"))
+      .add(numberOption("bank-threshold", "T", -any, any, "40", "bank tracking: noise variances a change must "
+                                                               "explain"))
+      .add(numberOption("r2", "V", -any, any, "1", "R2 of Algorithm 6.2"))
+      .add(numberOption("mu", "M", -any, any, "0", "regularisation (6.9)"))
+      .add(numberOption("start-scale", "S", -any, any, "1", "theta(0) = S * nominal (the seed starts 20 % above: "
+                                                           "1.2)"))
+      .add(textOption("p0", "a,b,c", "diag P(0) (default: the seed's pre-run)"))
+      .add(choiceOption("gradient", {"sensitivity", "difference"}, "sensitivity",
+                        "sensitivity (6.27) or difference (6.33; can diverge for an output-error model, Example "
+                        "6.1)"))
+      .add(integerOption("decimate", "N", 1, 1000000, "", "decimation factor (default: the log's rate up to 2 kHz; "
+                                                         "10 on a 2 kHz log is the seed's 200 Hz, with the torque "
+                                                         "held as its mean over each period)"))
+      .add(textOption("range", "A:B", "use the log from A to B seconds (default: all of it)"))
+      .add(textOption("out", "FILE.csv", "write the trajectory: time_s, theta, sigma per parameter, y, yhat, "
+                                         "epsilon"))
+      .add(flagOption("json", "print the result as JSON"))
+      .group("Reading the log")
+      .add(logReadOptionList());
+  t.note("JSON fields: final and std (the model's names: J_a even when theta holds J_a^-1), theta {name: {nominal, "
+         "start, final, std}} (theta's names), nominal, start, termination, message, caveat, samples, "
+         "sample_time_s, decimation, preparation, algorithm, gradient, lambda and r1 (as given), "
+         "design_sample_time_s, lambda_per_sample and r1_per_sample (as run), tracking, changes [{detected_s, "
+         "time_s}] (bank), lambda_min_reached (variable), p0, psi_variance (diag Q (6.53)), rms_prediction_error, "
+         "seconds, out.");
+  t.note("Exit status: 0 the estimates stayed within their bounds, 2 usage, 3 bad log, 4 the estimate left its "
+         "bounds or P blew up (the message says when; the trajectory up to there is written).");
+  return t;
+}
 
 // A comma-separated list of numbers; false with a sentence for anything else.
 bool parseNumbers(const std::string& option, const std::string& text, std::vector<double>& out,
@@ -111,22 +120,9 @@ nlohmann::json byName(const RecursiveResult& r, double RecursiveEstimate::*field
 }  // namespace
 
 int runRecursive(const std::vector<std::string>& argv, std::ostream& out, std::ostream& err) {
-  std::vector<std::string> valued = logReadOptionNames();
-  for (const char* n : {"model", "param", "nominal", "estimate", "invert", "algorithm", "lambda",
-                        "r1", "r2", "mu", "start-scale", "p0", "gradient", "decimate", "range",
-                        "out", "tracking", "lambda-min", "bank-spacing", "bank-size",
-                        "bank-threshold"})
-    valued.push_back(n);
-  ArgParser args({"json", "help", "per-sample"}, valued);
+  ArgParser args(recursiveTable());
   const std::string pre = "flexarm recursive: ";
-  if (!args.parse(argv)) {
-    err << pre << args.error() << "\n" << kRecursiveHelp;
-    return kExitUsage;
-  }
-  if (args.flag("help")) {
-    out << kRecursiveHelp << "\n" << logReadOptionsHelp();
-    return kExitOk;
-  }
+  if (auto rc = parseArguments(args, argv, "recursive", out, err)) return *rc;
   if (args.positional().size() != 1) {
     err << pre << "expected exactly one LOG\n";
     return kExitUsage;
@@ -156,30 +152,14 @@ int runRecursive(const std::vector<std::string>& argv, std::ostream& out, std::o
   std::string why;
   if (auto e = args.value("estimate")) o.estimate = splitList(*e);
   if (auto inv = args.value("invert")) o.inverted = *inv == "none" ? std::vector<std::string>{} : splitList(*inv);
-  // An option naming one of an enum's words: false (with the sentence written) for another.
-  auto choose = [&](const char* option, auto fromString, auto& target, const char* words) {
-    const auto text = args.value(option);
-    if (!text) return true;
-    const auto parsed = fromString(*text);
-    if (!parsed) {
-      err << pre << "--" << option << " must be " << words << ", not '" << *text << "'\n";
-      return false;
-    }
-    target = *parsed;
-    return true;
-  };
-  if (!choose("algorithm", recursiveAlgorithmFromString, o.algorithm, "forgetting or kalman") ||
-      !choose("gradient", recursiveGradientFromString, o.gradient, "sensitivity or difference") ||
-      !choose("tracking", recursiveTrackingFromString, o.tracking, "fixed, variable or bank"))
-    return kExitUsage;
-  long bankSize = o.bankSize;
-  if (!args.number("lambda", o.lambda) || !args.number("r2", o.r2) || !args.number("mu", o.mu) ||
-      !args.number("start-scale", o.startScale) || !args.number("lambda-min", o.lambdaMin) ||
-      !args.number("bank-spacing", o.bankSpacingS) || !args.integer("bank-size", bankSize) ||
-      !args.number("bank-threshold", o.bankThreshold)) {
-    err << pre << args.error() << "\n";
-    return kExitUsage;
-  }
+  o.algorithm = *recursiveAlgorithmFromString(args.text("algorithm"));
+  o.gradient = *recursiveGradientFromString(args.text("gradient"));
+  o.tracking = *recursiveTrackingFromString(args.text("tracking"));
+  for (auto [name, target] : {std::pair{"lambda", &o.lambda}, {"r2", &o.r2}, {"mu", &o.mu},
+                              {"start-scale", &o.startScale}, {"lambda-min", &o.lambdaMin},
+                              {"bank-spacing", &o.bankSpacingS}, {"bank-threshold", &o.bankThreshold}})
+    if (args.value(name)) *target = args.number(name);
+  if (args.value("bank-size")) o.bankSize = static_cast<int>(args.integer("bank-size"));
   if (auto v = args.value("r1"); v && !parseNumbers("r1", *v, o.r1, &why)) {
     err << pre << why << "\n";
     return kExitUsage;
@@ -189,22 +169,12 @@ int runRecursive(const std::vector<std::string>& argv, std::ostream& out, std::o
     return kExitUsage;
   }
   if (args.flag("per-sample")) o.designSampleTime = 0.0;
-  o.bankSize = static_cast<int>(std::clamp<long>(bankSize, -1, 1000));
   if (!o.isValid(&why)) {
     err << pre << why << "\n";
     return kExitUsage;
   }
   RecursiveDataOptions d;
-  long decimation = 0;
-  if (!args.integer("decimate", decimation)) {
-    err << pre << args.error() << "\n";
-    return kExitUsage;
-  }
-  if (args.value("decimate") && decimation < 1) {
-    err << pre << "--decimate must be at least 1\n";
-    return kExitUsage;
-  }
-  d.decimation = static_cast<int>(decimation);
+  d.decimation = static_cast<int>(args.integer("decimate"));  // 0: the log's rate up to 2 kHz
   if (auto r = args.value("range")) {
     d.range = secondsRangeFromText(*r, &why);
     if (!d.range) {

@@ -13,16 +13,19 @@ namespace {
 
 ReportRenderer gRenderer = nullptr;
 
-const char* kRunHelp =
-    "Usage: flexarm run SESSION.json [--log NAME=PATH ...] [--report OUT.pdf|OUT.html] [--json]\n\n"
-    "Replays a saved session without a window: reads its logs (checking their SHA-256),\n"
-    "applies its preprocessing and ranges, recomputes every part (models, fits, discovery,\n"
-    "the LQG design) and writes the report. At least one of --report and --json is needed.\n\n"
-    "  --log NAME=PATH       use PATH instead of the session's log NAME (repeatable), e.g.\n"
-    "                        tomorrow's log of the same experiment\n"
-    "  --report FILE         write the report: .pdf (vector plots) or .html (self-contained,\n"
-    "                        plots embedded as images)\n"
-    "  --json                print the report's provenance and numbers as JSON\n";
+OptionTable runTable() {
+  OptionTable t("flexarm run SESSION.json [--log NAME=PATH ...] [--report OUT.pdf|OUT.html] [--json]",
+                "Replays a saved session without a window: reads its logs (checking their SHA-256), applies its "
+                "preprocessing and ranges, recomputes every part (models, fits, discovery, the LQG design) and "
+                "writes the report. At least one of --report and --json is needed.");
+  t.add(textOption("log", "NAME=PATH", "use PATH instead of the session's log NAME, e.g. tomorrow's log of the "
+                                       "same experiment",
+                   true))
+      .add(textOption("report", "FILE", "write the report: .pdf (vector plots) or .html (self-contained, plots "
+                                        "embedded as images)"))
+      .add(flagOption("json", "print the report's provenance and numbers as JSON"));
+  return t;
+}
 
 bool endsWith(const std::string& s, const std::string& tail) {
   return s.size() >= tail.size() && s.compare(s.size() - tail.size(), tail.size(), tail) == 0;
@@ -34,17 +37,10 @@ void setReportRenderer(ReportRenderer renderer) { gRenderer = renderer; }
 ReportRenderer reportRenderer() { return gRenderer; }
 
 int runRun(const std::vector<std::string>& argv, std::ostream& out, std::ostream& err) {
-  ArgParser args({"json", "help"}, {"log", "report"});
-  if (!args.parse(argv)) {
-    err << "flexarm run: " << args.error() << "\n" << kRunHelp;
-    return kExitUsage;
-  }
-  if (args.flag("help")) {
-    out << kRunHelp;
-    return kExitOk;
-  }
+  ArgParser args(runTable());
+  if (auto rc = parseArguments(args, argv, "run", out, err)) return *rc;
   if (args.positional().size() != 1) {
-    err << "flexarm run: expected exactly one SESSION.json\n" << kRunHelp;
+    err << "flexarm run: expected exactly one SESSION.json\n" << args.table().help();
     return kExitUsage;
   }
   const auto reportPath = args.value("report");

@@ -29,6 +29,56 @@ std::optional<PolyStructure> polyStructureFromString(std::string_view s) {
   return std::nullopt;
 }
 
+const char* toString(PolyOrder o) {
+  switch (o) {
+    case PolyOrder::Na: return "na";
+    case PolyOrder::Nb: return "nb";
+    case PolyOrder::Nc: return "nc";
+    case PolyOrder::Nd: return "nd";
+    case PolyOrder::Nf: return "nf";
+    case PolyOrder::Nk: return "nk";
+  }
+  return "na";
+}
+
+const std::vector<PolyOrder>& polyOrdersOf(PolyStructure s) {
+  using O = PolyOrder;
+  static const std::vector<PolyOrder> kArx{O::Na, O::Nb, O::Nk}, kArmax{O::Na, O::Nb, O::Nc, O::Nk},
+      kOe{O::Nb, O::Nf, O::Nk}, kBj{O::Nb, O::Nc, O::Nd, O::Nf, O::Nk};
+  switch (s) {
+    case PolyStructure::Arx: return kArx;
+    case PolyStructure::Armax: return kArmax;
+    case PolyStructure::Oe: return kOe;
+    case PolyStructure::Bj: return kBj;
+  }
+  return kArx;
+}
+
+bool takesOrder(PolyStructure s, PolyOrder o) {
+  const auto& list = polyOrdersOf(s);
+  return std::find(list.begin(), list.end(), o) != list.end();
+}
+
+int& PolyOrders::operator[](PolyOrder o) {
+  switch (o) {
+    case PolyOrder::Na: return na;
+    case PolyOrder::Nb: return nb;
+    case PolyOrder::Nc: return nc;
+    case PolyOrder::Nd: return nd;
+    case PolyOrder::Nf: return nf;
+    case PolyOrder::Nk: return nk;
+  }
+  return na;
+}
+
+int PolyOrders::operator[](PolyOrder o) const { return (*const_cast<PolyOrders*>(this))[o]; }
+
+PolyOrders PolyOrders::of(PolyStructure s) const {
+  PolyOrders out{0, 0, 0, 0, 0, 0};
+  for (PolyOrder o : polyOrdersOf(s)) out[o] = (*this)[o];
+  return out;
+}
+
 int PolyOrders::parameters() const {
   const long long sum = static_cast<long long>(na) + nb + nc + nd + nf;
   return static_cast<int>(std::min<long long>(sum, std::numeric_limits<int>::max()));
@@ -111,14 +161,10 @@ bool PolyEstimateOptions::isValid(std::string* why) const {
 std::string PolynomialModel::name() const {
   std::ostringstream s;
   s << toString(structure) << "[";
-  const auto& o = orders;
-  switch (structure) {
-    case PolyStructure::Arx: s << o.na << " " << o.nb << " " << o.nk; break;
-    case PolyStructure::Armax: s << o.na << " " << o.nb << " " << o.nc << " " << o.nk; break;
-    case PolyStructure::Oe: s << o.nb << " " << o.nf << " " << o.nk; break;
-    case PolyStructure::Bj:
-      s << o.nb << " " << o.nc << " " << o.nd << " " << o.nf << " " << o.nk;
-      break;
+  const char* gap = "";
+  for (PolyOrder o : polyOrdersOf(structure)) {
+    s << gap << orders[o];
+    gap = " ";
   }
   s << "]";
   return s.str();

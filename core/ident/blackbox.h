@@ -18,11 +18,23 @@ enum class PolyStructure { Arx, Armax, Oe, Bj };
 const char* toString(PolyStructure s);
 std::optional<PolyStructure> polyStructureFromString(std::string_view s);
 
+// One order of (4.8): the degrees of A, B, C, D, F and the delay nk.
+enum class PolyOrder { Na, Nb, Nc, Nd, Nf, Nk };
+const char* toString(PolyOrder o);  // "na", "nb", "nc", "nd", "nf", "nk"
+// The orders a structure takes, in the order its name ("oe[2 2 1]") and a model spec
+// ("oe:2,2,1") list them: arx na nb nk, armax na nb nc nk, oe nb nf nk, bj nb nc nd nf nk.
+const std::vector<PolyOrder>& polyOrdersOf(PolyStructure s);
+bool takesOrder(PolyStructure s, PolyOrder o);
+
 // Orders of (4.8): na, nb, nc, nd, nf and the delay nk (B = b1 q^{-nk} + ... (4.10)).
 struct PolyOrders {
   static constexpr int kMaxOrder = 2000;    // of each polynomial, and of all together
   static constexpr int kMaxDelay = 1000000;  // nk, samples
   int na = 0, nb = 1, nc = 0, nd = 0, nf = 0, nk = 1;
+  int& operator[](PolyOrder o);
+  int operator[](PolyOrder o) const;
+  // These orders with the ones structure s does not take set to 0.
+  PolyOrders of(PolyStructure s) const;
   // na + nb + nc + nd + nf, computed without overflow (saturates at INT_MAX).
   int parameters() const;
   bool isValid(std::string* why) const;

@@ -42,53 +42,84 @@ std::optional<ClosedLoopChoice> closedLoopChoiceFromString(std::string_view s) {
   return std::nullopt;
 }
 
-bool FitModelSpec::isValid(std::string* why) const {
-  auto fail = [why](const std::string& text) {
-    if (why) *why = text;
-    return false;
-  };
-  switch (kind) {
+const char* describe(ClosedLoopChoice c) {
+  switch (c) {
+    case ClosedLoopChoice::Auto:
+      return "the indirect fit when the log is undecimated and its controller explains the torque, else the "
+             "two-stage fit on a log with a reference, the direct fit without one; it says which and why";
+    case ClosedLoopChoice::Direct:
+      return "output error to the logged input, which the noise fed back biases in closed loop (4.43)";
+    case ClosedLoopChoice::TwoStage:
+      return "output error to the part of the input the reference explains (an FIR of the reference), "
+             "consistent in closed loop";
+    case ClosedLoopChoice::Indirect:
+      return "the log's controller closed around the model, the loop fitted from the reference to the measured "
+             "motor angle at the log's own rate";
+  }
+  return "";
+}
+
+namespace {
+
+FitCheck refuse(FitIssue issue, std::string message) { return {issue, std::move(message)}; }
+
+// The rules of a model spec (FitModelSpec::isValid and FitOptions::check).
+FitCheck checkSpec(const FitModelSpec& m) {
+  using I = FitIssue;
+  switch (m.kind) {
     case FitModelKind::Physical: {
-      if (!start) return fail("a physical fit needs its start model");
+      if (!m.start) return refuse(I::NoStartModel, "a physical fit needs its start model");
       bool anyFree = false;
-      for (const auto& p : start->parameters()) anyFree = anyFree || p.free;
+      for (const auto& p : m.start->parameters()) anyFree = anyFree || p.free;
       std::vector<bool> seen(allEffectKinds().size(), false);
-      for (const auto& f : effects) {
+      for (const auto& f : m.effects) {
         std::string reason;
-        if (!f.effect.isValid(&reason)) return fail(reason);
+        if (!f.effect.isValid(&reason)) return refuse(I::InvalidEffect, reason);
         const std::string name = toString(f.effect.kind);
         if (f.effect.kind == EffectKind::ExtraMass)
-          return fail("extra_mass changes the structure; fit the larger structure instead");
-        if (seen[static_cast<std::size_t>(f.effect.kind)]) return fail("the effect " + name + " is given twice");
+          return refuse(I::EffectChangesStructure, "extra_mass changes the structure; fit the larger structure instead");
+        if (seen[static_cast<std::size_t>(f.effect.kind)])
+          return refuse(I::EffectTwice, "the effect " + name + " is given twice");
         seen[static_cast<std::size_t>(f.effect.kind)] = true;
         if ((f.effect.kind == EffectKind::Backlash || f.effect.kind == EffectKind::NonlinearSpring) &&
-            (start->topology().gearStiffness.empty() || start->structureName() == "two-mass-theta"))
-          return fail(name + " needs a model with a gear spring (two-mass, three-mass or four-mass), not " +
-                      start->structureName());
+            (m.start->topology().gearStiffness.empty() || m.start->structureName() == "two-mass-theta"))
+          return refuse(I::EffectNeedsGearSpring, name + " needs a model with a gear spring (two-mass, three-mass "
+                                                         "or four-mass), not " + m.start->structureName());
         for (std::size_t k = 0; k < effectParameters(f.effect.kind).size(); ++k) anyFree = anyFree || f.free[k];
       }
-      for (const auto& f : effects)
-        if (f.effect.kind == EffectKind::EncoderSkew && !armOutput)
-          return fail("encoder_skew shifts what the arm encoder reads: it goes with the arm as an output "
-                      "(--outputs motor,arm)");
-      if (armOutput && start->options().output != ModelOutput::MotorVelocity)
-        return fail("the arm as a second output goes with the motor velocity as the first");
-      if (!effects.empty() && start->options().armAcceleration)
-        return fail("a fit with effects takes one output (the motor velocity or angle), not the arm acceleration");
-      if (!anyFree) return fail("a physical fit needs at least one free parameter");
-      return true;
+      for (const auto& f : m.effects)
+        if (f.effect.kind == EffectKind::EncoderSkew && !m.armOutput)
+          return refuse(I::EncoderSkewNeedsArm, "encoder_skew shifts what the arm encoder reads: it goes with the "
+                                                "arm as an output (--outputs motor,arm)");
+      if (m.armOutput && m.start->options().output != ModelOutput::MotorVelocity)
+        return refuse(I::ArmOutputNeedsVelocity, "the arm as a second output goes with the motor velocity as the first");
+      if (!m.effects.empty() && m.start->options().armAcceleration)
+        return refuse(I::EffectsTakeOneOutput, "a fit with effects takes one output (the motor velocity or angle), "
+                                               "not the arm acceleration");
+      if (!anyFree) return refuse(I::NoFreeParameter, "a physical fit needs at least one free parameter");
+      return {};
     }
     case FitModelKind::BlackBox: {
       std::string reason;
-      if (!orders.isValid(&reason)) return fail("orders: " + reason);
-      return true;
+      if (!m.orders.isValid(&reason)) return refuse(I::InvalidOrders, "orders: " + reason);
+      break;
     }
     case FitModelKind::Spa:
     case FitModelKind::Etfe:
-      if (windowWidth < 0) return fail("the window width cannot be negative");
-      return true;
+      if (m.windowWidth < 0) return refuse(I::InvalidWindow, "the window width cannot be negative");
+      break;
   }
-  return true;
+  if (!m.effects.empty() || m.armOutput)
+    return refuse(I::PhysicalOnly, "effects and the arm as an output apply to physical models only");
+  return {};
+}
+
+}  // namespace
+
+bool FitModelSpec::isValid(std::string* why) const {
+  const FitCheck c = checkSpec(*this);
+  if (why) *why = c.message;
+  return c.ok();
 }
 
 std::string FitModelSpec::name() const {
@@ -110,82 +141,182 @@ bool FitModelSpec::wantsVelocity() const {
   return kind != FitModelKind::Physical || !start || start->options().output == ModelOutput::MotorVelocity;
 }
 
-bool FitOptions::isValidExceptData(std::string* why) const {
-  auto fail = [why](const std::string& text) {
-    if (why) *why = text;
-    return false;
-  };
-  if (!model.isValid(why)) return false;
-  if (estimation.empty()) return fail("the fit needs an estimation experiment");
+FitCheck FitOptions::checkExceptData() const {
+  using I = FitIssue;
+  if (FitCheck c = checkSpec(model); !c.ok()) return c;
+  const bool physical = model.kind == FitModelKind::Physical;
+  if (estimation.empty()) return refuse(I::NoEstimationData, "the fit needs an estimation experiment");
   if (estimation.size() > 1) {
     if (model.kind == FitModelKind::Spa || model.kind == FitModelKind::Etfe)
-      return fail(std::string(toString(model.kind)) + " takes one estimation experiment");
-    if (model.kind == FitModelKind::Physical &&
-        (closedLoop == ClosedLoopChoice::TwoStage || closedLoop == ClosedLoopChoice::Indirect))
-      return fail(std::string("the ") + toString(closedLoop) +
-                  " closed-loop fit takes one estimation experiment; several take the direct fit");
+      return refuse(I::OneExperimentOnly, std::string(toString(model.kind)) + " takes one estimation experiment");
+    if (physical && (closedLoop == ClosedLoopChoice::TwoStage || closedLoop == ClosedLoopChoice::Indirect))
+      return refuse(I::OneExperimentOnly, std::string("the ") + toString(closedLoop) +
+                                              " closed-loop fit takes one estimation experiment; several take "
+                                              "the direct fit");
   }
   for (const auto* list : {&estimation, &validation})
     for (const auto& e : *list)
-      if (e.range && !(e.range->start < e.range->end))
-        return fail("a range must have start < end");
-  if (decimation < 1) return fail("the decimation factor must be at least 1");
-  if (maxIterations < 1) return fail("at least one iteration is needed");
-  if (randomStarts < 0) return fail("the number of random starts cannot be negative");
-  if (!(level > 0.0 && level < 1.0)) return fail("the level must lie strictly between 0 and 1");
-  if (responsePoints < 2) return fail("the frequency response needs at least two points");
-  if (!(notchDepthDb >= 0.0)) return fail("the notch depth cannot be negative");
+      if (e.range && !(e.range->start < e.range->end)) return refuse(I::EmptyRange, "a range must have start < end");
+  if (decimation < 1) return refuse(I::OutOfRange, "the decimation factor must be at least 1");
+  if (maxIterations < 1) return refuse(I::OutOfRange, "at least one iteration is needed");
+  if (randomStarts < 0) return refuse(I::OutOfRange, "the number of random starts cannot be negative");
+  if (!(level > 0.0 && level < 1.0)) return refuse(I::OutOfRange, "the level must lie strictly between 0 and 1");
+  if (responsePoints < 2) return refuse(I::OutOfRange, "the frequency response needs at least two points");
+  if (!(notchDepthDb >= 0.0)) return refuse(I::OutOfRange, "the notch depth cannot be negative");
   if (method != FitMethod::PredictionError) {
-    if (model.kind != FitModelKind::Physical)
-      return fail(std::string("the ") + toString(method) + " method estimates a physical model's rigid part; "
-                  "give a physical model");
+    const std::string name = std::string("the ") + toString(method) + " method ";
+    if (!physical)
+      return refuse(I::MethodNeedsPhysical, name + "estimates a physical model's rigid part; give a physical model");
     if (!model.effects.empty())
-      return fail(std::string("the ") + toString(method) + " method has its own friction model; it takes no effects");
+      return refuse(I::MethodExcludesEffects, name + "has its own friction model; it takes no effects");
     if (decimation > 1)
-      return fail(std::string("the ") + toString(method) + " method filters and decimates the data itself; "
-                  "it excludes decimation");
-    if (estimation.size() > 1) return fail(std::string("the ") + toString(method) + " method takes one estimation experiment");
-    if (!idim.isValid(why)) return false;
+      return refuse(I::MethodExcludesDecimation, name + "filters and decimates the data itself; it excludes decimation");
+    if (estimation.size() > 1) return refuse(I::OneExperimentOnly, name + "takes one estimation experiment");
+    if (std::string why; !idim.isValid(&why)) return refuse(I::InvalidMethodOptions, why);
   }
-  if (model.kind == FitModelKind::Physical) {
-    if (noiseModel == NoiseModel::Innovations && closedLoop != ClosedLoopChoice::Auto &&
-        closedLoop != ClosedLoopChoice::Direct)
-      return fail(std::string("the ") + toString(closedLoop) +
-                  " closed-loop fit is output error; it excludes the innovations form");
-    if (closedLoop == ClosedLoopChoice::Indirect && decimation > 1)
-      return fail("the indirect closed-loop fit runs at the controller's rate; it excludes decimation");
-    if (model.nonlinear() && noiseModel != NoiseModel::OutputError)
-      return fail("a fit with effects is output error (5.7); it excludes the innovations form");
-    if (model.nonlinear() && closedLoop != ClosedLoopChoice::Auto && closedLoop != ClosedLoopChoice::Direct)
-      return fail(std::string("a fit with effects simulates the plant from the measured torque (the direct fit); "
-                              "it excludes the ") + toString(closedLoop) + " closed-loop fit");
-    if (controller && !controller->isValid(why)) return false;
-    if (!controllerIdent.isValid(why)) return false;
-    try {
-      FitOptions dataless = *this;  // the log's own gear ratio is the data's business (fitModel)
-      dataless.estimation.clear();
-      const auto start = fitStartModel(dataless);
-      bool anyFree = false;
-      for (const auto& p : start->parameters()) anyFree = anyFree || p.free;
-      if (!anyFree) return fail("a physical fit needs at least one free parameter");
-    } catch (const std::invalid_argument& e) {
-      return fail(e.what());
-    }
-  } else if (!startValues.empty() || !bounds.empty()) {
-    return fail("start values and bounds apply to physical models only");
+  if (!physical) {
+    if (!startValues.empty() || !bounds.empty())
+      return refuse(I::PhysicalOnly, "start values and bounds apply to physical models only");
+    if (noiseModel != NoiseModel::OutputError || randomStarts > 0 || closedLoop != ClosedLoopChoice::Auto)
+      return refuse(I::PhysicalOnly, "the innovations form, random starts and a closed-loop method apply to "
+                                     "physical models only");
+    return {};
   }
-  return true;
+  if (noiseModel == NoiseModel::Innovations && closedLoop != ClosedLoopChoice::Auto &&
+      closedLoop != ClosedLoopChoice::Direct)
+    return refuse(I::ExcludesInnovations, std::string("the ") + toString(closedLoop) +
+                                              " closed-loop fit is output error; it excludes the innovations form");
+  if (closedLoop == ClosedLoopChoice::Indirect && decimation > 1)
+    return refuse(I::IndirectExcludesDecimation,
+                  "the indirect closed-loop fit runs at the controller's rate; it excludes decimation");
+  if (model.nonlinear() && noiseModel != NoiseModel::OutputError)
+    return refuse(I::ExcludesInnovations, "a fit with effects is output error (5.7); it excludes the innovations form");
+  if (model.nonlinear() && closedLoop != ClosedLoopChoice::Auto && closedLoop != ClosedLoopChoice::Direct)
+    return refuse(I::EffectsNeedDirect, std::string("a fit with effects simulates the plant from the measured torque "
+                                                    "(the direct fit); it excludes the ") +
+                                            toString(closedLoop) + " closed-loop fit");
+  if (std::string why; controller && !controller->isValid(&why)) return refuse(I::InvalidController, why);
+  if (std::string why; !controllerIdent.isValid(&why)) return refuse(I::InvalidController, why);
+  // Start values and bounds name the start model's parameters (an effect's values are its own).
+  auto unknown = [this](const std::string& name, const char* what) {
+    std::string names;
+    for (const auto& p : model.start->parameters()) names += (names.empty() ? "" : ", ") + p.name;
+    return refuse(I::UnknownParameter, "the " + model.start->structureName() + " model has no parameter '" + name +
+                                           "'" + what + " (its parameters: " + names + ")");
+  };
+  for (const auto& v : startValues)
+    if (model.start->indexOf(v.name) < 0) return unknown(v.name, "");
+  for (const auto& b : bounds)
+    if (model.start->indexOf(b.name) < 0) return unknown(b.name, " to bound");
+  try {
+    FitOptions dataless = *this;  // the log's own gear ratio is the data's business (fitModel)
+    dataless.estimation.clear();
+    const auto start = fitStartModel(dataless);
+    bool anyFree = false;
+    for (const auto& p : start->parameters()) anyFree = anyFree || p.free;
+    if (!anyFree) return refuse(I::NoFreeParameter, "a physical fit needs at least one free parameter");
+  } catch (const std::invalid_argument& e) {
+    return refuse(I::OutsideBounds, e.what());
+  }
+  return {};
+}
+
+FitCheck FitOptions::check() const {
+  if (FitCheck c = checkExceptData(); !c.ok()) return c;
+  for (const auto* list : {&estimation, &validation})
+    for (const auto& e : *list)
+      if (!e.data) return refuse(FitIssue::NoData, "an experiment has no data");
+  return {};
+}
+
+bool FitOptions::isValidExceptData(std::string* why) const {
+  const FitCheck c = checkExceptData();
+  if (why) *why = c.message;
+  return c.ok();
 }
 
 bool FitOptions::isValid(std::string* why) const {
-  if (!isValidExceptData(why)) return false;
-  for (const auto* list : {&estimation, &validation})
-    for (const auto& e : *list)
-      if (!e.data) {
-        if (why) *why = "an experiment has no data";
-        return false;
-      }
-  return true;
+  const FitCheck c = check();
+  if (why) *why = c.message;
+  return c.ok();
+}
+
+const char* toString(FitIssue i) {
+  switch (i) {
+    case FitIssue::None: return "none";
+    case FitIssue::NoStartModel: return "no-start-model";
+    case FitIssue::NoFreeParameter: return "no-free-parameter";
+    case FitIssue::InvalidEffect: return "invalid-effect";
+    case FitIssue::EffectTwice: return "effect-twice";
+    case FitIssue::EffectChangesStructure: return "effect-changes-structure";
+    case FitIssue::EffectNeedsGearSpring: return "effect-needs-gear-spring";
+    case FitIssue::EncoderSkewNeedsArm: return "encoder-skew-needs-arm";
+    case FitIssue::ArmOutputNeedsVelocity: return "arm-output-needs-velocity";
+    case FitIssue::EffectsTakeOneOutput: return "effects-take-one-output";
+    case FitIssue::InvalidOrders: return "invalid-orders";
+    case FitIssue::InvalidWindow: return "invalid-window";
+    case FitIssue::NoEstimationData: return "no-estimation-data";
+    case FitIssue::NoData: return "no-data";
+    case FitIssue::OneExperimentOnly: return "one-experiment-only";
+    case FitIssue::EmptyRange: return "empty-range";
+    case FitIssue::OutOfRange: return "out-of-range";
+    case FitIssue::MethodNeedsPhysical: return "method-needs-physical";
+    case FitIssue::MethodExcludesEffects: return "method-excludes-effects";
+    case FitIssue::MethodExcludesDecimation: return "method-excludes-decimation";
+    case FitIssue::InvalidMethodOptions: return "invalid-method-options";
+    case FitIssue::ExcludesInnovations: return "excludes-innovations";
+    case FitIssue::IndirectExcludesDecimation: return "indirect-excludes-decimation";
+    case FitIssue::EffectsNeedDirect: return "effects-need-direct";
+    case FitIssue::InvalidController: return "invalid-controller";
+    case FitIssue::UnknownParameter: return "unknown-parameter";
+    case FitIssue::OutsideBounds: return "outside-bounds";
+    case FitIssue::PhysicalOnly: return "physical-only";
+  }
+  return "none";
+}
+
+const char* toString(FitStatus s) {
+  switch (s) {
+    case FitStatus::Ok: return "ok";
+    case FitStatus::BadRequest: return "bad-request";
+    case FitStatus::BadData: return "bad-data";
+    case FitStatus::Failed: return "failed";
+    case FitStatus::Cancelled: return "cancelled";
+  }
+  return "failed";
+}
+
+const char* toString(FitWarning w) {
+  switch (w) {
+    case FitWarning::Other: return "other";
+    case FitWarning::MaxIterations: return "max-iterations";
+    case FitWarning::OnBound: return "on-bound";
+    case FitWarning::SkippedStarts: return "skipped-starts";
+    case FitWarning::Unstable: return "unstable";
+    case FitWarning::ClosedLoopBias: return "closed-loop-bias";
+    case FitWarning::ZeroOrderHold: return "zero-order-hold";
+    case FitWarning::SmoothingSpeed: return "smoothing-speed";
+    case FitWarning::LinearPartResponse: return "linear-part-response";
+    case FitWarning::RandomStartsUnused: return "random-starts-unused";
+    case FitWarning::DeflectionDiverges: return "deflection-diverges";
+  }
+  return "other";
+}
+
+void FitResult::warn(FitWarning code, std::string text) {
+  warningCodes.resize(warnings.size(), FitWarning::Other);  // any added without a code
+  warnings.push_back(std::move(text));
+  warningCodes.push_back(code);
+}
+
+FitWarning FitResult::warningCode(std::size_t i) const {
+  return i < warningCodes.size() ? warningCodes[i] : FitWarning::Other;
+}
+
+bool FitResult::warned(FitWarning code) const {
+  for (std::size_t i = 0; i < warnings.size(); ++i)
+    if (warningCode(i) == code) return true;
+  return false;
 }
 
 std::optional<double> FitResult::fitValidation() const {
@@ -396,6 +527,9 @@ FitResult fitModel(const FitOptions& options, const ProgressCallback& progress) 
   auto finish = [&](Termination t, std::string message) -> FitResult {
     r.termination = t;
     r.message = std::move(message);
+    if (t == Termination::Cancelled) r.status = FitStatus::Cancelled;
+    else if (r.ok()) r.status = FitStatus::Ok;
+    else if (r.status != FitStatus::BadData && r.status != FitStatus::BadRequest) r.status = FitStatus::Failed;
     r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     return std::move(r);
   };
@@ -405,7 +539,7 @@ FitResult fitModel(const FitOptions& options, const ProgressCallback& progress) 
     for (const auto& e : options.estimation) {
       std::string bad;
       if (!logGearRatio(*e.data, &bad) && !bad.empty()) {
-        r.badData = true;
+        r.status = FitStatus::BadData;
         return finish(Termination::Failed, bad);
       }
     }
@@ -423,8 +557,10 @@ FitResult fitModel(const FitOptions& options, const ProgressCallback& progress) 
     d.decimatedInput = FitDataOptions::DecimatedInput::HeldMean;
   // The effects act on the real torque, velocity and angle: their means stay.
   d.removeMeans = options.removeMeans && !options.model.nonlinear() && !inverse;
-  r.badData = !prepareEstimation(options, d, r) || !prepareValidation(options, d, r);
-  if (r.badData) return finish(r.termination, r.message);
+  if (!prepareEstimation(options, d, r) || !prepareValidation(options, d, r)) {
+    r.status = FitStatus::BadData;
+    return finish(r.termination, r.message);
+  }
   const bool nonparametric = options.model.kind == FitModelKind::Spa || options.model.kind == FitModelKind::Etfe;
   bool constant = true;
   for (const auto& e : r.estimation) {
@@ -461,8 +597,10 @@ FitResult fitModel(const FitOptions& options, const ProgressCallback& progress) 
         std::string tooMuch;
         long long samples = 0;  // of every estimation experiment
         for (const auto& e : r.estimation) samples += static_cast<long long>(e.data.estimation.size());
-        r.badRequest = !options.model.orders.fitsData(options.model.structure, samples, &tooMuch);
-        if (r.badRequest) return finish(Termination::Failed, tooMuch);
+        if (!options.model.orders.fitsData(options.model.structure, samples, &tooMuch)) {
+          r.status = FitStatus::BadRequest;
+          return finish(Termination::Failed, tooMuch);
+        }
         fitBlackBox(options, r, progress);
         break;
       }
@@ -476,9 +614,10 @@ FitResult fitModel(const FitOptions& options, const ProgressCallback& progress) 
   }
   if (!r.summary.ok()) return finish(r.summary.termination, r.summary.message);
   if (r.summary.termination == Termination::MaxIterations)
-    r.warnings.push_back("the estimator stopped at its limit of " + std::to_string(options.maxIterations) +
-                         " iterations before it converged, so the estimate may not be the loss's minimum "
-                         "and its intervals may not hold; raise the iteration limit");
+    r.warn(FitWarning::MaxIterations, "the estimator stopped at its limit of " +
+                                          std::to_string(options.maxIterations) +
+                                          " iterations before it converged, so the estimate may not be the "
+                                          "loss's minimum and its intervals may not hold; raise the iteration limit");
 
   // 5. Evaluation.
   try {

@@ -80,6 +80,8 @@ struct FitModelSpec {
 enum class ClosedLoopChoice { Auto, Direct, TwoStage, Indirect };
 const char* toString(ClosedLoopChoice c);  // "auto", "direct", "two-stage", "indirect"
 std::optional<ClosedLoopChoice> closedLoopChoiceFromString(std::string_view s);
+// What the choice does, in a clause (help texts, tooltips).
+const char* describe(ClosedLoopChoice c);
 
 // How a physical model is estimated: by prediction error (the seed's (5.7), the default), or
 // its rigid part by inverse dynamics in closed form (core/ident/idim.h): least squares
@@ -87,6 +89,7 @@ std::optional<ClosedLoopChoice> closedLoopChoiceFromString(std::string_view s);
 enum class FitMethod { PredictionError, Idim, IdimIv };
 const char* toString(FitMethod m);  // "pem", "idim", "idim-iv"
 std::optional<FitMethod> fitMethodFromString(std::string_view s);
+const char* describe(FitMethod m);
 
 // A value of one physical parameter, by the name parameters() gives it (e.g. "J_m", "k_g").
 struct ParameterValue {
@@ -110,6 +113,46 @@ bool startsAndBoundsFromText(const std::string& text, std::vector<ParameterValue
                              std::vector<ParameterBound>& bounds, std::string* why);
 // The same as text: start values, then bounds.
 std::string startsAndBoundsText(const std::vector<ParameterValue>& starts, const std::vector<ParameterBound>& bounds);
+
+// Why a fit request (FitOptions) is refused: the rule it breaks, beside the sentence.
+enum class FitIssue {
+  None,
+  NoStartModel,            // a physical fit without its start model
+  NoFreeParameter,         // nothing to estimate
+  InvalidEffect,           // an effect's values are not physical
+  EffectTwice,
+  EffectChangesStructure,  // extra_mass: fit the larger structure instead
+  EffectNeedsGearSpring,   // backlash, nonlinear_spring on a model without a gear spring
+  EncoderSkewNeedsArm,     // encoder_skew without the arm as an output
+  ArmOutputNeedsVelocity,  // the arm as a second output goes with the motor velocity
+  EffectsTakeOneOutput,    // effects with the arm acceleration output
+  InvalidOrders,           // black-box orders (4.8)
+  InvalidWindow,           // SPA / ETFE window
+  NoEstimationData,        // no estimation experiment
+  NoData,                  // an experiment without its log
+  OneExperimentOnly,       // SPA, ETFE, two-stage, indirect and inverse dynamics take one
+  EmptyRange,              // a range with start >= end
+  OutOfRange,              // decimation, iterations, starts, level, points or depth out of range
+  MethodNeedsPhysical,     // idim / idim-iv of a black-box model
+  MethodExcludesEffects,
+  MethodExcludesDecimation,
+  InvalidMethodOptions,    // the inverse dynamics' filters
+  ExcludesInnovations,     // an output-error method (two-stage, indirect, effects) and the innovations form
+  IndirectExcludesDecimation,
+  EffectsNeedDirect,       // effects and the two-stage or indirect fit
+  InvalidController,       // the controller of the indirect fit or its identification
+  UnknownParameter,        // a start value, bound or free name the model does not have
+  OutsideBounds,           // a start value outside its bounds, or bounds LO > HI
+  PhysicalOnly,            // start values, bounds, the innovations form, random starts or a
+                           // closed-loop method asked of a black-box or non-parametric model
+};
+const char* toString(FitIssue i);  // "none", "no-start-model", ... (the enum in kebab case)
+
+struct FitCheck {
+  FitIssue issue = FitIssue::None;
+  std::string message;  // empty when ok
+  bool ok() const { return issue == FitIssue::None; }
+};
 
 // One experiment: a log and the part of it used.
 struct FitExperiment {
@@ -173,7 +216,11 @@ struct FitOptions {
   // extremum needs to count as a notch or peak (dB; non-parametric curves use 3).
   int responsePoints = 2000;
   double notchDepthDb = 1.0;
-  // Everything but the experiments' data (what a session stores).
+  // The request checked in one place, for every front end: the code of the first rule it
+  // breaks and a sentence (FitCheck). checkExceptData: everything but the experiments' data
+  // (what a session stores).
+  FitCheck checkExceptData() const;
+  FitCheck check() const;
   bool isValidExceptData(std::string* why) const;
   bool isValid(std::string* why) const;
 };
@@ -235,16 +282,39 @@ double encoderSkewOf(const std::vector<Effect>& effects);
 // both.
 Eigen::VectorXd measuredDeflection(const PreparedData& d, double gearRatio);
 
+// What became of a fit, beside its sentence (FitResult::message).
+enum class FitStatus {
+  Ok,          // an estimate: converged, or at the iteration limit (a warning says so)
+  BadRequest,  // the options ask for more than the data can carry (polynomial orders beyond
+               // the samples or the work FlexArm allows): a request to change
+  BadData,     // the data cannot carry the fit asked for (no usable channel or range, a
+               // closed-loop method the log cannot run, a gear ratio that is no ratio)
+  Failed,      // the estimator failed, diverged or met numerical trouble on usable data
+  Cancelled,
+};
+const char* toString(FitStatus s);  // "ok", "bad-request", "bad-data", "failed", "cancelled"
+
+// What a warning of a fit is about, beside its sentence (FitResult::warnings).
+enum class FitWarning {
+  Other,
+  MaxIterations,       // the estimator stopped at its iteration limit
+  OnBound,             // a parameter ended on one of its bounds
+  SkippedStarts,       // random starts skipped for numerical trouble
+  Unstable,            // G is unstable: no fit % of the simulated output
+  ClosedLoopBias,      // a closed-loop log fitted by a method the feedback biases (4.43)
+  ZeroOrderHold,       // decimated data: the intervals ignore the zero-order hold's error
+  SmoothingSpeed,      // coulomb_friction's v_s set from the data's speed
+  LinearPartResponse,  // the response of a fit with effects is its linear part's
+  RandomStartsUnused,  // a fit with effects starts from the values given only
+  DeflectionDiverges,  // the deflection check could not simulate the estimate
+};
+const char* toString(FitWarning w);  // "other", "max-iterations", "on-bound", ...
+
 struct FitResult {
   Termination termination = Termination::Failed;
   std::string message;  // a sentence: how it ended, or why it failed
   double seconds = 0.0;
-  // The data cannot carry the fit asked for (no usable channel or range, a closed-loop method
-  // the log cannot run), as opposed to an estimator that failed on them.
-  bool badData = false;
-  // The options ask for more than the data can carry (polynomial orders beyond the samples
-  // or the work FlexArm allows): a request to change, not an estimator that failed.
-  bool badRequest = false;
+  FitStatus status = FitStatus::Failed;
 
   FitModelSpec model;
   PreparedData data;  // the (first) estimation experiment as prepared
@@ -306,8 +376,14 @@ struct FitResult {
   bool residualsOnValidation = false;
   FrequencyResponse response;
   std::vector<double> notches, peaks;  // rad/s (5.4)
-  // Sentences for the user: biased method, unstable model, intervals to read with care.
+  // Sentences for the user: biased method, unstable model, intervals to read with care; the
+  // code of each in warningCodes (same order; warn() keeps them in step).
   std::vector<std::string> warnings;
+  std::vector<FitWarning> warningCodes;
+  void warn(FitWarning code, std::string text);
+  // The code of warnings[i] (Other for one added without a code).
+  FitWarning warningCode(std::size_t i) const;
+  bool warned(FitWarning code) const;
   // Sentences beside the numbers of a physical fit whose parameters are physically absurd: an
   // interval wider than its value, an inertia or stiffness orders of magnitude outside the
   // range of robot axes, a resonance the data cannot see, a gear ratio the log never stated.

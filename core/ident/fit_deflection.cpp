@@ -32,7 +32,7 @@ void deflectionCheck(const FitOptions& o, FitResult& r) {
   const auto b = static_cast<Eigen::Index>(d.estimation.begin), n = static_cast<Eigen::Index>(d.estimation.size());
   const Eigen::VectorXd predicted = predictedDeflection(o, r, d, d.estimation);
   if (predicted.size() != n) {
-    r.warnings.push_back("the estimate's deflection diverges when simulated, so it cannot be checked against the "
+    r.warn(FitWarning::DeflectionDiverges, "the estimate's deflection diverges when simulated, so it cannot be checked against the "
                          "arm-side encoder");
     return;
   }

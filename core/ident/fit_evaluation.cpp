@@ -94,7 +94,7 @@ void intervalCaveats(const FitOptions& o, FitResult& r) {
                          : " after decimation",
                   1e3 * d.sampleTime, controllerHz > 0.0 ? 1e3 / controllerHz : 1e3 * d.sampleTime / d.decimation,
                   kDecimatedCoverage, kDecimatedBias);
-    r.warnings.push_back(buf);
+    r.warn(FitWarning::ZeroOrderHold, buf);
   }
 }
 
@@ -190,7 +190,7 @@ void evaluate(const FitOptions& o, FitResult& r) {
           v.fitPercent.reset();
           v.fitPercentNrmse.reset();
         }
-      r.warnings.push_back("the model's G is unstable, so its simulated output diverges and the fit % is "
+      r.warn(FitWarning::Unstable, "the model's G is unstable, so its simulated output diverges and the fit % is "
                            "undefined; it can still predict one step ahead");
     }
     // Residual tests on the first validation experiment, else on the estimation range.
@@ -216,11 +216,11 @@ void evaluate(const FitOptions& o, FitResult& r) {
     r.notches = np.notches;
     r.peaks = np.peaks;
   }
-  if (nonparametric && !r.nonparametric.warning.empty()) r.warnings.push_back(r.nonparametric.warning);
+  if (nonparametric && !r.nonparametric.warning.empty()) r.warn(FitWarning::ClosedLoopBias, r.nonparametric.warning);
   if (r.method == ClosedLoopMethod::Direct && d.closedLoop &&
       (o.closedLoop == ClosedLoopChoice::Direct || o.model.nonlinear() ||
        (r.estimation.size() > 1 && o.noiseModel == NoiseModel::OutputError)))
-    r.warnings.push_back(std::string("the log was recorded in closed loop: only models with a flexible, "
+    r.warn(FitWarning::ClosedLoopBias, std::string("the log was recorded in closed loop: only models with a flexible, "
                                      "independently parameterized noise model (BJ) are free of bias (4.43); "
                                      "on simulated logs at the sample logs' noise only ") +
                          kDirectCoverage + " of the direct fit's 99 % intervals held the truth");
@@ -229,7 +229,7 @@ void evaluate(const FitOptions& o, FitResult& r) {
     deflectionCheck(o, r);
   }
   if (r.polynomial && d.closedLoop && r.polynomial->structure != PolyStructure::Bj)
-    r.warnings.push_back("the log was recorded in closed loop: only models with a flexible, independently "
+    r.warn(FitWarning::ClosedLoopBias, "the log was recorded in closed loop: only models with a flexible, independently "
                          "parameterized noise model (BJ) are free of bias (4.43)");
 }
 

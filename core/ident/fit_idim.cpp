@@ -24,6 +24,17 @@ std::optional<FitMethod> fitMethodFromString(std::string_view s) {
   return std::nullopt;
 }
 
+const char* describe(FitMethod m) {
+  switch (m) {
+    case FitMethod::PredictionError: return "prediction error (5.7)";
+    case FitMethod::Idim:
+      return "the rigid part by inverse dynamics in closed form (IDIM-LS): tau = J q'' + F_v q' + F_c sign(q') + "
+             "offset by least squares on the low-passed, differentiated position";
+    case FitMethod::IdimIv: return "the same with instruments from the position reference (IDIM-IV, closed loop)";
+  }
+  return "";
+}
+
 namespace fit_detail {
 namespace {
 
@@ -63,7 +74,7 @@ bool fitIdim(const FitOptions& o, FitResult& r) {
   auto fail = [&r](const std::string& text) {
     r.termination = Termination::Failed;
     r.message = text;
-    r.badData = true;
+    r.status = FitStatus::BadData;
     return false;
   };
   Eigen::VectorXd q, tau, ref;

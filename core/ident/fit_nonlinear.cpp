@@ -113,7 +113,7 @@ void fitNonlinear(const FitOptions& o, FitResult& r, const ProgressCallback& pro
         char buf[160];
         std::snprintf(buf, sizeof buf, "coulomb_friction's smoothing speed v_s = %.3g, 1 %% of the data's RMS "
                       "motor speed %.3g", r.smoothingSpeed, speed);
-        r.warnings.push_back(buf);
+        r.warn(FitWarning::SmoothingSpeed, buf);
       }
   }
   NonlinearPemOptions no = nonlinearOptions(o, r);
@@ -128,7 +128,7 @@ void fitNonlinear(const FitOptions& o, FitResult& r, const ProgressCallback& pro
         r.summary.message = std::string("the arm as an output needs the motor angle and the arm-side encoder's ") +
                             columns::kArmAngle + " in the log, and it has no " +
                             (d.arm.size() != d.u.size() ? columns::kArmAngle : columns::kMotorAngle);
-        r.badData = true;
+        r.status = FitStatus::BadData;
         return;
       }
       experiments[i].deflection.resize(static_cast<std::size_t>(n));
@@ -199,10 +199,10 @@ void keepNonlinear(NonlinearPemResult&& e, const FitOptions& o, const PhysicalMo
   r.physical = std::shared_ptr<const PhysicalModel>(std::move(e.model));
   if (r.summary.ok()) boundWarnings(start, r);
   if (!r.effects.empty())
-    r.warnings.push_back("the frequency response, its notches and peaks are of the model's linear part (the "
+    r.warn(FitWarning::LinearPartResponse, "the frequency response, its notches and peaks are of the model's linear part (the "
                          "effects left out)");
   if (o.randomStarts > 0)
-    r.warnings.push_back("random starts are not used by a fit with effects: it starts from the values given");
+    r.warn(FitWarning::RandomStartsUnused, "random starts are not used by a fit with effects: it starts from the values given");
 }
 
 }  // namespace flexarm::fit_detail

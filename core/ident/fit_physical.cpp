@@ -154,7 +154,7 @@ void keepEstimate(PemResult&& e, const FitOptions& o, FitResult& r) {
   (void)o;
   r.summary = e.summary;
   if (e.skippedStarts > 0)
-    r.warnings.push_back(std::to_string(e.skippedStarts) + " of " + std::to_string(e.starts) +
+    r.warn(FitWarning::SkippedStarts, std::to_string(e.skippedStarts) + " of " + std::to_string(e.starts) +
                          " starts were skipped for numerical trouble (" + e.skipReason + ")");
   for (const auto& p : e.parameters)
     r.parameters.push_back({p.name, p.unit, p.value, p.std, p.lower, p.upper, p.free, ""});
@@ -185,7 +185,7 @@ void boundWarnings(const PhysicalModel& start, FitResult& r) {
     };
     const bool low = near(p.lower), high = !low && near(p.upper);
     if (!low && !high) continue;
-    r.warnings.push_back(q.name + " sits on its " + (low ? "lower" : "upper") + " bound " +
+    r.warn(FitWarning::OnBound, q.name + " sits on its " + (low ? "lower" : "upper") + " bound " +
                          number(low ? p.lower : p.upper) + "; the data would push it " +
                          (low ? "below" : "above") + " (its interval does not account for the bound; " +
                          "widen the bound to let it go further)");
@@ -204,7 +204,7 @@ bool fitPhysical(const FitOptions& o, FitResult& r, const ProgressCallback& prog
   auto fail = [&r](const std::string& text) {  // the log cannot carry the method asked for
     r.termination = Termination::Failed;
     r.message = text;
-    r.badData = true;
+    r.status = FitStatus::BadData;
     return false;
   };
   PemOptions po;

@@ -3,6 +3,7 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "core/ident/fit_json.h"
 #include "core/session/json_fields.h"
 #include "core/session/model_json.h"
 
@@ -33,6 +34,17 @@ FitOptions fitOptionsOf(const FitRequest& request, std::shared_ptr<const IdData>
   return o;
 }
 
+FitRequest fitRequestOf(const FitOptions& options, const std::vector<ExperimentSource>& more) {
+  FitRequest r;
+  r.options = options;
+  r.options.estimation.clear();
+  r.options.validation.clear();
+  if (!options.estimation.empty()) r.estimation = options.estimation.front().range;
+  if (!options.validation.empty()) r.validation = options.validation.front().range;
+  r.experiments = more;
+  return r;
+}
+
 StoredFit storedFitOf(const FitResult& result) {
   StoredFit s;
   s.parameters = result.parameters;
@@ -45,17 +57,15 @@ StoredFit storedFitOf(const FitResult& result) {
 }
 
 json storedFitToJson(const StoredFit& fit) {
-  json params = json::array();
-  for (const auto& p : fit.parameters) {
-    json q = {{"name", p.name}, {"unit", p.unit}, {"value", jsonNumber(p.value)}, {"std", jsonNumber(p.std)},
-              {"lower", jsonNumber(p.lower)}, {"upper", jsonNumber(p.upper)}, {"free", p.free}};
-    if (!p.effect.empty()) q["effect"] = p.effect;
-    params.push_back(q);
-  }
-  json j = {{"parameters", params}, {"loss", jsonNumber(fit.loss)},
-            {"notches_rad_s", fit.notches}, {"peaks_rad_s", fit.peaks}};
-  if (fit.fitEstimation) j["fit_estimation_percent"] = jsonNumber(*fit.fitEstimation);
-  if (fit.fitValidation) j["fit_validation_percent"] = jsonNumber(*fit.fitValidation);
+  // The keys of fitResultJson, written by its pieces: a stored fit is a part of a fit result.
+  json j = {{"format", kFitJsonFormat},
+            {"version", kFitJsonVersion},
+            {"loss", fit.loss},
+            {"fit_percent", fitPercentJson(fit.fitEstimation)},
+            {"fit_percent_validation", fitPercentJson(fit.fitValidation)},
+            {"notches_rad_s", fit.notches},
+            {"peaks_rad_s", fit.peaks}};
+  addFitParameters(j, fit.parameters);
   return j;
 }
 
@@ -66,10 +76,16 @@ std::optional<StoredFit> storedFitFromJson(const json& j, std::string* why) {
     return std::nullopt;
   };
   if (!j.is_object()) return fail("must be an object");
+  // Sessions written before the fit schema's version 2 name the rows "parameters" and the fit
+  // percentages fit_estimation_percent and fit_validation_percent.
+  const bool before2 = !j.contains("version");
+  if (!before2 && (!j["version"].is_number_integer() || j["version"].get<int>() > kFitJsonVersion))
+    return fail("is of a fit schema newer than version " + std::to_string(kFitJsonVersion));
+  const char* rowsKey = before2 ? "parameters" : "parameter_rows";
   StoredFit s;
-  if (!j.contains("parameters") || !j["parameters"].is_array()) return fail("parameters must be a list");
-  if (j["parameters"].size() > 1000) return fail("more than 1000 parameters");
-  for (const auto& p : j["parameters"]) {
+  if (!j.contains(rowsKey) || !j[rowsKey].is_array()) return fail(std::string(rowsKey) + " must be a list");
+  if (j[rowsKey].size() > 1000) return fail("more than 1000 parameters");
+  for (const auto& p : j[rowsKey]) {
     FitParameter q;
     if (!readText(p, "name", q.name, true, why, where) || !readText(p, "unit", q.unit, false, why, where) ||
         !readNumber(p, "value", q.value, true, why, where) || !readNumber(p, "std", q.std, false, why, where) ||
@@ -80,9 +96,9 @@ std::optional<StoredFit> storedFitFromJson(const json& j, std::string* why) {
     s.parameters.push_back(q);
   }
   if (!readNumber(j, "loss", s.loss, false, why, where)) return std::nullopt;
-  for (auto [key, target] : {std::pair{"fit_estimation_percent", &s.fitEstimation},
-                             std::pair{"fit_validation_percent", &s.fitValidation}}) {
-    if (!j.contains(key)) continue;
+  for (auto [key, target] : {std::pair{before2 ? "fit_estimation_percent" : "fit_percent", &s.fitEstimation},
+                             std::pair{before2 ? "fit_validation_percent" : "fit_percent_validation", &s.fitValidation}}) {
+    if (!j.contains(key) || j[key].is_null()) continue;
     double v = 0.0;
     if (!readNumber(j, key, v, true, why, where)) return std::nullopt;
     *target = v;
@@ -353,7 +369,7 @@ FitResult runFitRequest(const FitRequest& request, const IdData& data, const Pro
   ExperimentLogs logs;
   if (!appendExperiments(options, request.experiments, LogReadOptions{}, logs, &why)) {
     FitResult failed;
-    failed.badData = true;
+    failed.status = FitStatus::BadData;
     failed.message = why;
     return failed;
   }

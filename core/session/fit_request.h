@@ -28,9 +28,10 @@ struct StoredFit {
   std::vector<double> notches, peaks;
 };
 StoredFit storedFitOf(const FitResult& result);
-// {"parameters": [{"name", "unit", "value", "std", "lower", "upper", "free", "effect" (an
-// effect's parameter only)}], "loss",
-// "fit_estimation_percent", "fit_validation_percent", "notches_rad_s", "peaks_rad_s"}.
+// The keys of fitResultJson (core/ident/fit_json.h) it has: {"format", "version",
+// "parameters", "std", "parameter_rows", "loss", "fit_percent", "fit_percent_validation", "notches_rad_s",
+// "peaks_rad_s"}; read back from those, or from a session written before version 2 of the fit
+// schema ("parameters" a list of rows, "fit_estimation_percent", "fit_validation_percent").
 nlohmann::json storedFitToJson(const StoredFit& fit);
 std::optional<StoredFit> storedFitFromJson(const nlohmann::json& j, std::string* why);
 
@@ -55,6 +56,10 @@ struct FitRequest {
 // The pipeline's options for the request on data: one estimation experiment over its range
 // and, with a validation range, one validation experiment on the same log.
 FitOptions fitOptionsOf(const FitRequest& request, std::shared_ptr<const IdData> data);
+// The request of options run on one log (its first estimation and validation experiments'
+// ranges) and more experiments: the same options without their data, no name, provenance or
+// result yet. fitOptionsOf of it on the same log gives the options back.
+FitRequest fitRequestOf(const FitOptions& options, const std::vector<ExperimentSource>& more);
 
 // {"name", "kind": "physical" | "black-box", "decimation", "max_iterations", "estimation_s",
 // "validation_s", physical: "start" (a model with its effects), "effects_free" (per effect,

@@ -167,8 +167,11 @@ class ModelsPart : public SessionPart {
       const auto samples = static_cast<std::size_t>(c.models.front().output.size());
       fit.rows.push_back({toString(range), std::to_string(samples), formatFixed(f.percent.seed52, 2),
                           formatFixed(f.percent.nrmse, 2), fitBasisText(f.basis)});
-      s.values[std::string("fit_") + toString(range) + "_percent"] = f.percent.seed52;
-      s.values[std::string("fit_") + toString(range) + "_basis"] = fitBasisJson(f.basis);
+      // The fit schema's names (core/ident/fit_json.h): fit_percent of the estimation range,
+      // fit_percent_validation of the validation range, each with what it is of.
+      const std::string suffix = range == DataRange::Estimation ? "" : "_validation";
+      s.values["fit_percent" + suffix] = f.percent.seed52;
+      s.values["fit_basis" + suffix] = fitBasisJson(f.basis);
       shown = std::move(c);
     }
     if (fit.rows.empty()) return;

@@ -125,8 +125,8 @@ TEST(CliCompare, ASessionsComparePartReplaysTheVerbsNumbers) {
     const std::string title = s["title"];
     if (title.rfind("Compare", 0) == 0) compare = &s["values"];
     if (title.rfind("Residual analysis", 0) == 0) residuals = &s["values"];
-    if (title.rfind("Model ", 0) == 0 && s["values"].contains("fit_validation_percent"))
-      modelSections[title.substr(6)] = s["values"]["fit_validation_percent"].get<double>();
+    if (title.rfind("Model ", 0) == 0 && s["values"].contains("fit_percent_validation"))
+      modelSections[title.substr(6)] = s["values"]["fit_percent_validation"].get<double>();
   }
   ASSERT_TRUE(compare && residuals);
   ASSERT_EQ((*compare)["models"].size(), 2u);

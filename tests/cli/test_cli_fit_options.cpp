@@ -39,6 +39,13 @@ json jsonRun(std::vector<std::string> args) {
   return r.code == 0 ? json::parse(r.out) : json::object({{"warnings", json::array()}});
 }
 
+// How many warnings of the JSON carry the code (FitWarning).
+int codeCount(const json& j, const std::string& code) {
+  int n = 0;
+  for (const auto& c : j["warning_codes"]) n += c == code;
+  return n;
+}
+
 std::string warnings(const json& j) {
   std::string all;
   for (const auto& w : j["warnings"]) all += w.get<std::string>() + "\n";
@@ -83,11 +90,10 @@ TEST(CliFitOptions, ABoundHoldsAndIsNamed) {
   const json j = jsonRun(args);
   ASSERT_TRUE(j.contains("parameters"));
   EXPECT_NEAR(j["parameters"]["J_m"].get<double>(), 5e-4, 1e-12);  // the truth is 9e-4
-  EXPECT_NE(warnings(j).find("J_m sits on its upper bound 0.0005; the data would push it above"), std::string::npos)
-      << warnings(j);
+  EXPECT_EQ(codeCount(j, "on-bound"), 1) << warnings(j);
   auto r = runFlexarm(args);
   ASSERT_EQ(r.code, 0) << r.err;
-  EXPECT_NE(r.out.find("warning: J_m sits on its upper bound"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("warning: J_m sits on its upper bound"), std::string::npos) << r.out;  // the text names it
   r = runFlexarm({"fit", twoMassLog(), "--model", "two-mass", "--bound", "J_m=5:1"});
   EXPECT_EQ(r.code, 2);
   EXPECT_NE(r.err.find("NAME=LO:HI"), std::string::npos) << r.err;
@@ -101,9 +107,6 @@ TEST(CliFitOptions, RandomStartsOnTheDaisyLogAreNeverAUsageError) {
                                "--starts", starts, "--json"});
     EXPECT_TRUE(r.code == 0 || r.code == 4) << model << ": " << r.code << " " << r.err;
     EXPECT_EQ(r.err.find("outside its bounds"), std::string::npos) << r.err;
-    if (r.code == 4) {
-      EXPECT_NE(r.err.find("the fit failed: "), std::string::npos) << r.err;
-    }
     if (r.code == 0) {
       EXPECT_TRUE(json::accept(r.out)) << r.out;
     }
@@ -141,7 +144,8 @@ TEST(CliFitOptions, MaxIterationsIsAWarning) {
                                          "--max-iterations", "3"};
   const json j = jsonRun(args);
   EXPECT_EQ(j["termination"], "max-iterations");
-  EXPECT_NE(warnings(j).find("stopped at its limit of 3 iterations"), std::string::npos) << warnings(j);
+  EXPECT_EQ(j["status"], "ok");  // an estimate, with a warning
+  EXPECT_EQ(codeCount(j, "max-iterations"), 1) << warnings(j);
   const auto r = runFlexarm(args);
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_NE(r.out.find("warning: the estimator stopped at its limit of 3 iterations"), std::string::npos) << r.out;

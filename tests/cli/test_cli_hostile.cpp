@@ -194,10 +194,10 @@ TEST(Hostile, Utf16AndByteOrderMarksAreNamed) {
 TEST(Hostile, IterationAndStartCountsOutOfRangeAreUsageErrorsInWords) {
   const MeasuredRun a = runFlexarmMeasured({"fit", kSample, "--model", "two-mass",
                                             "--max-iterations", "1e12"});
-  expectRefused(a, 2, "--max-iterations expects a whole number from 0 to 100000, got '1e12'", 100);
+  expectRefused(a, 2, "--max-iterations expects a whole number from 1 to 100000, got '1e12'", 100);
   const MeasuredRun b = runFlexarmMeasured({"fit", kSample, "--model", "two-mass",
                                             "--max-iterations", "1000000000000"});
-  expectRefused(b, 2, "--max-iterations expects a whole number from 0 to 100000", 100);
+  expectRefused(b, 2, "--max-iterations expects a whole number from 1 to 100000", 100);
   const MeasuredRun c = runFlexarmMeasured({"fit", kSample, "--model", "two-mass", "--starts",
                                             "1000000"});
   expectRefused(c, 2, "--starts expects a whole number from 0 to 1000, got '1000000'", 100);

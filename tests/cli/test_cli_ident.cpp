@@ -162,7 +162,7 @@ TEST(CliIdent, FitPhysicalOnAClosedLoopLogRunsTwoStageAndCoversTheTruth) {
     EXPECT_GT(s, 0.0) << p;
     EXPECT_LT(std::abs(v - t.at(p)), z * s) << p << " = " << v << " +- " << s << ", truth " << t.at(p);
   }
-  for (const auto& w : j["warnings"]) EXPECT_EQ(w.get<std::string>().find("(4.43)"), std::string::npos) << w;
+  for (const auto& w : j["warning_codes"]) EXPECT_NE(w, "closed-loop-bias") << j["warnings"];
 }
 
 TEST(CliIdent, BodeWritesMagnitudePhaseAndBandLimits) {
@@ -226,12 +226,11 @@ TEST(CliIdent, SpaLeavesOutFrequenciesWithoutInputPower) {
 
 TEST(CliIdent, BadRequestsExitWithUsageBadInputOrNumericalCodes) {
   // 2: usage.
+  // The rules behind these are the request's (FitOptions::check, FitSpec.* tests the codes).
   auto r = runFlexarm(daisy({"fit", "--model", "oe:6,6"}));
-  EXPECT_EQ(r.code, 2);
-  EXPECT_NE(r.err.find("needs 3 comma-separated integers"), std::string::npos) << r.err;
+  EXPECT_EQ(r.code, 2) << r.err;
   r = runFlexarm(daisy({"fit", "--model", "arx:2,2,1", "--free", "k_g"}));
-  EXPECT_EQ(r.code, 2);
-  EXPECT_NE(r.err.find("physical models only"), std::string::npos) << r.err;
+  EXPECT_EQ(r.code, 2) << r.err;
   r = runFlexarm({"fit", kChirp, "--model", "three-mass", "--free", "J_x"});
   EXPECT_EQ(r.code, 2);
   EXPECT_NE(r.err.find("no parameter 'J_x'"), std::string::npos) << r.err;
@@ -247,12 +246,10 @@ TEST(CliIdent, BadRequestsExitWithUsageBadInputOrNumericalCodes) {
   EXPECT_NE(r.err.find("auto, direct, two-stage or indirect"), std::string::npos) << r.err;
   r = runFlexarm({"fit", kChirp, "--model", "three-mass", "--closed-loop", "indirect",
                   "--decimate", "10"});
-  EXPECT_EQ(r.code, 2);
-  EXPECT_NE(r.err.find("excludes --decimate"), std::string::npos) << r.err;
+  EXPECT_EQ(r.code, 2) << r.err;
   r = runFlexarm({"fit", kChirp, "--model", "three-mass", "--closed-loop", "two-stage",
                   "--noise-model"});
-  EXPECT_EQ(r.code, 2);
-  EXPECT_NE(r.err.find("excludes --noise-model"), std::string::npos) << r.err;
+  EXPECT_EQ(r.code, 2) << r.err;
   EXPECT_EQ(runFlexarm(daisy({"bode", "--model", "arx:2,2,1"})).code, 2) << "--out missing";
   EXPECT_EQ(runFlexarm(daisy({"bode", "--model", "arx:2,2,1", "--out", "/tmp/x.csv", "--level",
                               "1.5"})).code, 2);
@@ -264,8 +261,7 @@ TEST(CliIdent, BadRequestsExitWithUsageBadInputOrNumericalCodes) {
   r = runFlexarm(daisy({"bode", "--model", "arx:2,2,1", "--out", "/no/such/dir/b.csv"}));
   EXPECT_EQ(r.code, 3);
   r = runFlexarm(daisy({"fit", "--model", "two-mass", "--closed-loop", "two-stage"}));
-  EXPECT_EQ(r.code, 3);
-  EXPECT_NE(r.err.find("needs a reference channel"), std::string::npos) << r.err;
+  EXPECT_EQ(r.code, 3) << r.err;  // FitStatus::BadData (Fit.AutoIsDirectWithoutReference*)
 
   // 3 again: a log whose input is constant zero carries no information, and is refused as
   // bad input naming the channel before any estimator runs (core/signal/excitation.h).

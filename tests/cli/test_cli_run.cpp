@@ -62,21 +62,23 @@ TEST(CliRun, PdfTextHasTitlesParametersChecksumAndTheJsonFitPercent) {
   int fits = 0, stds = 0;
   for (const auto& s : j["sections"]) {
     EXPECT_NE(text.find(s["title"].get<std::string>()), std::string::npos) << s["title"];
-    if (!s["values"].contains("parameters")) continue;
-    for (const auto& [name, value] : s["values"]["parameters"].items())
+    // A model's numbers are its section's values, a fit's the fit object in them.
+    const nlohmann::json& values = s["values"].contains("fit") ? s["values"]["fit"] : s["values"];
+    if (!values.contains("parameters")) continue;
+    for (const auto& [name, value] : values["parameters"].items())
       EXPECT_NE(text.find(name), std::string::npos) << name;
-    for (const char* key : {"fit_estimation_percent", "fit_validation_percent"}) {
+    for (const char* key : {"fit_percent", "fit_percent_validation"}) {
       char buf[32];
-      std::snprintf(buf, sizeof buf, "%.2f", s["values"][key].get<double>());
+      std::snprintf(buf, sizeof buf, "%.2f", values[key].get<double>());
       EXPECT_NE(text.find(buf), std::string::npos) << key << " " << buf;
       ++fits;
     }
-    if (!s["values"].contains("std")) continue;
+    if (!values.contains("std")) continue;
     // An estimate's table row: the name, its value and its std as printed (4 and 3 digits).
-    for (const auto& [name, sd] : s["values"]["std"].items()) {
+    for (const auto& [name, sd] : values["std"].items()) {
       if (sd.get<double>() == 0.0) continue;  // fixed
       char value[32], sdText[32];
-      std::snprintf(value, sizeof value, "%.6g", s["values"]["parameters"][name].get<double>());
+      std::snprintf(value, sizeof value, "%.6g", values["parameters"][name].get<double>());
       std::snprintf(sdText, sizeof sdText, "%.3g", sd.get<double>());
       const std::regex row(name + R"(\s+)" + std::regex_replace(value, std::regex(R"([.+])"), R"(\$&)") +
                            R"(\s+)" + std::regex_replace(sdText, std::regex(R"([.+])"), R"(\$&)") + R"(\s)");

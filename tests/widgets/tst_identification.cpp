@@ -195,7 +195,7 @@ class IdentificationTest : public QObject {
     const auto report = nlohmann::json::parse(rout.str());
     const nlohmann::json* replay = nullptr;
     for (const auto& section : report["sections"])
-      if (section["title"] == "Fit " + panel.name.toStdString()) replay = &section["values"];
+      if (section["title"] == "Fit " + panel.name.toStdString()) replay = &section["values"]["fit"];
     QVERIFY2(replay, rout.str().c_str());
 
     int free = 0;
@@ -213,8 +213,8 @@ class IdentificationTest : public QObject {
     }
     QCOMPARE(free, 4);
     QCOMPARE((*replay)["loss"].get<double>(), line["loss"].get<double>());
-    QCOMPARE((*replay)["fit_estimation_percent"].get<double>(), line["fit_percent"].get<double>());
-    QCOMPARE((*replay)["fit_validation_percent"].get<double>(), line["fit_percent_validation"].get<double>());
+    QCOMPARE((*replay)["fit_percent"].get<double>(), line["fit_percent"].get<double>());
+    QCOMPARE((*replay)["fit_percent_validation"].get<double>(), line["fit_percent_validation"].get<double>());
     QVERIFY((*replay)["notches_rad_s"] == line["notches_rad_s"]);
     const QString shown = QString::number(line["fit_percent_validation"].get<double>(), 'f', 1) + " %";
     QVERIFY2(fit->summaryText().contains(shown), qPrintable(shown + " not in " + fit->summaryText()));

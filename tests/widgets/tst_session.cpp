@@ -233,8 +233,8 @@ class SessionTest : public QObject {
       if (!isPhysical && s.title != "Fit " + blackBox.name.toStdString()) continue;
       ++found;
       const QString summary = isPhysical ? physicalSummary : blackBoxSummary;
-      for (const char* key : {"fit_estimation_percent", "fit_validation_percent"}) {
-        const QString shown = QString::number(s.values[key].get<double>(), 'f', 1) + " %";
+      for (const char* key : {"fit_percent", "fit_percent_validation"}) {
+        const QString shown = QString::number(s.values["fit"][key].get<double>(), 'f', 1) + " %";
         QVERIFY2(summary.contains(shown), qPrintable(shown + " not in " + summary));
       }
     }

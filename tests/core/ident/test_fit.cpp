@@ -114,8 +114,7 @@ TEST(Fit, AutoIsDirectWithoutReferenceAndTwoStageWhenDecimated) {
   o.closedLoop = ClosedLoopChoice::TwoStage;
   r = fitModel(o);
   EXPECT_EQ(r.termination, Termination::Failed);
-  EXPECT_TRUE(r.badData);
-  EXPECT_NE(r.message.find("needs a reference channel"), std::string::npos) << r.message;
+  EXPECT_EQ(r.status, FitStatus::BadData) << r.message;
 }
 
 // The pipeline adds preparation and evaluation around the estimators, nothing else: a black-box
@@ -147,9 +146,7 @@ TEST(Fit, BlackBoxAndSpaGiveWhatTheirEstimatorsGiveOnThePreparedData) {
                        static_cast<Eigen::Index>(p.validation.end)));
   ASSERT_EQ(r.parameters.size(), 8u);
   EXPECT_NEAR(r.parameters[0].upper - r.parameters[0].value, 2.5758 * r.parameters[0].std, 1e-3 * r.parameters[0].std);
-  bool warned = false;
-  for (const auto& w : r.warnings) warned = warned || w.find("(4.43)") != std::string::npos;
-  EXPECT_TRUE(warned) << "an OE model of closed-loop data is biased";
+  EXPECT_TRUE(r.warned(FitWarning::ClosedLoopBias)) << "an OE model of closed-loop data is biased";
 
   o.model.kind = FitModelKind::Spa;
   o.responsePoints = 100;
@@ -189,33 +186,31 @@ TEST(Fit, DataFailuresAreSentencesAndMisuseThrows) {
   // Dead data are refused by the data preparation, as bad data naming the channel.
   FitResult r = fitModel(physicalFit(flat));
   EXPECT_EQ(r.termination, Termination::Failed);
-  EXPECT_TRUE(r.badData);
+  EXPECT_EQ(r.status, FitStatus::BadData);
   EXPECT_NE(r.message.find("the channel torque_ref_nm carries no signal: it is constant (every sample is 0.3)"),
             std::string::npos)
       << r.message;
   r = fitModel(physicalFit(log, SecondsRange{5.0, 9.0}));
   EXPECT_EQ(r.termination, Termination::Failed);
-  EXPECT_TRUE(r.badData);
-  EXPECT_NE(r.message.find("holds no samples"), std::string::npos) << r.message;
+  EXPECT_EQ(r.status, FitStatus::BadData) << r.message;
 
   FitOptions o = physicalFit(log);
   o.decimation = 4;
   o.closedLoop = ClosedLoopChoice::Indirect;
-  std::string why;
-  EXPECT_FALSE(o.isValid(&why));
-  EXPECT_NE(why.find("controller's rate"), std::string::npos) << why;
+  EXPECT_EQ(o.check().issue, FitIssue::IndirectExcludesDecimation) << o.check().message;
   EXPECT_THROW(fitModel(o), std::invalid_argument);
   o = physicalFit(log);
   o.estimation.push_back(o.estimation.front());  // several experiments take the direct fit only
   o.closedLoop = ClosedLoopChoice::Indirect;
   EXPECT_THROW(fitModel(o), std::invalid_argument);
   o = physicalFit(nullptr);
-  EXPECT_FALSE(o.isValid(&why));
-  EXPECT_TRUE(o.isValidExceptData(&why)) << why;
+  EXPECT_EQ(o.check().issue, FitIssue::NoData);
+  EXPECT_TRUE(o.checkExceptData().ok()) << o.checkExceptData().message;
 
   // Abort from the progress callback ends the fit as cancelled.
   const FitResult c = fitModel(physicalFit(log), [](double, const std::string&) { return ProgressAction::Abort; });
   EXPECT_EQ(c.termination, Termination::Cancelled) << c.message;
+  EXPECT_EQ(c.status, FitStatus::Cancelled);
 }
 
 }  // namespace

@@ -212,13 +212,10 @@ TEST(FitExperiments, RefusesWhatSeveralExperimentsCannotTake) {
   const auto a = twoMassLog(600, 0, 31), b = twoMassLog(600, 1, 32);
   FitOptions o = physicalFit({{a, std::nullopt}, {b, std::nullopt}});
   o.closedLoop = ClosedLoopChoice::Indirect;
-  std::string why;
-  EXPECT_FALSE(o.isValid(&why));
-  EXPECT_NE(why.find("several take the direct fit"), std::string::npos) << why;
+  EXPECT_EQ(o.check().issue, FitIssue::OneExperimentOnly) << o.check().message;
   o.closedLoop = ClosedLoopChoice::Auto;
   o.model.kind = FitModelKind::Spa;
-  EXPECT_FALSE(o.isValid(&why));
-  EXPECT_NE(why.find("one estimation experiment"), std::string::npos) << why;
+  EXPECT_EQ(o.check().issue, FitIssue::OneExperimentOnly) << o.check().message;
 }
 
 // Experiments of different noise levels (the two-mass logs' noise is 2 % of each one's own

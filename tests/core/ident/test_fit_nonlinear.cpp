@@ -141,22 +141,18 @@ TEST(FitNonlinear, FixedEffectValuesStayAndMisuseIsRefused) {
       EXPECT_FALSE(p.free);
     }
   }
-  std::string why;
   FitOptions bad = o;
   bad.noiseModel = NoiseModel::Innovations;
-  EXPECT_FALSE(bad.isValid(&why));
-  EXPECT_NE(why.find("innovations"), std::string::npos) << why;
+  EXPECT_EQ(bad.check().issue, FitIssue::ExcludesInnovations) << bad.check().message;
   bad = o;
   bad.model.effects.push_back(bad.model.effects[0]);
-  EXPECT_FALSE(bad.isValid(&why));
-  EXPECT_NE(why.find("twice"), std::string::npos) << why;
+  EXPECT_EQ(bad.check().issue, FitIssue::EffectTwice) << bad.check().message;
   bad = o;
   bad.model.start = makeModel("rigid");
-  EXPECT_FALSE(bad.isValid(&why));
-  EXPECT_NE(why.find("gear spring"), std::string::npos) << why;
+  EXPECT_EQ(bad.check().issue, FitIssue::EffectNeedsGearSpring) << bad.check().message;
   bad = o;
   bad.model.effects.push_back(FitEffect::defaults(EffectKind::ExtraMass));
-  EXPECT_FALSE(bad.isValid(&why));
+  EXPECT_EQ(bad.check().issue, FitIssue::EffectChangesStructure) << bad.check().message;
 }
 
 }  // namespace

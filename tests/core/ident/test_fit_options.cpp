@@ -52,12 +52,6 @@ const FitParameter& row(const FitResult& r, const std::string& name) {
   throw std::invalid_argument("no row " + name);
 }
 
-bool hasWarning(const FitResult& r, const std::string& part) {
-  for (const auto& w : r.warnings)
-    if (w.find(part) != std::string::npos) return true;
-  return false;
-}
-
 std::string warningsOf(const FitResult& r) {
   std::string all;
   for (const auto& w : r.warnings) all += w + "\n";
@@ -83,13 +77,12 @@ TEST(FitOptions, StartValuesReplaceTheStartModelsAndHoldFixedOnes) {
   EXPECT_TRUE(row(r, "k_a").free);
 
   o.startValues = {{"k_g", 1.0}};
-  std::string why;
-  EXPECT_FALSE(o.isValid(&why));
-  EXPECT_NE(why.find("no parameter 'k_g'"), std::string::npos) << why;
-  EXPECT_NE(why.find("J_m, J_a, f_m, k_a, d_a, r, k_T"), std::string::npos) << why;
+  FitCheck c = o.check();
+  EXPECT_EQ(c.issue, FitIssue::UnknownParameter);
+  EXPECT_NE(c.message.find("J_m, J_a, f_m, k_a, d_a, r, k_T"), std::string::npos) << c.message;  // what there is
   o.startValues = {{"d_a", -3.0}};  // below the default bound 0
-  EXPECT_FALSE(o.isValid(&why));
-  EXPECT_NE(why.find("d_a = -3 is outside its bounds [0,"), std::string::npos) << why;
+  c = o.check();
+  EXPECT_EQ(c.issue, FitIssue::OutsideBounds) << c.message;
 }
 
 // Dampings are non-negative by default: the three-mass truth's d_g = -62 (Table 5.7 p6) ends
@@ -105,8 +98,7 @@ TEST(FitOptions, BoundsHoldAndAParameterOnABoundIsNamed) {
   const FitResult bounded = fitModel(o);
   ASSERT_TRUE(bounded.ok()) << bounded.message;
   EXPECT_EQ(row(bounded, "d_g").value, 0.0);
-  EXPECT_TRUE(hasWarning(bounded, "d_g sits on its lower bound 0; the data would push it below"))
-      << warningsOf(bounded);
+  EXPECT_TRUE(bounded.warned(FitWarning::OnBound)) << warningsOf(bounded);
 
   o.bounds = {{"d_g", -INFINITY, INFINITY}};
   const FitResult open = fitModel(o);
@@ -114,15 +106,14 @@ TEST(FitOptions, BoundsHoldAndAParameterOnABoundIsNamed) {
   const FitParameter& dg = row(open, "d_g");
   EXPECT_LE(dg.lower, -62.0) << dg.value << " +- " << dg.std;
   EXPECT_GE(dg.upper, -62.0) << dg.value << " +- " << dg.std;
-  EXPECT_FALSE(hasWarning(open, "sits on its")) << warningsOf(open);
+  EXPECT_FALSE(open.warned(FitWarning::OnBound)) << warningsOf(open);
 
   // A user's bound below the truth of J_m (4.56e-4).
   o.bounds.push_back({"J_m", 1e-4, 4e-4});
   const FitResult capped = fitModel(o);
   ASSERT_TRUE(capped.ok()) << capped.message;
   EXPECT_NEAR(row(capped, "J_m").value, 4e-4, 1e-12);
-  EXPECT_TRUE(hasWarning(capped, "J_m sits on its upper bound 0.0004; the data would push it above"))
-      << warningsOf(capped);
+  EXPECT_TRUE(capped.warned(FitWarning::OnBound)) << warningsOf(capped);
   // The estimate keeps the model's own (wider) bounds, so it can be edited as any model.
   EXPECT_LE(capped.physical->parameters()[static_cast<std::size_t>(capped.physical->indexOf("d_g"))].lower, -62.0);
 }
@@ -228,7 +219,7 @@ TEST(FitOptions, MaxIterationsIsAWarning) {
   o.maxIterations = 2;
   const FitResult physical = fitModel(o);
   ASSERT_EQ(physical.termination, Termination::MaxIterations) << physical.message;
-  EXPECT_TRUE(hasWarning(physical, "stopped at its limit of 2 iterations")) << warningsOf(physical);
+  EXPECT_TRUE(physical.warned(FitWarning::MaxIterations)) << warningsOf(physical);
 
   FitOptions b;
   b.model.kind = FitModelKind::BlackBox;
@@ -239,12 +230,12 @@ TEST(FitOptions, MaxIterationsIsAWarning) {
   b.maxIterations = 2;
   const FitResult oe = fitModel(b);
   ASSERT_EQ(oe.termination, Termination::MaxIterations) << oe.message;
-  EXPECT_TRUE(hasWarning(oe, "stopped at its limit of 2 iterations")) << warningsOf(oe);
+  EXPECT_TRUE(oe.warned(FitWarning::MaxIterations)) << warningsOf(oe);
 
   o.maxIterations = 100;  // converged: no such warning
   const FitResult converged = fitModel(o);
   ASSERT_EQ(converged.termination, Termination::Converged) << converged.message;
-  EXPECT_FALSE(hasWarning(converged, "iteration limit")) << warningsOf(converged);
+  EXPECT_FALSE(converged.warned(FitWarning::MaxIterations)) << warningsOf(converged);
 }
 
 }  // namespace

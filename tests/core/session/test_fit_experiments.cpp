@@ -96,6 +96,6 @@ TEST(FitRequest, MoreExperimentsRoundTripAndReplayAsTheFit) {
   missing.experiments = {{"no/such/log.csv", std::nullopt, false}};
   const FitResult failed = runFitRequest(missing, data);
   EXPECT_FALSE(failed.ok());
-  EXPECT_TRUE(failed.badData);
+  EXPECT_EQ(failed.status, FitStatus::BadData);
   EXPECT_NE(failed.message.find("no/such/log.csv"), std::string::npos) << failed.message;
 }
