@@ -83,7 +83,7 @@ DiscoveryPanel::DiscoveryPanel(Workspace* workspace, QWidget* parent)
       evidence_(new QLabel(this)),
       where_(new QLabel(this)),
       comparison_(new QLabel(this)),
-      table_(new QTableWidget(0, 7, this)),
+      table_(new QTableWidget(0, 8, this)),
       step_(new QComboBox(this)),
       ladder_(new QCustomPlot(this)),
       residualTime_(new QCustomPlot(this)),
@@ -117,7 +117,7 @@ DiscoveryPanel::DiscoveryPanel(Workspace* workspace, QWidget* parent)
     l->setTextInteractionFlags(Qt::TextSelectableByMouse);
   }
   table_->setHorizontalHeaderLabels({tr("Effect"), tr("Loss est."), tr("RMS val."), tr("ΔAIC"),
-                                     tr("F / threshold"), tr("Significant"), tr("Why")});
+                                     tr("F / threshold"), tr("Size"), tr("Significant"), tr("Why")});
   table_->horizontalHeader()->setStretchLastSection(true);
   table_->setWordWrap(true);
   table_->setToolTip(tr("Each candidate effect fitted on the estimation range: its loss, the RMS "
@@ -479,6 +479,16 @@ void DiscoveryPanel::showResult() {
     for (EffectKind k : r.tied) t << toString(k);
     verdict += tr("  (tie with %1)").arg(t.join(", "));
   }
+  // What was tried and rejected, apart from what was found.
+  if (!r.alsoTried.empty()) {
+    QStringList t;
+    for (const auto& x : r.alsoTried) {
+      QString name = toString(x.kind);
+      if (x.size.measured()) name += tr(" (%1 % of the torques)").arg(100.0 * x.size.share(), 0, 'f', 1);
+      if (!t.contains(name)) t << name;
+    }
+    verdict += "\n" + tr("Also tried, not named: %1").arg(t.join(", "));
+  }
   verdict_->setText(verdict);
   stage_->setText(tr("%1 step(s) in %2 s").arg(std::max<std::size_t>(1, r.rounds.size())).arg(r.seconds, 0, 'f', 1));
   add_->setEnabled(!r.found.empty() && r.augmentedModel != nullptr);
@@ -570,6 +580,8 @@ void DiscoveryPanel::showStep() {
         r.hasValidation ? num(c.score.rmsValidation, 4) : tr("no validation range"),
         std::isfinite(c.aic) ? QString::number(c.aic - aic, 'f', 1) : tr("-"),
         num(c.fStatistic, 3) + " / " + num(c.fThreshold, 3),
+        // The torque it adds against the model's friction and spring torques.
+        c.size.measured() ? QString::number(100.0 * c.size.share(), 'f', 1) + " %" : tr("-"),
         c.significant ? (c.confirmation.ran ? (c.confirmation.confirmed ? tr("yes, confirmed") : tr("yes, not confirmed"))
                                             : tr("yes"))
                       : tr("no"),

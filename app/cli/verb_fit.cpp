@@ -253,27 +253,20 @@ const char* fitOptionsHelp() {
   return "  --model SPEC          arx:NA,NB,NK | armax:NA,NB,NC,NK | oe:NB,NF,NK |\n"
          "                        bj:NB,NC,ND,NF,NK (orders of (4.8), delay NK), or a physical\n"
          "                        model two-mass|three-mass|four-mass|rigid (required)\n"
-         "  --effect NAME[:V1[,V2]] physical models: switch on a named effect (repeatable) and\n"
-         "                        fit its first value with the model's parameters (nonlinear\n"
-         "                        grey-box estimation): coulomb_friction:F_c,v_s (F_c tanh(\n"
-         "                        phi_m'/v_s) on the motor), nonlinear_spring:beta (gear spring\n"
-         "                        k delta (1 + beta delta^2)), backlash:b (dead zone of half-\n"
-         "                        width b, arm side), input_delay:T_d, torque_ripple:A,n\n"
-         "                        (A sin(n phi_m)); values default as `flexarm simulate --help`\n"
-         "                        lists them and are the start. The second value (v_s, n) is\n"
-         "                        held unless --free names it; --fix NAME=V holds any of them.\n"
+         "  --effect NAME[:V1,...] physical models: switch on a named effect (repeatable; the list\n"
+         "                        under Effects below) and fit its sizes with the model's\n"
+         "                        parameters (nonlinear grey-box estimation); the values given\n"
+         "                        (else the defaults listed) are the start. A smoothing speed\n"
+         "                        (v_s), the ripple's order n and gravity's phase phi_0 are held\n"
+         "                        unless --free names them; --fix NAME=V holds any of them.\n"
          "                        The plant is simulated by Runge-Kutta from the measured torque\n"
          "                        (output error (5.7), each experiment from rigid-body motion at\n"
          "                        its first sample's speed, the means kept), the gradient by\n"
          "                        finite differences; standard deviations from the Gauss-Newton\n"
          "                        Jacobian (4.37). Closed-loop logs take the direct fit. The\n"
-         "                        frequency response, notches and peaks are the linear part's\n"
-         "                        Arm side: arm_friction:f_a,F_a (viscous and Coulomb on the\n"
-         "                        arm), asymmetric_coulomb:F_c+,F_c- (Coulomb friction forwards\n"
-         "                        and backwards), gravity:mgl,phi_0 (mgl sin(phi_a + phi_0) on\n"
-         "                        the arm), encoder_skew:T_o (the arm encoder reads T_o s late;\n"
-         "                        with --outputs motor,arm). The smooth signs' speed v_s is 1 %\n"
-         "                        of the data's RMS motor speed unless given\n"
+         "                        frequency response, notches and peaks are the linear part's.\n"
+         "                        The smooth signs' speed v_s is 1 % of the data's RMS motor\n"
+         "                        speed unless given\n"
          "  --outputs motor,arm   physical models on a log with an arm-side encoder: fit the arm\n"
          "                        too, the deflection r phi_m - phi_a with the motor output\n"
          "                        (nonlinear estimator), each weighted by its noise level (a\n"
@@ -562,7 +555,8 @@ int runFit(const std::vector<std::string>& argv, std::ostream& out, std::ostream
     return kExitUsage;
   }
   if (args.flag("help")) {
-    out << kFitHelp << fitOptionsHelp() << "\n" << logReadOptionsHelp();
+    out << kFitHelp << fitOptionsHelp() << "\nEffects (--effect NAME[:V1,...]; values default as shown):\n"
+        << effectHelpLines() << "\n" << logReadOptionsHelp();
     return kExitOk;
   }
   FitResult fit;

@@ -22,12 +22,10 @@ using Clock = std::chrono::steady_clock;
 
 // The candidates a round tests on the current model: those asked for that it lacks and can
 // take (a gear effect needs a gear spring, a mass a structure below four-mass).
-std::vector<EffectKind> candidateKinds(const DiscoveryOptions& o, const ModelFit& current) {
+std::vector<EffectKind> candidateKinds(const Context& ctx, const DiscoveryOptions& o, const ModelFit& current) {
   std::vector<EffectKind> kinds;
   for (EffectKind k : o.candidates) {
-    if (hasEffect(current.effects, k) || std::find(kinds.begin(), kinds.end(), k) != kinds.end()) continue;
-    if (gearEffect(k) && !hasGearSpring(*current.model)) continue;
-    if (k == EffectKind::ExtraMass && structureWith(*current.model, current.effects) == "four-mass") continue;
+    if (std::find(kinds.begin(), kinds.end(), k) != kinds.end() || !canJoin(ctx, current, k)) continue;
     kinds.push_back(k);
   }
   return kinds;
@@ -127,7 +125,7 @@ DiscoveryResult discoverMissingEffect(const PhysicalModel& base, const IdData& e
     D.disagreement = mapDisagreement(ctx.est, current.yhatEst, current.deflection, *current.model, current.effects,
                                      current.score, true);
     const EffectBounds bounds = effectBounds(ctx.est, current.deflection, *current.model, current.effects);
-    const std::vector<EffectKind> kinds = candidateKinds(o, current);
+    const std::vector<EffectKind> kinds = candidateKinds(ctx, o, current);
     if (kinds.empty()) {
       R.stopReason = "every candidate effect is in the model";
       break;
@@ -165,18 +163,35 @@ DiscoveryResult discoverMissingEffect(const PhysicalModel& base, const IdData& e
     std::vector<ModelFit> pairFits;
     ctx.report(0.88, "choosing among the significant candidates");
     const std::vector<std::size_t> ranked = rankSignificant(ctx, current, work, bounds, pairFits, D.decision, D.tied);
-    // The first of them is named, and the second method says whether it confirms it.
-    const int best = ranked.empty() ? -1 : static_cast<int>(ranked.front());
-    if (best >= 0 && !cancel.load()) {
-      const std::size_t i = ranked.front();
+    // The first of them that the second method confirms is named (the best three tried in
+    // their order); those passed over are reported apart, as tried.
+    int best = -1;
+    for (std::size_t r = 0; r < ranked.size() && r < 3 && best < 0 && !cancel.load(); ++r) {
+      const std::size_t i = ranked[r];
       ctx.report(0.93, std::string("confirming ") + toString(work[i].fit.kind));
       work[i].fit.confirmation = confirmEffect(ctx, current, work[i].outcome, work[i].fit.kind, work);
+      if (work[i].fit.confirmation.confirmed) best = static_cast<int>(i);
     }
     if (cancel.load()) {
       cancelled = true;
       break;
     }
     for (auto& w : work) D.candidates.push_back(w.fit);
+    // Tried and rejected: significant but not named, or a real statistic of no size.
+    for (const auto& w : work) {
+      const CandidateFit& c = w.fit;
+      if (static_cast<int>(&w - work.data()) == best) continue;
+      const bool noSize = !c.significant && !c.matters;
+      if (!c.significant && !noSize) continue;
+      DiscoveryResult::Rejected t{round, c.kind, c.effect, c.magnitude, c.size, c.reason};
+      if (c.significant)
+        t.reason = c.confirmation.ran ? c.confirmation.text
+                                      : (best >= 0 ? std::string("significant, but ") +
+                                                         toString(work[static_cast<std::size_t>(best)].fit.kind) +
+                                                         " explains the data better (" + c.reason + ")"
+                                                   : c.reason);
+      R.alsoTried.push_back(std::move(t));
+    }
     D.best = best;
     if (best < 0) {
       D.estimation = trace(ctx.est, current.yhatEst, current.yhatEst);
@@ -184,7 +199,8 @@ DiscoveryResult discoverMissingEffect(const PhysicalModel& base, const IdData& e
       D.augmented = D.score;
       D.evidence = roundEvidence(ctx, D, nullptr);
       R.rounds.push_back(std::move(D));
-      R.stopReason = "none of the candidates is significant";
+      R.stopReason = ranked.empty() ? "none of the candidates is significant"
+                                    : "no significant candidate is confirmed on the held-out data";
       break;
     }
     CandidateWork& w = work[static_cast<std::size_t>(best)];
@@ -201,6 +217,7 @@ DiscoveryResult discoverMissingEffect(const PhysicalModel& base, const IdData& e
     }
     FoundEffect found;
     found.kind = w.fit.kind;
+    found.size = w.fit.size;
     found.before = current.score;
     found.after = w.outcome.score;
     found.evidence = D.evidence;
@@ -230,6 +247,7 @@ DiscoveryResult discoverMissingEffect(const PhysicalModel& base, const IdData& e
       if (current.effects[e].kind == f.kind) {
         f.effect = current.effects[e];
         f.parameters = current.estimates[e];
+        f.magnitude = current.magnitudes[e];
       }
   R.augmentedModel = current.model;
   R.augmentedEffects = current.effects;

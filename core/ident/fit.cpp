@@ -57,20 +57,20 @@ bool FitModelSpec::isValid(std::string* why) const {
         std::string reason;
         if (!f.effect.isValid(&reason)) return fail(reason);
         const std::string name = toString(f.effect.kind);
-        if (f.effect.kind == EffectKind::ExtraMass)
-          return fail("extra_mass changes the structure; fit the larger structure instead");
+        const EffectDefinition& d = effectDefinition(f.effect);
+        if (d.structural()) return fail(name + " changes the structure; fit the larger structure instead");
         if (seen[static_cast<std::size_t>(f.effect.kind)]) return fail("the effect " + name + " is given twice");
         seen[static_cast<std::size_t>(f.effect.kind)] = true;
-        if ((f.effect.kind == EffectKind::Backlash || f.effect.kind == EffectKind::NonlinearSpring) &&
+        if (d.needsGearSpring() &&
             (start->topology().gearStiffness.empty() || start->structureName() == "two-mass-theta"))
           return fail(name + " needs a model with a gear spring (two-mass, three-mass or four-mass), not " +
                       start->structureName());
-        for (std::size_t k = 0; k < effectParameters(f.effect.kind).size(); ++k) anyFree = anyFree || f.free[k];
+        for (std::size_t k = 0; k < f.effect.values.size(); ++k) anyFree = anyFree || f.isFree(k);
       }
       for (const auto& f : effects)
-        if (f.effect.kind == EffectKind::EncoderSkew && !armOutput)
-          return fail("encoder_skew shifts what the arm encoder reads: it goes with the arm as an output "
-                      "(--outputs motor,arm)");
+        if (effectDefinition(f.effect).needsArmEncoder() && !armOutput)
+          return fail(std::string(toString(f.effect.kind)) + " changes what the arm encoder reads: it goes with the "
+                      "arm as an output (--outputs motor,arm)");
       if (armOutput && start->options().output != ModelOutput::MotorVelocity)
         return fail("the arm as a second output goes with the motor velocity as the first");
       if (!effects.empty() && start->options().armAcceleration)
