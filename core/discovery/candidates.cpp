@@ -313,7 +313,20 @@ void fitCandidate(const Context& ctx, EffectKind kind, const ModelFit& current, 
     pr.effects[at] = bestStart;
     phi0 = bestSol.phi.size() ? bestSol.phi : pr.coordinatesOf(pr.effects);
   }
-  f.sol = pr.solve(phi0, o.candidateIterations);
+  // A few iterations first: a candidate whose loss has not begun to fall by a quarter of what
+  // its F-test asks is not refitted to the end (most candidates of a round explain nothing;
+  // their full fits were most of the loop's time).
+  const int first = std::min(3, o.candidateIterations);
+  f.sol = pr.solve(phi0, first);
+  if (f.sol.eps.size() && o.candidateIterations > first && !ctx.cancelled()) {
+    const double loss = f.sol.sumSquares / static_cast<double>(f.sol.eps.size());
+    const double nEff = static_cast<double>(ctx.estY.size()) / current.inflation;
+    const int q = std::max(1, f.parameterCount - current.parameterCount);
+    const double d2 = std::max(1.0, nEff - f.parameterCount);
+    const double F = loss > 0.0 ? (current.loss - loss) / loss * d2 / q : 0.0;
+    if (F > 0.25 * fQuantile(o.level, q, static_cast<int>(d2)))
+      f.sol = pr.solve(f.sol.phi, o.candidateIterations - first);
+  }
   finishFit(ctx, f);
   // An effect of several terms (the ripple's harmonics) grows while the next term pays for
   // itself: the F-test of its values at the level, on the estimation data.

@@ -94,9 +94,10 @@ Confirmation confirmEffect(const Context& ctx, const ModelFit& current, const Mo
   };
   const double size = std::abs(C.fitted) > 0.0 ? C.fitted : profiledSize(ctx, current, *fitted);
   if (!signature(*fitted, size)) return C;
-  // Rivals: every other effect the current model lacks, at the values its own candidate fit
-  // found this round (ripple and a mass need those: a period count, a frequency).
-  for (EffectKind k : o.candidates) {
+  // Rivals: every other effect of the seed's six the current model lacks (whether or not it is
+  // a candidate), at the values its own candidate fit found this round (ripple and a mass need
+  // those: a period count, a frequency), else at a profiled size.
+  for (EffectKind k : seedEffectKinds()) {
     if (k == kind || !canJoin(ctx, current, k)) continue;
     const EffectDefinition& rd = effectDefinition(k);
     // Two forms of one effect (asymmetric_coulomb holds coulomb_friction) are no rivals.

@@ -28,7 +28,7 @@ EffectSize effectSize(const Context& ctx, const ModelFit& fit, std::size_t index
         torque = false;
         return;
       }
-      const double fm = plant.motorFriction(x), sp = plant.gearTorque(x) / r;
+      const double fm = plant.motorFriction(x), sp = plant.gearTorque(x) * r;
       added += t * t;
       friction += fm * fm;
       spring += sp * sp;

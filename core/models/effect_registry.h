@@ -165,8 +165,8 @@ class EffectDefinition {
   // side; else it must lie above 0.
   virtual bool signedMagnitude() const { return false; }
   virtual std::vector<DerivedQuantity> derivedQuantities(const Effect&) const { return {}; }
-  // The torque the effect adds at one instant, motor side (N m; arm-side torques through the
-  // gear ratio): its size against the model's own friction and spring torques. NaN for an
+  // The torque the effect adds at one instant, motor side (N m; an arm-side torque T counts as
+  // r T at the motor, phi_a = r phi_m): its size against the model's own friction and spring torques. NaN for an
   // effect that is no torque (a structure, an encoder's lag). By default the sum of its plant
   // terms.
   virtual double addedTorque(const Effect& e, const JointSignals& s) const;

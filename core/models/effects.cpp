@@ -267,7 +267,7 @@ double EffectDefinition::addedTorque(const Effect& e, const JointSignals& s) con
   addToPlant(e, terms);
   double t = 0.0;
   for (const auto& term : terms.torques)
-    t += term.term->torque(s) * (term.site == TorqueSite::Motor ? 1.0 : 1.0 / s.ratio);
+    t += term.term->torque(s) * (term.site == TorqueSite::Motor ? 1.0 : s.ratio);
   return t;
 }
 

@@ -545,7 +545,8 @@ bool candidatesFromJson(const json& j, std::vector<CandidateFit>& out, std::stri
     f.kind = *k;
     f.termination = Termination::Converged;
     if ((c.contains("parameters") && !parametersFromJson(c["parameters"], f.parameters, why, cw)) ||
-        !readText(c, "spec", spec, false, why, cw) || !readText(c, "termination", termination, false, why, cw) ||
+        !(c.contains("spec") && c["spec"].is_null() ? true : readText(c, "spec", spec, false, why, cw)) ||
+        !readText(c, "termination", termination, false, why, cw) ||
         !readWhole(c, "parameter_count", f.parameterCount, why, cw) ||
         !readNumber(c, "loss_est", f.lossEst, true, why, cw) ||
         !readNumber(c, "aic", f.aic, false, why, cw) || !readNumber(c, "f", f.fStatistic, false, why, cw) ||
@@ -645,7 +646,8 @@ std::optional<DiscoveryResult> discoveryResultFromJson(const json& j, std::strin
       DiscoveryResult::Rejected x;
       std::string name, spec;
       const std::string tw = where + "also tried: ";
-      if (!t.is_object() || !readText(t, "effect", name, true, why, tw) || !readText(t, "spec", spec, false, why, tw) ||
+      if (!t.is_object() || !readText(t, "effect", name, true, why, tw) ||
+          !(t.contains("spec") && t["spec"].is_null() ? true : readText(t, "spec", spec, false, why, tw)) ||
           !readWhole(t, "round", x.round, why, tw) || !readText(t, "reason", x.reason, false, why, tw) ||
           !readEstimate(t, "magnitude", x.magnitude, why, tw) || !readSize(t, x.size, why, tw))
         return std::nullopt;
@@ -701,9 +703,9 @@ std::optional<DiscoveryResult> discoveryResultFromJson(const json& j, std::strin
     for (const auto& d : j["rounds"]) {
       DiscoveryRound round;
       const std::string rw = where + "round: ";
-      std::string effect;
+      std::string named;
       if (!d.is_object() || !readEffects(d, "effects", round.effects, why, rw) ||
-          !readText(d, "effect", effect, false, why, rw) || !readWhole(d, "best", round.best, why, rw) ||
+          !readText(d, "effect", named, false, why, rw) || !readWhole(d, "best", round.best, why, rw) ||
           !readText(d, "decision", round.decision, false, why, rw) ||
           !readText(d, "evidence", round.evidence, false, why, rw) ||
           !readEffectList(d, "tied", "tied must be a list", "unknown tied effect ", round.tied, why, rw) ||
@@ -711,7 +713,7 @@ std::optional<DiscoveryResult> discoveryResultFromJson(const json& j, std::strin
           (d.contains("score") && !scoreFromJson(d["score"], round.score, why, rw + "score: ")) ||
           !candidatesFromJson(d, round.candidates, why, rw))
         return std::nullopt;
-      if (!effect.empty() && effect != "none") round.effect = effectKindFromString(effect);
+      if (!named.empty() && named != "none") round.effect = effectKindFromString(named);
       r.rounds.push_back(std::move(round));
     }
   if (r.best < -1 || r.best >= static_cast<int>(r.candidates.size())) {

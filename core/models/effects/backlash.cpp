@@ -44,7 +44,7 @@ class Backlash : public EffectDefinition {
     const double b = e.value(0), d = s.gearDeflection;
     const double inGap = std::abs(d) < b ? s.gearStiffness * d + s.gearDamping * s.gearRate
                                          : s.gearStiffness * (d > 0.0 ? b : -b);
-    return -inGap / s.ratio;
+    return -inGap * s.ratio;
   }
   bool roughLoss() const override { return true; }
   double displayFactor() const override { return 1e3; }

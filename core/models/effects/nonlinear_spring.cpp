@@ -22,7 +22,7 @@ class NonlinearSpring : public EffectDefinition {
   // k beta delta^3, motor side.
   double addedTorque(const Effect& e, const JointSignals& s) const override {
     const double d = s.gearDeflection;
-    return s.gearStiffness * e.value(0) * d * d * d / s.ratio;
+    return s.gearStiffness * e.value(0) * d * d * d * s.ratio;
   }
   // A response far from linear in beta: a few starts over a decade.
   EffectSearchPlan searchPlan(const Effect& e0, const EffectSearchBounds&) const override {

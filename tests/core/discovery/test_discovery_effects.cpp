@@ -123,7 +123,9 @@ TEST(DiscoveryEffects, NoFrictionOfNoSizeBesideABacklash) {
     EXPECT_EQ(r.found[0].kind, EffectKind::Backlash);
     for (const auto& f : r.found) {
       EXPECT_TRUE(f.confirmation.confirmed) << toString(f.kind) << ": " << f.confirmation.text;
-      if (f.size.measured()) EXPECT_GE(f.size.share(), DiscoveryOptions{}.minTorqueShare) << toString(f.kind);
+      if (f.size.measured()) {
+        EXPECT_GE(f.size.share(), DiscoveryOptions{}.minTorqueShare) << toString(f.kind);
+      }
       EXPECT_NE(f.kind, EffectKind::CoulombFriction) << f.evidence;
     }
   }

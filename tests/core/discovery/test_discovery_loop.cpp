@@ -70,6 +70,8 @@ void print(const LoopOutcome& o) {
     std::printf("  val RMS %.4g -> %.4g\n      %s\n", f.before.rmsValidation, f.after.rmsValidation,
                 f.confirmation.text.c_str());
   }
+  for (const auto& t : o.r.alsoTried)
+    std::printf("   also tried (round %d) %-17s %s\n", t.round + 1, toString(t.kind), t.reason.c_str());
   for (std::size_t i = 0; i < o.r.rounds.size(); ++i)
     for (const auto& c : o.r.rounds[i].candidates)
       std::printf("      round %zu %-17s F %.1f/%.1f z %.2f surv %.1f %s\n", i + 1, toString(c.kind), c.fStatistic,

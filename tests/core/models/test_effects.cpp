@@ -85,10 +85,11 @@ TEST(Effects, EveryRegisteredEffectIsComplete) {
     for (const auto& q : d.derivedQuantities(e)) est.push_back({q.name, q.unit, q.value(e.values), 0.0, 0.0, 0.0, true, true});
     EXPECT_FALSE(d.describe(est).empty()) << toString(k);
     // Its size scales: withMagnitude gives the size asked for.
-    if (!d.structural() && std::abs(d.magnitude(e)) > 0.0)
+    if (!d.structural() && std::abs(d.magnitude(e)) > 0.0) {
       EXPECT_NEAR(d.magnitude(d.withMagnitude(e, 0.5 * d.magnitude(e))), 0.5 * d.magnitude(e),
                   1e-12 * std::abs(d.magnitude(e)))
           << toString(k);
+    }
   }
 }
 
