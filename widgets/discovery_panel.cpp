@@ -677,6 +677,9 @@ void DiscoveryPanel::showComparison() {
   const DiscoveryResult& r = *result_;
   // A stored summary shows the final scores at once: its model is not in the list.
   const bool after = added_ || (!r.found.empty() && (r.estimation.time.empty() || r.found.size() > 1));
+  // The fit % of every panel is fitPercents (core/ident/evaluation.h); this one is of
+  // discovery's predictor, which the tooltip says.
+  comparison_->setToolTip(tr("Fit %: the seed's (5.2), %1").arg(QString::fromStdString(r.fitBasis)));
   QString text = tr("Base: fit (5.2) %1 % (estimation)").arg(r.base.fitPercent, 0, 'f', 1);
   text += tr(", %1 % (held out), residual RMS %2 rad/s").arg(r.base.fitPercentValidation, 0, 'f', 1).arg(num(r.base.rmsValidation));
   if (after) {

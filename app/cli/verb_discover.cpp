@@ -185,7 +185,6 @@ int runDiscover(const std::vector<std::string>& argv, std::ostream& out, std::os
     err << pre << r.message << "\n";
     return kExitNumerical;
   }
-  const CandidateFit* best = r.best >= 0 ? &r.candidates[static_cast<std::size_t>(r.best)] : nullptr;
   if (!args.flag("json")) {
     if (options.maxEffects > 1) {
       out << "Effects: ";
@@ -228,6 +227,7 @@ int runDiscover(const std::vector<std::string>& argv, std::ostream& out, std::os
       }
     }
     if (!r.found.empty() && r.augmentedModel) out << "Refine: " << refineLine(args.positional()[0], r) << "\n";
+    out << "Fit %: the seed's (5.2), " << r.fitBasis << "\n";
     out << "Seconds: " << r.seconds << "\n";
     return kExitOk;
   }

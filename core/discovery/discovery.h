@@ -205,6 +205,10 @@ struct DiscoveryResult {
   double sampleTime = 0.0;  // of the data the fits ran on (after internal decimation)
   bool hasValidation = false;  // held-out data exist (a validation log or the log's end)
   bool heldOutSplit = false;   // the held-out data are the end of the estimation log
+  // What every fit % of the result is of, in words: fitPercents (core/ident/evaluation.h) of
+  // the motor velocity as discovery's predictor forms it (through the load observer, with
+  // the model's effects, means kept, at the fitting rate).
+  std::string fitBasis;
   std::string validationData;  // which, in words
   std::vector<DiscoveryRound> rounds;
   // Every effect named, in order: each significant, its size's interval excluding 0, its

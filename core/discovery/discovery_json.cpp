@@ -131,6 +131,7 @@ json discoveryResultJson(const DiscoveryResult& r) {
   j["has_validation"] = r.hasValidation;
   j["held_out_split"] = r.heldOutSplit;
   j["fit_percent_definition"] = discoveryFitPercentDefinition();
+  j["fit_basis"] = r.fitBasis;
   j["base"] = discoveryScoreJson(r.base);
   j["base"]["loss"] = num(r.baseLoss);
   j["base"]["aic"] = num(r.baseAic);

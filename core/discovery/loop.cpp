@@ -4,6 +4,7 @@
 // and look again, until nothing is missing or the number asked for is found.
 #include <algorithm>
 #include <chrono>
+#include <cstdio>
 #include <cmath>
 #include <mutex>
 #include <stdexcept>
@@ -76,6 +77,15 @@ DiscoveryResult discoverMissingEffect(const PhysicalModel& base, const IdData& e
   R.hasValidation = true;
   R.heldOutSplit = ctx.heldOutSplit;
   R.validationData = ctx.validationData;
+  {
+    char basis[200];
+    std::snprintf(basis, sizeof basis, "%s, with the model's effects, means kept, at %.4g Hz",
+                  o.observerBandwidthHz > 0.0
+                      ? ("one-step prediction through the " + number(o.observerBandwidthHz) + " Hz load observer").c_str()
+                      : "simulation (open loop from the input)",
+                  1.0 / ctx.est.Ts);
+    R.fitBasis = basis;
+  }
   ctx.substeps = o.substeps > 0 ? o.substeps : defaultSubsteps(ctx.est.Ts);
   ctx.observer = loadObserver(base, o.observerBandwidthHz);
   {

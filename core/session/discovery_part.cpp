@@ -591,7 +591,8 @@ std::optional<DiscoveryResult> discoveryResultFromJson(const json& j, std::strin
   if (!readEffectList(j, "tied", "tied must be a list", "unknown tied effect ", r.tied, why,
                       where) ||
       !readText(j, "stop_reason", r.stopReason, false, why, where) ||
-      !readText(j, "validation_data", r.validationData, false, why, where))
+      !readText(j, "validation_data", r.validationData, false, why, where) ||
+      !readText(j, "fit_basis", r.fitBasis, false, why, where))
     return std::nullopt;
   if (j.contains("effects")) {
     if (!j["effects"].is_array()) {

@@ -121,12 +121,13 @@ class DiscoveryPanelTest : public QObject {
     QCOMPARE(fit->dataCount(), 2);
     QVERIFY(fit->data()->at(1)->value > fit->data()->at(0)->value);
     // Two steps: the one that named the ripple (its overlay shows the model with it), and the
-    // last, where nothing more was missing (five candidates, no overlay after it).
+    // last, where nothing more was missing (the registry's candidates less the ripple and the
+    // arm encoder's skew, no overlay after it).
     QCOMPARE(panel_->stepBox()->count(), 2);
     QVERIFY(panel_->overlayPlot()->graph(2)->dataCount() > 1000);
-    QCOMPARE(panel_->candidatesTable()->rowCount(), 6);
+    QCOMPARE(panel_->candidatesTable()->rowCount(), 9);
     panel_->selectStep(1);
-    QCOMPARE(panel_->candidatesTable()->rowCount(), 5);
+    QCOMPARE(panel_->candidatesTable()->rowCount(), 8);
     QCOMPARE(panel_->overlayPlot()->graph(2)->dataCount(), 0);
     QVERIFY2(panel_->evidenceText().startsWith("No missing effect"), qPrintable(panel_->evidenceText()));
     panel_->selectStep(0);
