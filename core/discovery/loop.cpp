@@ -174,13 +174,20 @@ DiscoveryResult discoverMissingEffect(const PhysicalModel& base, const IdData& e
     ctx.report(0.88, "choosing among the significant candidates");
     const std::vector<std::size_t> ranked = rankSignificant(ctx, current, work, bounds, pairFits, D.decision, D.tied);
     // The first of them that the second method confirms is named (the best three tried in
-    // their order); those passed over are reported apart, as tried.
+    // their order); those passed over are reported apart, as tried. When none confirms, the
+    // first is named as it stands, "not confirmed", and the loop ends with it: the list of
+    // effects ends with the last one that holds.
     int best = -1;
+    bool unconfirmedLast = false;
     for (std::size_t r = 0; r < ranked.size() && r < 3 && best < 0 && !cancel.load(); ++r) {
       const std::size_t i = ranked[r];
       ctx.report(0.93, std::string("confirming ") + toString(work[i].fit.kind));
       work[i].fit.confirmation = confirmEffect(ctx, current, work[i].outcome, work[i].fit.kind, work);
       if (work[i].fit.confirmation.confirmed) best = static_cast<int>(i);
+    }
+    if (best < 0 && !ranked.empty() && !cancel.load()) {
+      best = static_cast<int>(ranked.front());
+      unconfirmedLast = true;
     }
     if (cancel.load()) {
       cancelled = true;
@@ -209,8 +216,7 @@ DiscoveryResult discoverMissingEffect(const PhysicalModel& base, const IdData& e
       D.augmented = D.score;
       D.evidence = roundEvidence(ctx, D, nullptr);
       R.rounds.push_back(std::move(D));
-      R.stopReason = ranked.empty() ? "none of the candidates is significant"
-                                    : "no significant candidate is confirmed on the held-out data";
+      R.stopReason = "none of the candidates is significant";
       break;
     }
     CandidateWork& w = work[static_cast<std::size_t>(best)];
@@ -236,6 +242,11 @@ DiscoveryResult discoverMissingEffect(const PhysicalModel& base, const IdData& e
     R.rounds.push_back(std::move(D));
     current = std::move(w.outcome);
     warmFits = std::move(pairFits);
+    if (unconfirmedLast) {
+      R.stopReason = std::string(toString(R.found.back().kind)) +
+                     " is significant but not confirmed on the held-out data; the loop ends with it";
+      break;
+    }
     if (static_cast<int>(R.found.size()) >= o.maxEffects) {
       R.stopReason = o.maxEffects == 1 ? "one effect asked for"
                                        : "the " + std::to_string(o.maxEffects) + " effects asked for are found";

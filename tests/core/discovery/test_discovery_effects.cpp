@@ -121,8 +121,12 @@ TEST(DiscoveryEffects, NoFrictionOfNoSizeBesideABacklash) {
     ASSERT_EQ(r.termination, Termination::Converged) << r.message;
     ASSERT_FALSE(r.found.empty());
     EXPECT_EQ(r.found[0].kind, EffectKind::Backlash);
-    for (const auto& f : r.found) {
-      EXPECT_TRUE(f.confirmation.confirmed) << toString(f.kind) << ": " << f.confirmation.text;
+    for (std::size_t i = 0; i < r.found.size(); ++i) {
+      const FoundEffect& f = r.found[i];
+      // Only the last may stand unconfirmed (the list ends with it).
+      if (i + 1 < r.found.size()) {
+        EXPECT_TRUE(f.confirmation.confirmed) << toString(f.kind) << ": " << f.confirmation.text;
+      }
       if (f.size.measured()) {
         EXPECT_GE(f.size.share(), DiscoveryOptions{}.minTorqueShare) << toString(f.kind);
       }
