@@ -572,8 +572,11 @@ void DiscoveryPanel::showStep() {
     const int row = static_cast<int>(row0);
     // The confirmation's numbers are in the evidence above and in the tooltip: in the cell
     // they made the named effect's row taller than the table.
-    const QString why = QString::fromStdString(c.reason);
-    const QString whyWhole = c.confirmation.ran ? why + " — " + QString::fromStdString(c.confirmation.text) : why;
+    // The size is in its own column: the cell keeps the reason's statistics (the tooltip has
+    // every word).
+    const QString reason = QString::fromStdString(c.reason);
+    const QString why = reason.section("; it adds", 0, 0);
+    const QString whyWhole = c.confirmation.ran ? reason + " — " + QString::fromStdString(c.confirmation.text) : reason;
     const QStringList cells = {
         toString(c.kind),
         num(c.lossEst, 4),
