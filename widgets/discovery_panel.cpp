@@ -83,7 +83,7 @@ DiscoveryPanel::DiscoveryPanel(Workspace* workspace, QWidget* parent)
       evidence_(new QLabel(this)),
       where_(new QLabel(this)),
       comparison_(new QLabel(this)),
-      table_(new QTableWidget(0, 7, this)),
+      table_(new QTableWidget(0, 8, this)),
       step_(new QComboBox(this)),
       ladder_(new QCustomPlot(this)),
       residualTime_(new QCustomPlot(this)),
@@ -117,7 +117,7 @@ DiscoveryPanel::DiscoveryPanel(Workspace* workspace, QWidget* parent)
     l->setTextInteractionFlags(Qt::TextSelectableByMouse);
   }
   table_->setHorizontalHeaderLabels({tr("Effect"), tr("Loss est."), tr("RMS val."), tr("ΔAIC"),
-                                     tr("F / threshold"), tr("Significant"), tr("Why")});
+                                     tr("F / threshold"), tr("Size"), tr("Significant"), tr("Why")});
   table_->horizontalHeader()->setStretchLastSection(true);
   table_->setWordWrap(true);
   table_->setToolTip(tr("Each candidate effect fitted on the estimation range: its loss, the RMS "
@@ -479,6 +479,16 @@ void DiscoveryPanel::showResult() {
     for (EffectKind k : r.tied) t << toString(k);
     verdict += tr("  (tie with %1)").arg(t.join(", "));
   }
+  // What was tried and rejected, apart from what was found.
+  if (!r.alsoTried.empty()) {
+    QStringList t;
+    for (const auto& x : r.alsoTried) {
+      QString name = toString(x.kind);
+      if (x.size.measured()) name += tr(" (%1 % of the torques)").arg(100.0 * x.size.share(), 0, 'f', 1);
+      if (!t.contains(name)) t << name;
+    }
+    verdict += "\n" + tr("Also tried, not named: %1").arg(t.join(", "));
+  }
   verdict_->setText(verdict);
   stage_->setText(tr("%1 step(s) in %2 s").arg(std::max<std::size_t>(1, r.rounds.size())).arg(r.seconds, 0, 'f', 1));
   add_->setEnabled(!r.found.empty() && r.augmentedModel != nullptr);
@@ -562,14 +572,19 @@ void DiscoveryPanel::showStep() {
     const int row = static_cast<int>(row0);
     // The confirmation's numbers are in the evidence above and in the tooltip: in the cell
     // they made the named effect's row taller than the table.
-    const QString why = QString::fromStdString(c.reason);
-    const QString whyWhole = c.confirmation.ran ? why + " — " + QString::fromStdString(c.confirmation.text) : why;
+    // The size is in its own column: the cell keeps the reason's statistics (the tooltip has
+    // every word).
+    const QString reason = QString::fromStdString(c.reason);
+    const QString why = reason.section("; it adds", 0, 0);
+    const QString whyWhole = c.confirmation.ran ? reason + " — " + QString::fromStdString(c.confirmation.text) : reason;
     const QStringList cells = {
         toString(c.kind),
         num(c.lossEst, 4),
         r.hasValidation ? num(c.score.rmsValidation, 4) : tr("no validation range"),
         std::isfinite(c.aic) ? QString::number(c.aic - aic, 'f', 1) : tr("-"),
         num(c.fStatistic, 3) + " / " + num(c.fThreshold, 3),
+        // The torque it adds against the model's friction and spring torques.
+        c.size.measured() ? QString::number(100.0 * c.size.share(), 'f', 1) + " %" : tr("-"),
         c.significant ? (c.confirmation.ran ? (c.confirmation.confirmed ? tr("yes, confirmed") : tr("yes, not confirmed"))
                                             : tr("yes"))
                       : tr("no"),
@@ -665,6 +680,9 @@ void DiscoveryPanel::showComparison() {
   const DiscoveryResult& r = *result_;
   // A stored summary shows the final scores at once: its model is not in the list.
   const bool after = added_ || (!r.found.empty() && (r.estimation.time.empty() || r.found.size() > 1));
+  // The fit % of every panel is fitPercents (core/ident/evaluation.h); this one is of
+  // discovery's predictor, which the tooltip says.
+  comparison_->setToolTip(tr("Fit %: the seed's (5.2), %1").arg(QString::fromStdString(r.fitBasis)));
   QString text = tr("Base: fit (5.2) %1 % (estimation)").arg(r.base.fitPercent, 0, 'f', 1);
   text += tr(", %1 % (held out), residual RMS %2 rad/s").arg(r.base.fitPercentValidation, 0, 'f', 1).arg(num(r.base.rmsValidation));
   if (after) {

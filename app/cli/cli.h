@@ -86,6 +86,7 @@ class OptionTable {
   // Replaces the option of that name (a verb that shares another's table and says more).
   OptionTable& replace(Option option);
   OptionTable& note(std::string paragraph);  // printed after the options
+  OptionTable& block(std::string text);      // printed as it is (own line breaks), after the notes
   const Option* find(const std::string& name) const;
   std::vector<const Option*> options() const;  // every option, --help included
   // Usage, description, every option with its value, help, choices, range and default, notes;
@@ -100,6 +101,7 @@ class OptionTable {
   std::string usage_, description_;
   std::vector<Group> groups_;
   std::vector<std::string> notes_;
+  std::vector<std::string> blocks_;
 };
 
 // The parser of a verb's table. Options are --name VALUE, --name=VALUE or flags (--json);

@@ -154,6 +154,11 @@ OptionTable& OptionTable::note(std::string paragraph) {
   return *this;
 }
 
+OptionTable& OptionTable::block(std::string text) {
+  blocks_.push_back(std::move(text));
+  return *this;
+}
+
 const Option* OptionTable::find(const std::string& name) const {
   for (const auto& g : groups_)
     for (const auto& o : g.options)
@@ -192,6 +197,7 @@ std::string OptionTable::help() const {
     out += "\n";
     wrap(out, n, 0, 0);
   }
+  for (const auto& b : blocks_) out += "\n" + b + (b.empty() || b.back() == '\n' ? "" : "\n");
   return out;
 }
 

@@ -7,6 +7,7 @@
 #include "app/cli/cli.h"
 #include "app/cli/log_args.h"
 #include "core/discovery/discovery.h"
+#include "core/discovery/discovery_json.h"
 #include "core/session/report.h"
 #include "core/signal/excitation.h"
 
@@ -23,13 +24,14 @@ const char* kDiscoverHelp =
     "or an output in rad/s, is integrated to an angle from zero and differentiated the same\n"
     "way) by prediction error, simulating the model from the torque reference at the data's\n"
     "rate with a slow load observer (the predictor `flexarm fit --effect` uses on closed-loop\n"
-    "logs). Each candidate effect (coulomb_friction, backlash, nonlinear_spring, input_delay,\n"
-    "torque_ripple, extra_mass) is added as a physical term and refitted with the base\n"
-    "parameters and every effect already in the model. An effect is named only when the\n"
-    "F-test of its parameters passes at 99 %, the AIC falls, its parameter's 99 % interval\n"
-    "excludes zero and the residual on held-out data (the validation log, else the last 30 %\n"
-    "of every second of the log) is explained by the change the effect predicts (z-test at\n"
-    "99 %); otherwise the answer is none.\n"
+    "logs). Each candidate effect (every effect below; encoder_skew only on a log with an arm\n"
+    "encoder) is added as a physical term and refitted with the base parameters and every\n"
+    "effect already in the model. An effect is named only when the F-test of its parameters\n"
+    "passes at 99 %, the AIC falls, its size's 99 % interval excludes zero (F_c = 0, b = 0,\n"
+    "T_d = 0, ...), the torque it adds is at least 2 % of the model's own friction and gear\n"
+    "spring torques at the log's speeds, and the residual on held-out data (the validation\n"
+    "log, else the last 30 % of every second of the log) is explained by the change the\n"
+    "effect predicts (z-test at 99 %); otherwise the answer is none.\n"
     "When several are significant, each pair is refitted together and the one whose\n"
     "parameters still pass the F-test with the other in the model is named. Every verdict is\n"
     "then confirmed or not by a second method on the held-out data: the residual before and\n"
@@ -44,73 +46,20 @@ const char* kDiscoverHelp =
     "  --max-effects N       effects the loop finds at most (default 4)\n"
     "  --effect NAME[:V1[,V2]]  an effect the base already has (repeatable, as in `fit`):\n"
     "                        refitted with it and not looked for again\n"
-    "  --effects A,B         candidates to test (default: all six)\n"
+    "  --effects A,B         candidates to test (default: every effect listed below)\n"
     "  --threads N           candidates fitted in parallel (default 2)\n"
     "  --observer-bandwidth HZ  the load observer's bandwidth (default 1; 0: simulation)\n"
     "  --json                print the result as JSON\n\n"
-    "JSON fields: effect (the first effect named, or \"none\"), effects [{effect, parameters\n"
-    "{name: {value, std, unit, lower, upper}}, evidence, confirmed, confirmation, before and\n"
-    "after (scores)}] in the order found, stop_reason, tied, effect_parameters, evidence,\n"
-    "candidates [{effect, loss_est, rms_val, aic, f, f_threshold, held_out_z, significant,\n"
-    "reason, parameters}] of the first round, rounds [{effects, best, candidates}], base and\n"
-    "augmented {fit_percent, fit_percent_validation (the seed's (5.2)), fit_percent_nrmse,\n"
-    "fit_percent_validation_nrmse (MATLAB compare's NRMSE fit), rms_estimation,\n"
-    "rms_validation}, validation_data, disagreement (summary, whiteness and independence\n"
-    "tests), sample_time, seconds.\n";
-
-nlohmann::json scoreJson(const DiscoveryScore& s) {
-  return {{"fit_percent", s.fitPercent},
-          {"fit_percent_nrmse", s.fitPercentNrmse},
-          {"rms_estimation", s.rmsEstimation},
-          {"fit_percent_validation", s.fitPercentValidation},
-          {"fit_percent_validation_nrmse", s.fitPercentValidationNrmse},
-          {"rms_validation", s.rmsValidation}};
-}
-
-nlohmann::json finiteOrNull(double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(); }
-
-nlohmann::json parametersJson(const std::vector<EffectParameterEstimate>& ps) {
-  nlohmann::json j = nlohmann::json::object();
-  for (const auto& p : ps)
-    j[p.name] = {{"value", p.value},       {"std", finiteOrNull(p.std)},
-                 {"unit", p.unit},         {"lower", finiteOrNull(p.lower)},
-                 {"upper", finiteOrNull(p.upper)}, {"estimated", p.estimated}};
-  return j;
-}
-
-nlohmann::json candidatesJson(const std::vector<CandidateFit>& candidates) {
-  nlohmann::json list = nlohmann::json::array();
-  for (const auto& c : candidates)
-    list.push_back({{"effect", toString(c.kind)},
-                    {"loss_est", c.lossEst},
-                    {"rms_val", finiteOrNull(c.score.rmsValidation)},
-                    {"aic", finiteOrNull(c.aic)},
-                    {"f", c.fStatistic},
-                    {"f_threshold", c.fThreshold},
-                    {"held_out_z", finiteOrNull(c.heldOutZ)},
-                    {"significant", c.significant},
-                    {"reason", c.reason},
-                    {"parameters", parametersJson(c.parameters)}});
-  return list;
-}
-
-nlohmann::json confirmationJson(const Confirmation& c) {
-  return {{"confirmed", c.confirmed},
-          {"held_out_data", c.heldOutData},
-          {"rms_before", c.rmsBefore},
-          {"rms_after", c.rmsAfter},
-          {"held_out_z", finiteOrNull(c.heldOutZ)},
-          {"held_out_passes", c.heldOutPasses},
-          {"test", c.test},
-          {"value", finiteOrNull(c.value)},
-          {"std", finiteOrNull(c.std)},
-          {"z", finiteOrNull(c.z)},
-          {"fitted", c.fitted},
-          {"unit", c.unit},
-          {"rivals", c.rivals},
-          {"specific_passes", c.specificPasses},
-          {"text", c.text}};
-}
+    "JSON (the shape sessions and reports keep, schema 2): effect (the first effect named, or\n"
+    "\"none\"), effects [{effect, spec, parameters [{name, unit, value, std, lower, upper,\n"
+    "estimated, derived}], magnitude, size {torque_rms, friction_rms, spring_rms, share},\n"
+    "evidence, confirmed, confirmation {...}, before, after}] in the order found, also_tried\n"
+    "[{round, effect, spec, magnitude, size, reason}], stop_reason, tied, evidence,\n"
+    "candidates (of the first round) and rounds [{effects, effect, decision, candidates}],\n"
+    "base and augmented {fit_percent, fit_percent_validation (the seed's (5.2)),\n"
+    "fit_percent_nrmse, fit_percent_validation_nrmse (MATLAB compare's NRMSE fit),\n"
+    "rms_estimation, rms_validation}, fit_percent_definition, validation_data, disagreement,\n"
+    "sample_time, seconds.\n";
 
 // The `flexarm fit` command that refines the final model from where discovery ended: an
 // extra mass folded into the larger structure, the other effects as --effect.
@@ -138,7 +87,8 @@ int runDiscover(const std::vector<std::string>& argv, std::ostream& out, std::os
     return kExitUsage;
   }
   if (args.flag("help")) {
-    out << kDiscoverHelp << "\n" << logReadOptionsHelp();
+    out << kDiscoverHelp << "\nEffects (candidates and --effect; values default as shown):\n" << effectHelpLines()
+        << "\n" << logReadOptionsHelp();
     return kExitOk;
   }
   const std::string pre = "flexarm discover: ";
@@ -235,13 +185,33 @@ int runDiscover(const std::vector<std::string>& argv, std::ostream& out, std::os
     err << pre << r.message << "\n";
     return kExitNumerical;
   }
-  const CandidateFit* best = r.best >= 0 ? &r.candidates[static_cast<std::size_t>(r.best)] : nullptr;
   if (!args.flag("json")) {
     if (options.maxEffects > 1) {
       out << "Effects: ";
       if (r.found.empty()) out << "none";
       for (std::size_t i = 0; i < r.found.size(); ++i) out << (i ? ", " : "") << toString(r.found[i].kind);
       out << " (" << r.stopReason << ")\n";
+      // The gap step by step: the held-out residual and fit % after each confirmed effect.
+      if (!r.found.empty()) {
+        char line[240];
+        std::snprintf(line, sizeof line, "  step 0  %-36s held-out RMS %.4g rad/s  fit %.2f %%\n", "base",
+                      r.found.front().before.rmsValidation, r.found.front().before.fitPercentValidation);
+        out << line;
+        std::string model = "base";
+        for (std::size_t i = 0; i < r.found.size(); ++i) {
+          const FoundEffect& f = r.found[i];
+          model += " + " + std::string(toString(f.kind));
+          std::snprintf(line, sizeof line, "  step %zu  %-36s held-out RMS %.4g rad/s  fit %.2f %%  %s\n", i + 1,
+                        model.c_str(), f.after.rmsValidation, f.after.fitPercentValidation,
+                        f.confirmation.confirmed ? "confirmed" : "not confirmed");
+          out << line;
+        }
+      }
+    }
+    if (!r.alsoTried.empty()) {
+      out << "Also tried:\n";
+      for (const auto& t : r.alsoTried)
+        out << "  round " << t.round + 1 << " " << toString(t.kind) << ": " << t.reason << "\n";
     }
     for (std::size_t i = 0; i < r.rounds.size(); ++i) {
       const DiscoveryRound& d = r.rounds[i];
@@ -257,52 +227,11 @@ int runDiscover(const std::vector<std::string>& argv, std::ostream& out, std::os
       }
     }
     if (!r.found.empty() && r.augmentedModel) out << "Refine: " << refineLine(args.positional()[0], r) << "\n";
+    out << "Fit %: the seed's (5.2), " << r.fitBasis << "\n";
     out << "Seconds: " << r.seconds << "\n";
     return kExitOk;
   }
-  nlohmann::json j;
-  j["effect"] = r.effect ? toString(*r.effect) : "none";
-  j["effects"] = nlohmann::json::array();
-  for (const auto& f : r.found)
-    j["effects"].push_back({{"effect", toString(f.kind)},
-                            {"spec", toString(f.effect)},
-                            {"parameters", parametersJson(f.parameters)},
-                            {"evidence", f.evidence},
-                            {"confirmed", f.confirmation.confirmed},
-                            {"confirmation", confirmationJson(f.confirmation)},
-                            {"before", scoreJson(f.before)},
-                            {"after", scoreJson(f.after)}});
-  j["stop_reason"] = r.stopReason;
-  j["tied"] = nlohmann::json::array();
-  for (EffectKind k : r.tied) j["tied"].push_back(toString(k));
-  j["effect_parameters"] = best ? parametersJson(best->parameters) : nlohmann::json::object();
-  j["evidence"] = r.evidence;
-  j["candidates"] = candidatesJson(r.candidates);
-  j["rounds"] = nlohmann::json::array();
-  for (const auto& d : r.rounds) {
-    nlohmann::json effects = nlohmann::json::array();
-    for (const auto& e : d.effects) effects.push_back(toString(e));
-    j["rounds"].push_back({{"effects", effects},
-                           {"effect", d.effect ? toString(*d.effect) : "none"},
-                           {"decision", d.decision},
-                           {"score", scoreJson(d.score)},
-                           {"candidates", candidatesJson(d.candidates)}});
-  }
-  j["base"] = scoreJson(r.base);
-  j["base"]["aic"] = r.baseAic;
-  j["augmented"] = scoreJson(r.augmented);
-  // The final model's effects as `flexarm fit --effect` takes them.
-  j["augmented"]["effects"] = nlohmann::json::array();
-  for (const auto& e : r.augmentedEffects) j["augmented"]["effects"].push_back(toString(e));
-  j["validation_data"] = r.validationData;
-  j["disagreement"] = {{"summary", r.disagreement.summary},
-                       {"white", r.disagreement.tests.white},
-                       {"independent", r.disagreement.tests.independent},
-                       {"residual_peak_rad_s", r.disagreement.spectrumPeakRadS},
-                       {"correlation_sign_velocity", r.disagreement.correlationSignVelocity},
-                       {"resonances_rad_s", r.disagreement.resonancesRadS}};
-  j["sample_time"] = r.sampleTime;
-  j["seconds"] = r.seconds;
+  const nlohmann::json j = discoveryResultJson(r);
   out << j.dump(2) << "\n";
   return kExitOk;
 }

@@ -10,22 +10,20 @@
 #include "core/ident/fit_experiments.h"
 #include "core/ident/fit_spec.h"
 #include "core/ident/fit_text.h"
+#include "core/models/effects.h"
 
 namespace flexarm::cli {
 
 namespace {
 
-// The effects --effect switches on, until the effect registry says them.
+// What --effect does; the effects themselves are listed from the registry (effectHelpLines).
 const char* kEffectHelp =
-    "physical models: switch on a named effect and fit its first value with the model's parameters "
-    "(nonlinear grey-box estimation, the plant simulated by Runge-Kutta from the measured torque, output "
-    "error (5.7)): coulomb_friction:F_c,v_s (F_c tanh(phi_m'/v_s) on the motor), nonlinear_spring:beta (gear "
-    "spring k delta (1 + beta delta^2)), backlash:b (dead zone of half-width b, arm side), input_delay:T_d, "
-    "torque_ripple:A,n (A sin(n phi_m)), arm_friction:f_a,F_a (viscous and Coulomb on the arm), "
-    "asymmetric_coulomb:F_c+,F_c- (Coulomb friction forwards and backwards), gravity:mgl,phi_0 (mgl sin(phi_a "
-    "+ phi_0) on the arm), encoder_skew:T_o (the arm encoder reads T_o s late; with --outputs motor,arm). "
-    "Values default as `flexarm simulate --help` lists them and are the start; the second value (v_s, n) is "
-    "held unless --free names it, and v_s is 1 % of the data's RMS motor speed unless given";
+    "physical models: switch on a named effect (repeatable; the list under Effects below) and fit its sizes "
+    "with the model's parameters (nonlinear grey-box estimation, the plant simulated by Runge-Kutta from the "
+    "measured torque, output error (5.7)); the values given (else the defaults listed) are the start. A "
+    "smoothing speed (v_s), the ripple's order n and gravity's phase phi_0 are held unless --free names them; "
+    "--fix NAME=V holds any of them. The smooth signs' speed v_s is 1 % of the data's RMS motor speed unless "
+    "given";
 
 std::string closedLoopHelp() {
   std::string text = "physical output-error fits of a log with a reference channel: the closed-loop method; ";
@@ -62,6 +60,7 @@ OptionTable fitTable() {
          "notches_rad_s, peaks_rad_s) are the local minima and maxima of |G(i w)| of the estimate, what a click "
          "on the Bode plot reads. The JSON is the fit schema " + std::string(kFitJsonFormat) + " version " +
          std::to_string(kFitJsonVersion) + ", as a session's report gives it.");
+  t.block("Effects (--effect NAME[:V1,...]; values default as shown):\n" + effectHelpLines());
   return t;
 }
 
@@ -172,7 +171,7 @@ std::vector<Option> fitOptionList(bool nonparametric) {
                                                "smoothed over W bins, each chosen from the data when not given"
                                              : "") +
                               ")")),
-      textOption("effect", "NAME[:V1[,V2]]", kEffectHelp, true),
+      textOption("effect", "NAME[:V1,...]", kEffectHelp, true),
       choiceOption("outputs", {"motor", "motor,arm"}, "motor",
                    "physical models on a log with an arm-side encoder: motor,arm fits the deflection r phi_m - "
                    "phi_a with the motor output (nonlinear estimator), each weighted by its noise level"),

@@ -28,15 +28,7 @@ const char* kSimulateHelp =
     "The same options and seed give the same bytes.\n\n";
 
 const char* kSimulateHelpTail =
-    "\nEffects (repeatable; values default as shown):\n"
-    "  coulomb_friction:F_c,v_s   F_c tanh(phi_m'/v_s) on the motor (0.05 N m, 0.1 rad/s)\n"
-    "  backlash:b                 dead zone of half-width b in the gear spring (2e-4 rad)\n"
-    "  nonlinear_spring:beta      gear spring k delta (1 + beta delta^2) (2e6 1/rad^2)\n"
-    "  input_delay:T_d            the torque acts T_d seconds late (1e-3 s)\n"
-    "  torque_ripple:A,n          A sin(n phi_m) on the motor (0.05 N m, 6 per revolution)\n"
-    "  extra_mass:omega,fraction  one more mass: the fraction of the outer mass on a spring\n"
-    "                             resonating at omega (250 rad/s, 0.3)\n\n"
-    "Excitation (added to the motor position reference):\n"
+    "\nExcitation (added to the motor position reference):\n"
     "  --excitation KIND     chirp (default; 30 -> 0.5 Hz, Section 5.1), multisine (lines\n"
     "                        2 pi k/12 rad/s, k = 1..360, random phases, (6.50)), prbs, none\n"
     "  --amplitude RAD       excitation amplitude on the motor side (default 0.05 rad)\n"
@@ -89,7 +81,7 @@ nlohmann::json truthJson(const PhysicalModel& model, const std::vector<Effect>& 
   nlohmann::json fx = nlohmann::json::array();
   for (const auto& e : effects) {
     nlohmann::json params = nlohmann::json::object();
-    const auto& info = effectParameters(e.kind);
+    const auto info = effectParameters(e);
     for (std::size_t i = 0; i < info.size(); ++i)
       params[info[i].name] = {{"value", e.values[i]}, {"unit", info[i].unit}};
     fx.push_back({{"name", toString(e.kind)}, {"parameters", params}});
@@ -163,7 +155,8 @@ int runSimulate(const std::vector<std::string>& argv, std::ostream& out, std::os
   };
   if (!args.parse(argv)) return usage(args.error());
   if (args.flag("help")) {
-    out << kSimulateHelp << modelOptionsHelp() << kSimulateHelpTail << kSimulateFleetHelp;
+    out << kSimulateHelp << modelOptionsHelp() << "\nEffects (repeatable; values default as shown):\n" << effectHelpLines()
+        << kSimulateHelpTail << kSimulateFleetHelp;
     return kExitOk;
   }
   if (args.value("fleet")) return runSimulateFleet(args, out, err);

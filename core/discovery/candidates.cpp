@@ -3,6 +3,7 @@
 // its values, so short screening fits pick the start of the full refit.
 #include <algorithm>
 #include <cmath>
+#include <functional>
 
 #include "core/discovery/discovery_internal.h"
 #include "core/ident/evaluation.h"
@@ -11,14 +12,24 @@ namespace flexarm::discovery_detail {
 
 namespace {
 
-NonlinearCoordinate effectCoordinate(int effect, int index, CoordinateMap map, EffectKind kind) {
+// The search coordinate of an effect value as its definition describes it.
+NonlinearCoordinate effectCoordinate(int effect, const EffectSearchCoordinate& ec, bool rough) {
   NonlinearCoordinate c;
   c.base = false;
-  c.rough = true;
+  c.rough = rough;
   c.effect = effect;
-  c.index = index;
-  c.map = map;
-  c.scale = std::abs(effectParameters(kind)[static_cast<std::size_t>(index)].defaultValue);
+  c.index = ec.index;
+  c.scale = ec.scale > 0.0 ? ec.scale : 1.0;
+  switch (ec.map) {
+    case EffectSearchCoordinate::Map::Log:
+      c.map = CoordinateMap::Log;
+      if (ec.lower > 0.0) c.minPhi = std::log(ec.lower);
+      if (ec.upper > 0.0) c.maxPhi = std::log(ec.upper);
+      break;
+    case EffectSearchCoordinate::Map::NonNegative: c.map = CoordinateMap::NonNegative; break;
+    case EffectSearchCoordinate::Map::Signed: c.map = CoordinateMap::Scaled; break;
+    case EffectSearchCoordinate::Map::Fraction: c.map = CoordinateMap::Fraction; break;
+  }
   return c;
 }
 
@@ -59,25 +70,72 @@ void finishFit(const Context& ctx, ModelFit& f) {
   setFit(f.score, true, ctx.valY, f.yhatVal);
   const double z = twoSidedNormalQuantile(ctx.options->level);
   f.estimates.assign(f.effects.size(), {});
+  f.magnitudes.assign(f.effects.size(), {});
   for (std::size_t e = 0; e < f.effects.size(); ++e) {
-    const auto& info = effectParameters(f.effects[e].kind);
-    for (std::size_t i = 0; i < info.size(); ++i) {
-      EffectParameterEstimate p;
-      p.name = info[i].name;
-      p.unit = info[i].unit;
-      p.value = f.effects[e].values[i];
-      p.estimated = false;
-      for (std::size_t j = 0; j < f.problem.coords.size(); ++j) {
-        const auto& cj = f.problem.coords[j];
-        if (cj.base || cj.effect != static_cast<int>(e) || cj.index != static_cast<int>(i)) continue;
-        p.estimated = true;
-        const double slope = cj.slope(sol.phi[static_cast<Eigen::Index>(j)]);
-        p.std = std::abs(slope) * std::sqrt(f.inflation * conditionalVariance(sol, static_cast<Eigen::Index>(j)));
+    const Effect& fx = f.effects[e];
+    const EffectDefinition& d = effectDefinition(fx);
+    const auto info = effectParameters(fx);
+    // The covariance of this effect's searched values (physical units) and which value each
+    // coordinate is.
+    std::vector<Eigen::Index> block;
+    std::vector<std::size_t> valueOf;
+    for (std::size_t j = 0; j < f.problem.coords.size(); ++j) {
+      const auto& cj = f.problem.coords[j];
+      if (cj.base || cj.effect != static_cast<int>(e)) continue;
+      block.push_back(static_cast<Eigen::Index>(j));
+      valueOf.push_back(static_cast<std::size_t>(cj.index));
+    }
+    Eigen::MatrixXd C = block.empty() ? Eigen::MatrixXd() : blockCovariance(sol, block);
+    for (std::size_t a = 0; a < block.size(); ++a)
+      for (std::size_t b = 0; b < block.size(); ++b) {
+        const auto ia = static_cast<Eigen::Index>(a), ib = static_cast<Eigen::Index>(b);
+        C(ia, ib) *= f.inflation * f.problem.coords[static_cast<std::size_t>(block[a])].slope(sol.phi[block[a]]) *
+                     f.problem.coords[static_cast<std::size_t>(block[b])].slope(sol.phi[block[b]]);
       }
-      p.lower = p.value - z * p.std;
-      p.upper = p.value + z * p.std;
+    // The standard deviation of a function of the values by the delta method (a central
+    // difference per searched value).
+    auto deltaStd = [&](const std::function<double(const std::vector<double>&)>& g) {
+      if (block.empty()) return 0.0;
+      Eigen::VectorXd grad(static_cast<Eigen::Index>(block.size()));
+      for (std::size_t a = 0; a < block.size(); ++a) {
+        std::vector<double> up = fx.values, down = fx.values;
+        const double h = 1e-6 * (std::abs(fx.values[valueOf[a]]) + f.problem.coords[static_cast<std::size_t>(block[a])].scale);
+        up[valueOf[a]] += h;
+        down[valueOf[a]] -= h;
+        grad[static_cast<Eigen::Index>(a)] = (g(up) - g(down)) / (2.0 * h);
+      }
+      const double v = grad.dot(C * grad);
+      return std::isfinite(v) ? std::sqrt(std::max(0.0, v)) : INFINITY;
+    };
+    auto estimate = [&](const std::string& name, const std::string& unit, double value, double sd, bool estimated) {
+      EffectParameterEstimate p;
+      p.name = name;
+      p.unit = unit;
+      p.value = value;
+      p.std = sd;
+      p.estimated = estimated;
+      p.lower = value - z * sd;
+      p.upper = value + z * sd;
+      return p;
+    };
+    for (std::size_t i = 0; i < info.size(); ++i) {
+      const auto at = std::find(valueOf.begin(), valueOf.end(), i);
+      const bool searched = at != valueOf.end();
+      const double sd = searched ? std::sqrt(C(at - valueOf.begin(), at - valueOf.begin())) : 0.0;
+      f.estimates[e].push_back(estimate(info[i].name, info[i].unit, fx.values[i], sd, searched));
+    }
+    for (const auto& q : d.derivedQuantities(fx)) {
+      auto p = estimate(q.name, q.unit, q.value(fx.values), deltaStd(q.value), true);
+      p.derived = true;
       f.estimates[e].push_back(p);
     }
+    f.magnitudes[e] = estimate(d.magnitudeName(), d.displayUnit(), d.magnitude(fx),
+                               deltaStd([&d, &fx](const std::vector<double>& v) {
+                                 Effect probe = fx;
+                                 probe.values = v;
+                                 return d.magnitude(probe);
+                               }),
+                               !block.empty());
   }
   f.model = std::shared_ptr<const PhysicalModel>(std::move(built.first));
 }
@@ -104,11 +162,13 @@ std::optional<std::vector<Effect>> sameKinds(const std::vector<Effect>& warm, co
   return out;
 }
 
-// The backlash gap profiled on a logarithmic grid up to the gear travel the data show, from
-// the current model and the engineer's values: the response is far from smooth in the gap b
-// (each contact moves with it). The best three points, with the model they came from.
-void backlashStarts(const Context& ctx, const NonlinearProblem& pr, const ModelFit& current, Effect e0, double range,
-                    std::vector<Effect>& starts, std::vector<const PhysicalModel*>& startModels) {
+// An effect's main value profiled on a logarithmic grid up to `range` (the backlash gap up to
+// the gear travel the data show), from the current model and the engineer's values: the
+// response is far from smooth in it (each contact of a gap moves with it). The best three
+// points, with the model they came from.
+void profileStarts(const Context& ctx, const NonlinearProblem& pr, const ModelFit& current, Effect e0, int main,
+                   double range, std::vector<Effect>& starts, std::vector<const PhysicalModel*>& startModels) {
+  const auto at = static_cast<std::size_t>(main);
   struct GridPoint {
     double loss;
     const PhysicalModel* model;
@@ -124,7 +184,7 @@ void backlashStarts(const Context& ctx, const NonlinearProblem& pr, const ModelF
     NonlinearProblem gp = pr;
     gp.base = m;
     auto lossAt = [&](double gap) {
-      effects.back().values[0] = gap;
+      effects.back().values[at] = gap;
       return gp.simulate(gp.coordinatesOf(effects), ctx.est, yhat) ? rms(ctx.estY, ctx.pickEst(yhat)) : INFINITY;
     };
     double bestLoss = INFINITY;
@@ -156,12 +216,12 @@ void backlashStarts(const Context& ctx, const NonlinearProblem& pr, const ModelF
   }
   std::sort(grid.begin(), grid.end(), [](const GridPoint& a, const GridPoint& b) { return a.loss < b.loss; });
   for (std::size_t i = 0; i < grid.size() && i < 3; ++i) {
-    e0.values[0] = grid[i].b;
+    e0.values[at] = grid[i].b;
     starts.push_back(e0);
     startModels.push_back(grid[i].model);
   }
   if (starts.empty()) {
-    e0.values[0] = 0.3 * range;
+    e0.values[at] = 0.3 * range;
     starts.push_back(e0);
   }
 }
@@ -170,40 +230,9 @@ void backlashStarts(const Context& ctx, const NonlinearProblem& pr, const ModelF
 
 int addEffectCoordinates(NonlinearProblem& pr, int index, const EffectBounds& bounds) {
   const Effect& e = pr.effects[static_cast<std::size_t>(index)];
-  switch (e.kind) {
-    case EffectKind::CoulombFriction:  // F_c searched, the smoothing speed v_s held
-    case EffectKind::NonlinearSpring:
-    case EffectKind::InputDelay:
-      pr.coords.push_back(effectCoordinate(index, 0, CoordinateMap::NonNegative, e.kind));
-      return 0;
-    case EffectKind::TorqueRipple:  // A searched; n chosen on a grid, counted as a parameter
-      pr.coords.push_back(effectCoordinate(index, 0, CoordinateMap::NonNegative, e.kind));
-      return 1;
-    case EffectKind::Backlash: {
-      // A gap wider than the gear travel the data show is a motor that never meets the arm:
-      // its loss is flat in b and its interval does not exclude zero.
-      const double range = std::max({bounds.gapRange, 3.0 * e.value(0), 1e-3 * effectParameters(e.kind)[0].defaultValue});
-      auto c = effectCoordinate(index, 0, CoordinateMap::Log, e.kind);
-      c.minPhi = std::log(1e-3 * range);
-      c.maxPhi = std::log(range);
-      pr.coords.push_back(c);
-      return 0;
-    }
-    case EffectKind::ExtraMass: {
-      // The new mode lies within a band around the model's resonance that the data inform
-      // (0.25 to 6 times it): far below it a mass on a very soft spring would stand for a
-      // motor running free of the arm, which is not a mass the arm has.
-      auto c = effectCoordinate(index, 0, CoordinateMap::Log, e.kind);
-      const double w = std::max(bounds.resonanceRadS, 1e-3);
-      c.minPhi = std::log(std::min(0.25 * w, 0.5 * e.value(0)));
-      c.maxPhi = std::log(std::max(6.0 * w, 2.0 * e.value(0)));
-      pr.coords.push_back(c);
-      pr.coords.push_back(effectCoordinate(index, 1, CoordinateMap::Fraction, e.kind));
-      return 0;
-    }
-    default: break;  // not a candidate (DiscoveryOptions::isValid)
-  }
-  return 0;
+  const EffectDefinition& d = effectDefinition(e);
+  for (const auto& c : d.searchCoordinates(e, bounds)) pr.coords.push_back(effectCoordinate(index, c, d.roughLoss()));
+  return d.gridValues(e);
 }
 
 ModelFit fitModel(const Context& ctx, std::shared_ptr<const PhysicalModel> start, const std::vector<Effect>& effects,
@@ -217,9 +246,12 @@ ModelFit fitModel(const Context& ctx, std::shared_ptr<const PhysicalModel> start
   return f;
 }
 
-void fitCandidate(const Context& ctx, EffectKind kind, const ModelFit& current, const EffectBounds& bounds,
+void fitCandidate(const Context& ctx, EffectKind kind, const ModelFit& current, const EffectBounds& bounds0,
                   double residualPeakRadS, const ModelFit* warm, CandidateWork& w) {
   const DiscoveryOptions& o = *ctx.options;
+  const EffectDefinition& d = effectDefinition(kind);
+  EffectBounds bounds = bounds0;
+  bounds.residualPeakRadS = residualPeakRadS;
   CandidateFit& c = w.fit;
   c.kind = kind;
   std::vector<Effect> effects = current.effects;
@@ -228,61 +260,31 @@ void fitCandidate(const Context& ctx, EffectKind kind, const ModelFit& current, 
   f.start = current.model;
   setupProblem(ctx, f, effects, bounds, 1);
   NonlinearProblem& pr = f.problem;
-  const auto& info = effectParameters(kind);
   const std::size_t at = effects.size() - 1;
-  Effect e0 = effects.back();
 
   Eigen::VectorXd phi0;
   const auto warmEffects = warm && warm->ok() ? sameKinds(warm->effects, effects) : std::nullopt;
-  if (warmEffects) {
+  if (warmEffects && warmEffects->back().values.size() == effects.back().values.size()) {
     // The same effects fitted in the previous round (with the one found since): start there.
-    phi0 = coordinatesFrom(pr, *warm->model, *warmEffects);
     pr.effects = *warmEffects;
+    phi0 = coordinatesFrom(pr, *warm->model, *warmEffects);
   } else {
-    // Starts well away from the defaults (half of them, or a grid).
+    // The definition's starts (away from the defaults, a grid, or a profile of its main value).
+    const EffectSearchPlan plan = d.searchPlan(effects.back(), bounds);
     std::vector<Effect> starts;
     std::vector<const PhysicalModel*> startModels;  // base of each start (default: current)
-    switch (kind) {
-      case EffectKind::CoulombFriction:
-        e0.values[0] = 0.5 * info[0].defaultValue;
-        starts.push_back(e0);
-        break;
-      case EffectKind::Backlash:
-        backlashStarts(ctx, pr, current, e0, std::exp(pr.coords.back().maxPhi), starts, startModels);
-        break;
-      case EffectKind::NonlinearSpring:
-      case EffectKind::InputDelay:
-        // Responses far from linear in the value: a few starts over a decade.
-        for (double x : {0.2, 0.5, 1.2}) {
-          e0.values[0] = x * info[0].defaultValue;
-          starts.push_back(e0);
-        }
-        break;
-      case EffectKind::TorqueRipple:
-        e0.values[0] = 0.5 * info[0].defaultValue;
-        for (int n = 1; n <= 12; ++n) {
-          Effect e = e0;
-          e.values[1] = n;
-          starts.push_back(e);
-        }
-        break;
-      case EffectKind::ExtraMass: {
-        const double w0 = bounds.resonanceRadS;
-        std::vector<double> omegas = {0.5 * w0, 0.8 * w0, 1.3 * w0, 2.0 * w0};
-        if (residualPeakRadS > 1.2 * w0) omegas.push_back(residualPeakRadS);
-        for (double om : omegas) {
-          Effect e = e0;
-          e.values[0] = om;
-          e.values[1] = 0.25;
-          starts.push_back(e);
-        }
-        break;
-      }
-      default:  // not a candidate (DiscoveryOptions::isValid)
-        starts.push_back(e0);
-        break;
+    if (plan.profileMain) {
+      double range = 0.0;
+      for (const auto& cj : pr.coords)
+        if (!cj.base && cj.effect == static_cast<int>(at) && cj.index == d.mainParameter()) range = std::exp(cj.maxPhi);
+      profileStarts(ctx, pr, current, plan.starts.empty() ? effects.back() : plan.starts.front(), d.mainParameter(),
+                    range, starts, startModels);
+    } else {
+      starts = plan.starts;
     }
-    // Screening: a few iterations from every start; the ripple grid fits A alone (linear in A).
+    if (starts.empty()) starts.push_back(effects.back());
+    // Screening: a few iterations from every start (only this effect's coordinates when its
+    // response is linear in them and the rest is fitted already).
     LeastSquaresSolution bestSol;
     Effect bestStart = starts.front();
     double bestSum = INFINITY;
@@ -291,35 +293,77 @@ void fitCandidate(const Context& ctx, EffectKind kind, const ModelFit& current, 
         NonlinearProblem sp = pr;
         if (i < startModels.size()) sp.base = startModels[i];
         sp.effects[at] = starts[i];
-        if (kind == EffectKind::TorqueRipple) sp.coords.erase(sp.coords.begin(), sp.coords.end() - 1);  // A only
+        sp.coords = baseCoordinates(*sp.base);
+        for (std::size_t e = 0; e < sp.effects.size(); ++e) addEffectCoordinates(sp, static_cast<int>(e), bounds);
+        if (plan.screenOwnOnly)
+          sp.coords.erase(std::remove_if(sp.coords.begin(), sp.coords.end(),
+                                         [at](const NonlinearCoordinate& cj) { return cj.base || cj.effect != static_cast<int>(at); }),
+                          sp.coords.end());
         auto sol = sp.solve(sp.coordinatesOf(sp.effects), 3);
         if (sol.eps.size() && sol.sumSquares < bestSum) {
           bestSum = sol.sumSquares;
           bestStart = sp.build(sol.phi).second[at];
-          if (kind != EffectKind::TorqueRipple) bestSol = std::move(sol);
+          if (!plan.screenOwnOnly && sp.coords.size() == pr.coords.size())
+            bestSol = std::move(sol);
+          else
+            bestSol = LeastSquaresSolution{};
         }
       }
     }
     pr.effects[at] = bestStart;
     phi0 = bestSol.phi.size() ? bestSol.phi : pr.coordinatesOf(pr.effects);
   }
-  f.sol = pr.solve(phi0, o.candidateIterations);
+  // A few iterations first: a candidate whose loss has not begun to fall by a quarter of what
+  // its F-test asks is not refitted to the end (most candidates of a round explain nothing;
+  // their full fits were most of the loop's time).
+  const int first = std::min(3, o.candidateIterations);
+  f.sol = pr.solve(phi0, first);
+  if (f.sol.eps.size() && o.candidateIterations > first && !ctx.cancelled()) {
+    const double loss = f.sol.sumSquares / static_cast<double>(f.sol.eps.size());
+    const double nEff = static_cast<double>(ctx.estY.size()) / current.inflation;
+    const int q = std::max(1, f.parameterCount - current.parameterCount);
+    const double d2 = std::max(1.0, nEff - f.parameterCount);
+    const double F = loss > 0.0 ? (current.loss - loss) / loss * d2 / q : 0.0;
+    if (F > 0.25 * fQuantile(o.level, q, static_cast<int>(d2)))
+      f.sol = pr.solve(f.sol.phi, o.candidateIterations - first);
+  }
   finishFit(ctx, f);
+  // An effect of several terms (the ripple's harmonics) grows while the next term pays for
+  // itself: the F-test of its values at the level, on the estimation data.
+  while (f.ok() && f.sol.summary.ok() && !ctx.cancelled()) {
+    const auto bigger = d.withOneMoreTerm(f.effects[at]);
+    if (!bigger) break;
+    ModelFit g;
+    g.start = f.model;
+    std::vector<Effect> grown = f.effects;
+    grown[at] = *bigger;
+    setupProblem(ctx, g, grown, bounds, 1);
+    g.sol = g.problem.solve(g.problem.coordinatesOf(grown), o.candidateIterations);
+    finishFit(ctx, g);
+    if (!g.ok() || !g.sol.summary.ok()) break;
+    const double nEff = static_cast<double>(ctx.estY.size()) / f.inflation;
+    const int q = g.parameterCount - f.parameterCount;
+    const double d2 = std::max(1.0, nEff - g.parameterCount);
+    const double F = g.loss > 0.0 ? (f.loss - g.loss) / g.loss * d2 / std::max(1, q) : 0.0;
+    if (!(F > fQuantile(o.level, std::max(1, q), static_cast<int>(d2)))) break;
+    f = std::move(g);
+  }
   c.termination = ctx.cancelled() ? Termination::Cancelled : f.sol.summary.termination;
   c.parameterCount = f.parameterCount;
   if (!f.sol.summary.ok() || f.sol.eps.size() == 0 || !f.ok()) {
     c.termination = ctx.cancelled() ? Termination::Cancelled : Termination::Failed;
     c.reason = "the fit did not finish: " + f.sol.summary.message;
-    c.effect = pr.effects[at];
+    c.effect = f.problem.effects[at];
     return;
   }
   c.effect = f.effects[at];
   c.parameters = f.estimates[at];
+  c.magnitude = f.magnitudes[at];
   c.effects = f.effects;
   c.effectEstimates = f.estimates;
   c.model = f.model;
-  const auto& mp = c.parameters[static_cast<std::size_t>(mainParameter(kind))];
-  c.intervalExcludesZero = std::isfinite(mp.std) && mp.lower > 0.0;
+  const auto& mp = c.magnitude;
+  c.intervalExcludesZero = std::isfinite(mp.std) && (mp.lower > 0.0 || (d.signedMagnitude() && mp.upper < 0.0));
   c.lossEst = f.loss;
   c.score = f.score;
   std::vector<double> share(f.yhatEst.size());
@@ -341,8 +385,8 @@ ModelFit fitPair(const Context& ctx, const CandidateWork& first, const Candidate
     const CandidateWork& other = from == &first ? second : first;
     std::vector<Effect> effects = from->outcome.effects;
     effects.push_back(other.fit.effect);
-    const int m = mainParameter(other.fit.kind);
-    effects.back().values[static_cast<std::size_t>(m)] *= m == 0 ? 0.1 : 0.5;
+    const EffectDefinition& od = effectDefinition(other.fit.kind);
+    effects.back() = od.withMagnitude(effects.back(), od.magnitude(effects.back()) * (od.structural() ? 0.5 : 0.1));
     ModelFit f;
     f.start = from->outcome.model;
     setupProblem(ctx, f, effects, bounds, ctx.options->threads);

@@ -22,35 +22,17 @@ namespace flexarm::discovery_detail {
 
 namespace {
 
-// What the specific test of each effect looks at, in words.
-std::string signatureText(EffectKind k) {
-  switch (k) {
-    case EffectKind::CoulombFriction:
-      return "the residual against the sign of the motor velocity (the response to a torque -F_c sign(phi_m'))";
-    case EffectKind::Backlash:
-      return "the residual against the gear's dead zone (the response to the gear torque lost inside the gap)";
-    case EffectKind::NonlinearSpring:
-      return "the residual against the cubic gear torque (the response to k beta delta^3)";
-    case EffectKind::InputDelay:
-      return "the residual against the phase lag of a delay (the response to u(t - T_d) - u(t))";
-    case EffectKind::TorqueRipple:
-      return "the residual lines at n times the motor angle (the response to A sin(n phi_m))";
-    case EffectKind::ExtraMass:
-      return "the residual against the resonance shift of an added mass at omega";
-    default: break;  // not a candidate (DiscoveryOptions::isValid)
-  }
-  return toString(k);
-}
-
 // The size of a look-alike that has no fit of its own this round: its main value profiled
 // on a logarithmic grid (a hundredth to ten times its default) with the current model held.
 double profiledSize(const Context& ctx, const ModelFit& current, Effect e) {
-  const int m = mainParameter(e.kind);
-  const double d = effectParameters(e.kind)[static_cast<std::size_t>(m)].defaultValue;
+  const EffectDefinition& def = effectDefinition(e);
+  double d = std::abs(def.magnitude(Effect::withDefaults(e.kind)));
+  if (!(d > 0.0)) d = std::abs(effectParameters(e.kind)[static_cast<std::size_t>(def.mainParameter())].defaultValue);
+  if (!(d > 0.0)) d = 1e-3;
   double best = d, bestLoss = INFINITY;
   std::vector<double> y;
   for (int i = 0; i <= 12; ++i) {
-    e.values[static_cast<std::size_t>(m)] = d * std::pow(10.0, -2.0 + 3.0 * i / 12.0);
+    e = def.withMagnitude(e, d * std::pow(10.0, -2.0 + 3.0 * i / 12.0));
     std::vector<Effect> effects = current.effects;
     effects.push_back(e);
     try {
@@ -60,7 +42,7 @@ double profiledSize(const Context& ctx, const ModelFit& current, Effect e) {
       continue;
     }
     const double l = rms(ctx.estY, ctx.pickEst(y));
-    if (l < bestLoss) bestLoss = l, best = e.value(m);
+    if (l < bestLoss) bestLoss = l, best = def.magnitude(e);
   }
   return best;
 }
@@ -88,15 +70,14 @@ Confirmation confirmEffect(const Context& ctx, const ModelFit& current, const Mo
   for (const Effect& e : augmented.effects)
     if (e.kind == kind) fitted = &e;
   if (!fitted) return C;
-  const int main = mainParameter(kind);
-  C.fitted = fitted->value(main);
-  C.unit = effectParameters(kind)[static_cast<std::size_t>(main)].unit;
-  C.test = signatureText(kind);
+  const EffectDefinition& def = effectDefinition(kind);
+  C.fitted = def.magnitude(*fitted);
+  C.unit = def.displayUnit();
+  C.test = def.signature();
   std::vector<std::vector<double>> columns;
   auto signature = [&](const Effect& e, double size) {
     std::vector<Effect> effects = current.effects;
-    effects.push_back(e);
-    effects.back().values[static_cast<std::size_t>(mainParameter(e.kind))] = size;
+    effects.push_back(effectDefinition(e).withMagnitude(e, size));
     std::vector<double> y;
     try {
       const NonlinearPlant plant(*current.model, effects);
@@ -104,26 +85,32 @@ Confirmation confirmEffect(const Context& ctx, const ModelFit& current, const Mo
     } catch (const std::invalid_argument&) {
       return false;
     }
-    const double h = effects.back().value(mainParameter(e.kind));
+    const double h = effectDefinition(e).magnitude(effects.back());
+    if (!(std::abs(h) > 0.0)) return false;
     y = ctx.pickVal(y);
     for (std::size_t k = 0; k < N; ++k) y[k] = (y[k] - current.yhatVal[k]) / h;
     columns.push_back(std::move(y));
     return true;
   };
-  const double size = C.fitted > 0.0 ? C.fitted : effectParameters(kind)[static_cast<std::size_t>(main)].defaultValue;
+  const double size = std::abs(C.fitted) > 0.0 ? C.fitted : profiledSize(ctx, current, *fitted);
   if (!signature(*fitted, size)) return C;
-  // Rivals: every other effect the current model lacks, at the values its own candidate fit
-  // found this round (ripple and a mass need those: a period count, a frequency).
+  // Rivals: every other effect of the seed's six the current model lacks (whether or not it is
+  // a candidate), at the values its own candidate fit found this round (ripple and a mass need
+  // those: a period count, a frequency), else at a profiled size.
   for (EffectKind k : seedEffectKinds()) {
-    if (k == kind || hasEffect(current.effects, k)) continue;
-    if (gearEffect(k) && !hasGearSpring(*current.model)) continue;
-    if (k == EffectKind::ExtraMass && structureWith(*current.model, current.effects) == "four-mass") continue;
+    if (k == kind || !canJoin(ctx, current, k)) continue;
+    const EffectDefinition& rd = effectDefinition(k);
+    // Two forms of one effect (asymmetric_coulomb holds coulomb_friction) are no rivals.
+    const auto held = rd.holds(), holding = def.holds();
+    if (std::find(held.begin(), held.end(), kind) != held.end() ||
+        std::find(holding.begin(), holding.end(), k) != holding.end())
+      continue;
     const CandidateFit* fit = nullptr;
     for (const auto& w : rivals)
       if (w.fit.kind == k && w.fit.termination != Termination::Failed && !w.fit.parameters.empty()) fit = &w.fit;
-    if (!fit && (k == EffectKind::TorqueRipple || k == EffectKind::ExtraMass)) continue;
+    if (!fit && (rd.gridValues(Effect::withDefaults(k)) > 0 || rd.structural())) continue;
     Effect e = fit ? fit->effect : Effect::withDefaults(k);
-    const double s = fit && e.value(mainParameter(k)) > 0.0 ? e.value(mainParameter(k)) : profiledSize(ctx, current, e);
+    const double s = fit && std::abs(rd.magnitude(e)) > 0.0 ? rd.magnitude(e) : profiledSize(ctx, current, e);
     if (signature(e, s)) C.rivals.push_back(toString(k));
   }
   // The base parameters' (and the current effects') sensitivities on the held-out data.
@@ -191,17 +178,18 @@ Confirmation confirmEffect(const Context& ctx, const ModelFit& current, const Mo
   for (std::size_t i = 0; i < C.rivals.size(); ++i) {
     const auto j = static_cast<Eigen::Index>(i + 1);
     const double sd = stdOf(j);
-    if (beta[j] > 0.0 && std::isfinite(sd) && beta[j] / sd > zTwo && C.z <= zTwo)
+    if (beta[j] > 0.0 && std::isfinite(sd) && beta[j] / sd > zTwo && C.z * (C.fitted < 0.0 ? -1.0 : 1.0) <= zTwo)
       strongerRival += (strongerRival.empty() ? "" : ", ") + C.rivals[i] + " (z = " + number(beta[j] / sd, 3) + ")";
   }
-  C.specificPasses = C.value > 0.0 && std::isfinite(C.std) && strongerRival.empty();
+  // The signature's coefficient is the size by this test, per unit of the fitted size: the
+  // same sign as the fit's.
+  C.specificPasses = C.value * (C.fitted < 0.0 ? -1.0 : 1.0) > 0.0 && std::isfinite(C.std) && strongerRival.empty();
   C.confirmed = C.heldOutPasses && C.specificPasses;
 
   // The verdict in words.
-  const double factor = kind == EffectKind::Backlash || kind == EffectKind::InputDelay ? 1e3 : (kind == EffectKind::ExtraMass ? 100.0 : 1.0);
-  const std::string unit = kind == EffectKind::Backlash ? "mrad" : kind == EffectKind::InputDelay ? "ms"
-                                                                   : kind == EffectKind::ExtraMass ? "%" : C.unit;
-  const std::string pname = effectParameters(kind)[static_cast<std::size_t>(main)].name;
+  const double factor = def.displayFactor();
+  const std::string unit = def.displayUnit();
+  const std::string pname = def.magnitudeName();
   std::string s = C.confirmed ? "confirmed" : "not confirmed";
   s += " on " + C.heldOutData + ": residual RMS " + number(C.rmsBefore) + " -> " + number(C.rmsAfter) +
        " rad/s (z = " + number(C.heldOutZ, 3) + (C.heldOutPasses ? ", passes" : ", fails") + "); " + C.test;

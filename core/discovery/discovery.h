@@ -23,6 +23,7 @@
 //   verdict.cpp        significance, the choice among several, the evidence in words
 //   confirmation.cpp   the second method: the held-out data and a test specific to the effect
 //   loop.cpp           find, add, refit everything, find again (discoverMissingEffect)
+#include <cmath>
 #include <memory>
 #include <optional>
 #include <string>
@@ -37,8 +38,13 @@
 
 namespace flexarm {
 
+// The effects discovery looks for by default: every effect of the registry that is a
+// candidate (core/models/effect_registry.h); those that need an arm encoder are tested only
+// on logs that have one.
+const std::vector<EffectKind>& discoveryCandidateKinds();
+
 struct DiscoveryOptions {
-  std::vector<EffectKind> candidates = seedEffectKinds();  // effects to test
+  std::vector<EffectKind> candidates = discoveryCandidateKinds();  // effects to test
   // Effects the base model already has (their values the start): refitted with it, and not
   // tested again. extra_mass among them enlarges the structure.
   std::vector<Effect> startEffects;
@@ -61,17 +67,23 @@ struct DiscoveryOptions {
   double heldOutFraction = 0.3;
   // Two significant candidates whose held-out RMS differ by less than this part tie.
   double tieTolerance = 0.02;
+  // An effect is named only when the torque it adds (RMS over the estimation log, motor side)
+  // is at least this part of the model's own friction and gear spring torques there: an
+  // effect of no size that the statistics still find (Coulomb friction of 0.003 N m beside a
+  // backlash) is reported as tried, not as found.
+  double minTorqueShare = 0.02;
   int threads = 2;            // candidates fitted in parallel
   bool isValid(std::string* why) const;
 };
 
-// An estimated effect parameter with its standard deviation and interval at `level`.
-struct EffectParameterEstimate {
-  std::string name, unit;
-  double value = 0.0;
-  double std = 0.0;
-  double lower = 0.0, upper = 0.0;
-  bool estimated = true;  // false: held at a value chosen by a grid (e.g. ripple periods n)
+// An effect's size against the model it joins: the torque it adds, RMS over the estimation
+// log on the motor side (NaN for an effect that is no torque: a structure, an encoder's lag),
+// beside the base model's own friction torque f_m phi_m' and gear spring torque (motor side).
+struct EffectSize {
+  double torqueRms = NAN;
+  double frictionRms = 0.0, springRms = 0.0;
+  double share() const { return torqueRms / (frictionRms + springRms); }  // NaN without a torque
+  bool measured() const { return std::isfinite(torqueRms); }
 };
 
 // Fit % and residual RMS of one model on the estimation and the validation data: fit % as
@@ -108,7 +120,11 @@ struct Confirmation {
 struct CandidateFit {
   EffectKind kind = EffectKind::CoulombFriction;
   Effect effect;                                    // fitted values
-  std::vector<EffectParameterEstimate> parameters;  // in effectParameters(kind) order
+  // In effectParameters(effect) order, then the quantities derived from them (a ripple
+  // harmonic's amplitude and phase).
+  std::vector<EffectParameterEstimate> parameters;
+  EffectParameterEstimate magnitude;  // the effect's size, whose interval must exclude 0
+  EffectSize size;
   // Every effect of the fit (the current model's, then this one) and their estimates.
   std::vector<Effect> effects;
   std::vector<std::vector<EffectParameterEstimate>> effectEstimates;
@@ -125,6 +141,7 @@ struct CandidateFit {
   DiscoveryScore score;
   Confirmation confirmation;  // of a significant candidate the round tried to name
   bool intervalExcludesZero = false;
+  bool matters = true;  // its torque share reaches minTorqueShare (or it is no torque)
   bool significant = false;
   std::string reason;  // why (not) significant, one sentence
   Termination termination = Termination::Failed;
@@ -174,6 +191,8 @@ struct FoundEffect {
   EffectKind kind = EffectKind::CoulombFriction;
   Effect effect;                                    // its values in the final model
   std::vector<EffectParameterEstimate> parameters;  // in the final model (everything refitted)
+  EffectParameterEstimate magnitude;                // its size there
+  EffectSize size;                                  // the torque it adds where it was named
   DiscoveryScore before, after;                     // the model without and with it
   std::string evidence;
   Confirmation confirmation;
@@ -186,9 +205,27 @@ struct DiscoveryResult {
   double sampleTime = 0.0;  // of the data the fits ran on (after internal decimation)
   bool hasValidation = false;  // held-out data exist (a validation log or the log's end)
   bool heldOutSplit = false;   // the held-out data are the end of the estimation log
+  // What every fit % of the result is of, in words: fitPercents (core/ident/evaluation.h) of
+  // the motor velocity as discovery's predictor forms it (through the load observer, with
+  // the model's effects, means kept, at the fitting rate).
+  std::string fitBasis;
   std::string validationData;  // which, in words
   std::vector<DiscoveryRound> rounds;
-  std::vector<FoundEffect> found;  // every effect named, in order
+  // Every effect named, in order: each significant, its size's interval excluding 0, its
+  // torque mattering against the model, and confirmed on held-out data. The list ends with
+  // the last one that holds.
+  std::vector<FoundEffect> found;
+  // What was tried and rejected: the significant candidates of each round that were not
+  // named (no size, not confirmed, beaten by another), with the reason.
+  struct Rejected {
+    int round = 0;
+    EffectKind kind = EffectKind::CoulombFriction;
+    Effect effect;
+    EffectParameterEstimate magnitude;
+    EffectSize size;
+    std::string reason;
+  };
+  std::vector<Rejected> alsoTried;
   std::string stopReason;          // why the loop ended
   // The first round, as one search gives it: the verdict, the base (with the start effects)
   // and the candidates.

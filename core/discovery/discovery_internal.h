@@ -42,10 +42,7 @@ struct Context {
 
 // Bounds of effect coordinates that depend on the data: the widest backlash gap the data can
 // show, the current model's highest resonance (an added mass resonates near it).
-struct EffectBounds {
-  double gapRange = 1e-3;
-  double resonanceRadS = 100.0;
-};
+using EffectBounds = EffectSearchBounds;
 
 // A base model with effects, its free parameters fitted together by the discovery predictor.
 struct ModelFit {
@@ -62,7 +59,8 @@ struct ModelFit {
   // Context::valY) and of the whole series they come from.
   std::vector<double> yhatEst, yhatVal, yhatValFull, deflection;
   DiscoveryScore score;
-  std::vector<std::vector<EffectParameterEstimate>> estimates;  // per effect
+  std::vector<std::vector<EffectParameterEstimate>> estimates;  // per effect (parameters, then derived)
+  std::vector<EffectParameterEstimate> magnitudes;              // per effect: its size
   bool ok() const { return model && !yhatEst.empty(); }
 };
 
@@ -102,6 +100,11 @@ DisagreementMap mapDisagreement(const NonlinearSeries& est, const std::vector<do
 EffectBounds effectBounds(const NonlinearSeries& est, const std::vector<double>& deflection,
                           const PhysicalModel& model, const std::vector<Effect>& effects);
 
+// size.cpp: the torque effect `index` of fit adds against the model's own (RMS over the
+// estimation log), and the sentence that says it ("" for an effect that is no torque).
+EffectSize effectSize(const Context& ctx, const ModelFit& fit, std::size_t index);
+std::string sizeText(const EffectSize& s);
+
 // verdict.cpp: the statistics of every candidate against the current model, the choice among
 // several significant ones (pair refits), and the round's verdict and evidence.
 void judgeCandidates(const Context& ctx, const ModelFit& current, std::vector<CandidateWork>& work);
@@ -112,7 +115,6 @@ void judgeCandidates(const Context& ctx, const ModelFit& current, std::vector<Ca
 std::vector<std::size_t> rankSignificant(const Context& ctx, const ModelFit& current, std::vector<CandidateWork>& work,
                                          const EffectBounds& bounds, std::vector<ModelFit>& pairFits,
                                          std::string& decision, std::vector<EffectKind>& tied);
-std::string describeEffect(EffectKind kind, const std::vector<EffectParameterEstimate>& p);
 std::string roundEvidence(const Context& ctx, const DiscoveryRound& round, const CandidateWork* winner);
 
 // confirmation.cpp
@@ -131,13 +133,17 @@ double conditionalVariance(const LeastSquaresSolution& sol, Eigen::Index j);
 double heldOutZ(const std::vector<double>& y, const std::vector<double>& a, const std::vector<double>& b);
 double percentile99(const std::vector<double>& a);
 bool hasGearSpring(const PhysicalModel& m);
-bool gearEffect(EffectKind k);
-// Index of the effect parameter whose interval must exclude zero for the effect to exist.
-int mainParameter(EffectKind k);
+// The covariance of a block of coordinates (lambda times the block of (psi^T psi)^{-1}, formed
+// from the part of the block's columns the others do not explain); infinite when singular.
+Eigen::MatrixXd blockCovariance(const LeastSquaresSolution& sol, const std::vector<Eigen::Index>& block);
 std::string number(double v, int digits = 3);
 std::string plusMinus(const EffectParameterEstimate& p, double factor = 1.0);
 // The structure the effects give the base (extra_mass adds one mass).
 std::string structureWith(const PhysicalModel& base, const std::vector<Effect>& effects);
 bool hasEffect(const std::vector<Effect>& effects, EffectKind k);
+// Whether effect k can join the current model: not in it, nor held by (or holding) one of its
+// effects; a gear effect needs a gear spring, a structural one a structure below four-mass, an
+// arm-encoder effect a log with an arm encoder.
+bool canJoin(const Context& ctx, const ModelFit& current, EffectKind k);
 
 }  // namespace flexarm::discovery_detail

@@ -4,6 +4,7 @@
 // and look again, until nothing is missing or the number asked for is found.
 #include <algorithm>
 #include <chrono>
+#include <cstdio>
 #include <cmath>
 #include <mutex>
 #include <stdexcept>
@@ -22,12 +23,10 @@ using Clock = std::chrono::steady_clock;
 
 // The candidates a round tests on the current model: those asked for that it lacks and can
 // take (a gear effect needs a gear spring, a mass a structure below four-mass).
-std::vector<EffectKind> candidateKinds(const DiscoveryOptions& o, const ModelFit& current) {
+std::vector<EffectKind> candidateKinds(const Context& ctx, const DiscoveryOptions& o, const ModelFit& current) {
   std::vector<EffectKind> kinds;
   for (EffectKind k : o.candidates) {
-    if (hasEffect(current.effects, k) || std::find(kinds.begin(), kinds.end(), k) != kinds.end()) continue;
-    if (gearEffect(k) && !hasGearSpring(*current.model)) continue;
-    if (k == EffectKind::ExtraMass && structureWith(*current.model, current.effects) == "four-mass") continue;
+    if (std::find(kinds.begin(), kinds.end(), k) != kinds.end() || !canJoin(ctx, current, k)) continue;
     kinds.push_back(k);
   }
   return kinds;
@@ -78,6 +77,15 @@ DiscoveryResult discoverMissingEffect(const PhysicalModel& base, const IdData& e
   R.hasValidation = true;
   R.heldOutSplit = ctx.heldOutSplit;
   R.validationData = ctx.validationData;
+  {
+    char basis[200];
+    std::snprintf(basis, sizeof basis, "%s, with the model's effects, means kept, at %.4g Hz",
+                  o.observerBandwidthHz > 0.0
+                      ? ("one-step prediction through the " + number(o.observerBandwidthHz) + " Hz load observer").c_str()
+                      : "simulation (open loop from the input)",
+                  1.0 / ctx.est.Ts);
+    R.fitBasis = basis;
+  }
   ctx.substeps = o.substeps > 0 ? o.substeps : defaultSubsteps(ctx.est.Ts);
   ctx.observer = loadObserver(base, o.observerBandwidthHz);
   {
@@ -127,7 +135,7 @@ DiscoveryResult discoverMissingEffect(const PhysicalModel& base, const IdData& e
     D.disagreement = mapDisagreement(ctx.est, current.yhatEst, current.deflection, *current.model, current.effects,
                                      current.score, true);
     const EffectBounds bounds = effectBounds(ctx.est, current.deflection, *current.model, current.effects);
-    const std::vector<EffectKind> kinds = candidateKinds(o, current);
+    const std::vector<EffectKind> kinds = candidateKinds(ctx, o, current);
     if (kinds.empty()) {
       R.stopReason = "every candidate effect is in the model";
       break;
@@ -165,18 +173,42 @@ DiscoveryResult discoverMissingEffect(const PhysicalModel& base, const IdData& e
     std::vector<ModelFit> pairFits;
     ctx.report(0.88, "choosing among the significant candidates");
     const std::vector<std::size_t> ranked = rankSignificant(ctx, current, work, bounds, pairFits, D.decision, D.tied);
-    // The first of them is named, and the second method says whether it confirms it.
-    const int best = ranked.empty() ? -1 : static_cast<int>(ranked.front());
-    if (best >= 0 && !cancel.load()) {
-      const std::size_t i = ranked.front();
+    // The first of them that the second method confirms is named (the best three tried in
+    // their order); those passed over are reported apart, as tried. When none confirms, the
+    // first is named as it stands, "not confirmed", and the loop ends with it: the list of
+    // effects ends with the last one that holds.
+    int best = -1;
+    bool unconfirmedLast = false;
+    for (std::size_t r = 0; r < ranked.size() && r < 3 && best < 0 && !cancel.load(); ++r) {
+      const std::size_t i = ranked[r];
       ctx.report(0.93, std::string("confirming ") + toString(work[i].fit.kind));
       work[i].fit.confirmation = confirmEffect(ctx, current, work[i].outcome, work[i].fit.kind, work);
+      if (work[i].fit.confirmation.confirmed) best = static_cast<int>(i);
+    }
+    if (best < 0 && !ranked.empty() && !cancel.load()) {
+      best = static_cast<int>(ranked.front());
+      unconfirmedLast = true;
     }
     if (cancel.load()) {
       cancelled = true;
       break;
     }
     for (auto& w : work) D.candidates.push_back(w.fit);
+    // Tried and rejected: significant but not named, or a real statistic of no size.
+    for (const auto& w : work) {
+      const CandidateFit& c = w.fit;
+      if (static_cast<int>(&w - work.data()) == best) continue;
+      const bool noSize = !c.significant && !c.matters;
+      if (!c.significant && !noSize) continue;
+      DiscoveryResult::Rejected t{round, c.kind, c.effect, c.magnitude, c.size, c.reason};
+      if (c.significant)
+        t.reason = c.confirmation.ran ? c.confirmation.text
+                                      : (best >= 0 ? std::string("significant, but ") +
+                                                         toString(work[static_cast<std::size_t>(best)].fit.kind) +
+                                                         " explains the data better (" + c.reason + ")"
+                                                   : c.reason);
+      R.alsoTried.push_back(std::move(t));
+    }
     D.best = best;
     if (best < 0) {
       D.estimation = trace(ctx.est, current.yhatEst, current.yhatEst);
@@ -201,6 +233,7 @@ DiscoveryResult discoverMissingEffect(const PhysicalModel& base, const IdData& e
     }
     FoundEffect found;
     found.kind = w.fit.kind;
+    found.size = w.fit.size;
     found.before = current.score;
     found.after = w.outcome.score;
     found.evidence = D.evidence;
@@ -209,6 +242,11 @@ DiscoveryResult discoverMissingEffect(const PhysicalModel& base, const IdData& e
     R.rounds.push_back(std::move(D));
     current = std::move(w.outcome);
     warmFits = std::move(pairFits);
+    if (unconfirmedLast) {
+      R.stopReason = std::string(toString(R.found.back().kind)) +
+                     " is significant but not confirmed on the held-out data; the loop ends with it";
+      break;
+    }
     if (static_cast<int>(R.found.size()) >= o.maxEffects) {
       R.stopReason = o.maxEffects == 1 ? "one effect asked for"
                                        : "the " + std::to_string(o.maxEffects) + " effects asked for are found";
@@ -230,6 +268,7 @@ DiscoveryResult discoverMissingEffect(const PhysicalModel& base, const IdData& e
       if (current.effects[e].kind == f.kind) {
         f.effect = current.effects[e];
         f.parameters = current.estimates[e];
+        f.magnitude = current.magnitudes[e];
       }
   R.augmentedModel = current.model;
   R.augmentedEffects = current.effects;

@@ -10,23 +10,28 @@
 
 namespace flexarm {
 
+const std::vector<EffectKind>& discoveryCandidateKinds() {
+  static const std::vector<EffectKind> kinds = [] {
+    std::vector<EffectKind> v;
+    for (EffectKind k : allEffectKinds())
+      if (effectDefinition(k).discoveryCandidate()) v.push_back(k);
+    return v;
+  }();
+  return kinds;
+}
+
 bool DiscoveryOptions::isValid(std::string* why) const {
   auto fail = [why](const std::string& s) {
     if (why) *why = s;
     return false;
   };
   if (candidates.empty()) return fail("at least one candidate effect is needed");
-  auto seed = [](EffectKind k) {
-    return std::find(seedEffectKinds().begin(), seedEffectKinds().end(), k) != seedEffectKinds().end();
-  };
+  auto candidate = [](EffectKind k) { return effectDefinition(k).discoveryCandidate(); };
   for (EffectKind k : candidates)
-    if (!seed(k))
-      return fail(std::string("discovery looks for the effects of the seed's Section 3.2 assumptions; ") + toString(k) +
-                  " is fitted with fit --effect");
+    if (!candidate(k)) return fail(std::string(toString(k)) + " is not a candidate of discovery; fit it with fit --effect");
   for (const Effect& e : startEffects)
-    if (!seed(e.kind))
-      return fail(std::string("discovery refits the effects of the seed's Section 3.2 assumptions; the start effect ") +
-                  toString(e.kind) + " is fitted with fit --effect");
+    if (!candidate(e.kind))
+      return fail(std::string("the start effect ") + toString(e.kind) + " is not one discovery refits; fit it with fit --effect");
   for (std::size_t i = 0; i < startEffects.size(); ++i) {
     std::string reason;
     if (!startEffects[i].isValid(&reason)) return fail("start effect: " + reason);
@@ -46,6 +51,7 @@ bool DiscoveryOptions::isValid(std::string* why) const {
   if (!(heldOutFraction >= 0.1 && heldOutFraction <= 0.5))
     return fail("the held-out part of the log must be in [0.1, 0.5]");
   if (!(tieTolerance >= 0.0 && tieTolerance < 1.0)) return fail("the tie tolerance must be in [0, 1)");
+  if (!(minTorqueShare >= 0.0 && minTorqueShare < 1.0)) return fail("the minimum torque share must be in [0, 1)");
   if (threads < 1 || threads > 64) return fail("threads must be in 1..64");
   if (why) why->clear();
   return true;
@@ -69,12 +75,14 @@ std::pair<std::unique_ptr<PhysicalModel>, std::vector<Effect>> mergedModel(const
   std::unique_ptr<PhysicalModel> m(static_cast<PhysicalModel*>(model.clone().release()));
   std::vector<Effect> rest;
   for (const Effect& e : effects) {
-    if (e.kind != EffectKind::ExtraMass) {
+    const EffectDefinition& d = effectDefinition(e);
+    if (!d.structural()) {
       rest.push_back(e);
       continue;
     }
-    auto bigger = addMass(*m, e.value(1), e.value(0));
-    if (!bigger) throw std::invalid_argument("extra_mass: the " + m->structureName() + " model is the largest structure");
+    std::string why;
+    auto bigger = d.structure(*m, e, &why);
+    if (!bigger) throw std::invalid_argument(why);
     m = std::move(bigger);
   }
   return {std::move(m), std::move(rest)};
@@ -186,18 +194,33 @@ bool hasGearSpring(const PhysicalModel& m) {
   return !m.topology().gearStiffness.empty() && m.topology().gearDeflectionState >= 0;
 }
 
-bool gearEffect(EffectKind k) { return k == EffectKind::Backlash || k == EffectKind::NonlinearSpring; }
+std::string number(double v, int digits) { return effect_text::number(v, digits); }
 
-int mainParameter(EffectKind k) { return k == EffectKind::ExtraMass ? 1 : 0; }
+std::string plusMinus(const EffectParameterEstimate& p, double factor) { return effect_text::plusMinus(p, factor); }
 
-std::string number(double v, int digits) {
-  char buf[48];
-  std::snprintf(buf, sizeof buf, "%.*g", digits, v);
-  return buf;
-}
-
-std::string plusMinus(const EffectParameterEstimate& p, double factor) {
-  return number(p.value * factor) + " +- " + number(p.std * factor, 2);
+Eigen::MatrixXd blockCovariance(const LeastSquaresSolution& sol, const std::vector<Eigen::Index>& block) {
+  const Eigen::MatrixXd& psi = sol.psi;
+  const Eigen::Index n = psi.rows(), p = psi.cols();
+  const auto b = static_cast<Eigen::Index>(block.size());
+  Eigen::MatrixXd inf = Eigen::MatrixXd::Constant(b, b, INFINITY);
+  if (n <= p || b == 0) return inf;
+  const double lambda = sol.sumSquares / static_cast<double>(n - p);
+  Eigen::MatrixXd S(n, b), others(n, p - b);
+  for (Eigen::Index c = 0, o = 0; c < p; ++c) {
+    const auto at = std::find(block.begin(), block.end(), c);
+    if (at != block.end()) S.col(at - block.begin()) = psi.col(c);
+    else others.col(o++) = psi.col(c);
+  }
+  if (p > b) {
+    Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(others);
+    qr.setThreshold(1e-9);
+    S -= others * qr.solve(S);
+  }
+  const Eigen::MatrixXd G = S.transpose() * S;
+  Eigen::LDLT<Eigen::MatrixXd> ldlt(G);
+  if (ldlt.info() != Eigen::Success || !(ldlt.vectorD().minCoeff() > 1e-12 * std::max(1e-300, ldlt.vectorD().maxCoeff())))
+    return inf;
+  return lambda * ldlt.solve(Eigen::MatrixXd::Identity(b, b));
 }
 
 std::string structureWith(const PhysicalModel& base, const std::vector<Effect>& effects) {
@@ -207,12 +230,27 @@ std::string structureWith(const PhysicalModel& base, const std::vector<Effect>& 
     if (base.structureName() == kOrder[i]) at = i;
   if (at < 0) return base.structureName();
   for (const Effect& e : effects)
-    if (e.kind == EffectKind::ExtraMass) ++at;
+    if (effectDefinition(e).structural()) ++at;
   return at <= 3 ? kOrder[at] : "larger than four-mass";
 }
 
 bool hasEffect(const std::vector<Effect>& effects, EffectKind k) {
   return std::any_of(effects.begin(), effects.end(), [k](const Effect& e) { return e.kind == k; });
+}
+
+bool canJoin(const Context& ctx, const ModelFit& current, EffectKind k) {
+  if (hasEffect(current.effects, k) || !current.model) return false;
+  const EffectDefinition& d = effectDefinition(k);
+  if (d.needsGearSpring() && !hasGearSpring(*current.model)) return false;
+  if (d.structural() && structureWith(*current.model, current.effects) == "four-mass") return false;
+  if (d.needsArmEncoder() && ctx.est.deflection.empty()) return false;
+  const auto held = d.holds();
+  for (const Effect& e : current.effects) {
+    const auto others = effectDefinition(e).holds();
+    if (std::find(others.begin(), others.end(), k) != others.end()) return false;
+    if (std::find(held.begin(), held.end(), e.kind) != held.end()) return false;
+  }
+  return true;
 }
 
 }  // namespace discovery_detail

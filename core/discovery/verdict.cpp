@@ -50,16 +50,26 @@ void judgeCandidates(const Context& ctx, const ModelFit& current, std::vector<Ca
     c.heldOutZ = heldOutZ(ctx.valY, current.yhatVal, w.outcome.yhatVal);
     const bool valOk = c.score.rmsValidation <= (1.0 - o.minValidationImprovement) * current.score.rmsValidation &&
                        c.heldOutZ > zThreshold;
-    const auto& mp = c.parameters[static_cast<std::size_t>(mainParameter(c.kind))];
+    const auto& mp = c.magnitude;
     // Without curvature in the effect's parameter (a backlash gap wider than any deflection
     // in the data leaves the loss flat in b: a motor running free of the arm, which explains
     // much of any data) the effect is not named.
-    c.significant = t.passes() && aicOk && valOk && c.intervalExcludesZero;
+    const bool statistics = t.passes() && aicOk && valOk && c.intervalExcludesZero;
+    // Nor is one whose torque is too small to matter against the model's own.
+    if (statistics) {
+      c.size = effectSize(ctx, w.outcome, w.outcome.effects.size() - 1);
+      c.matters = !c.size.measured() || c.size.share() >= o.minTorqueShare;
+    }
+    c.significant = statistics && c.matters;
     const std::string held = "the held-out residual RMS " + number(current.score.rmsValidation) + " -> " +
                              number(c.score.rmsValidation) + " rad/s (z = " + number(c.heldOutZ, 2) + ")";
+    const std::string size = sizeText(c.size);
     if (c.significant) {
       c.reason = "significant: F = " + number(c.fStatistic) + " > " + number(c.fThreshold) + ", " + mp.name +
-                 " interval excludes 0, " + held;
+                 " interval excludes 0, " + held + (size.empty() ? "" : "; " + size);
+    } else if (statistics) {
+      c.reason = "too small to matter: " + size + " (at least " + number(100.0 * o.minTorqueShare, 2) +
+                 " % needed), though " + mp.name + " interval excludes 0 and " + held;
     } else if (!c.intervalExcludesZero) {
       c.reason = "the " + number(100 * o.level, 2) + " % interval of " + mp.name + " [" + number(mp.lower) + ", " +
                  number(mp.upper) + "] includes 0";
@@ -94,14 +104,22 @@ std::vector<std::size_t> rankSignificant(const Context& ctx, const ModelFit& cur
       if (ctx.cancelled()) return {};
       const std::size_t i = sig[a], j = sig[b];
       ctx.report(-1.0, std::string("refitting ") + toString(work[i].fit.kind) + " with " + toString(work[j].fit.kind));
-      ModelFit both = fitPair(ctx, work[i], work[j], bounds);
+      // An effect that holds the other as a special case (asymmetric_coulomb and
+      // coulomb_friction) is the pair: nothing to refit.
+      auto holdsKind = [](EffectKind general, EffectKind special) {
+        const auto h = effectDefinition(general).holds();
+        return std::find(h.begin(), h.end(), special) != h.end();
+      };
+      const bool nested = holdsKind(work[i].fit.kind, work[j].fit.kind) || holdsKind(work[j].fit.kind, work[i].fit.kind);
+      ModelFit both = nested ? ModelFit{} : fitPair(ctx, work[i], work[j], bounds);
       // A pair search that ended above either effect alone has not found the pair's
       // optimum: the better single fit bounds it.
       const double pairLoss = std::min({both.ok() ? both.loss : INFINITY, work[i].fit.lossEst, work[j].fit.lossEst});
-      const int pairCount = work[i].fit.parameterCount + work[j].fit.parameterCount - current.parameterCount;
+      const int pairCount = nested ? std::max(work[i].fit.parameterCount, work[j].fit.parameterCount)
+                                   : work[i].fit.parameterCount + work[j].fit.parameterCount - current.parameterCount;
       for (auto [x, y] : {std::pair{i, j}, std::pair{j, i}}) {
-        const FTest t = fTest(work[y].fit.lossEst, pairLoss, work[x].fit.parameterCount - current.parameterCount,
-                              pairCount, nEff, o.level);
+        const FTest t = fTest(work[y].fit.lossEst, pairLoss, pairCount - work[y].fit.parameterCount, pairCount, nEff,
+                              o.level);
         survival[x] = std::min(survival[x], t.f);
         threshold[x] = std::max(threshold[x], t.threshold);
         survives[x][y] = t.passes();
@@ -141,26 +159,6 @@ std::vector<std::size_t> rankSignificant(const Context& ctx, const ModelFit& cur
   return ranked;
 }
 
-std::string describeEffect(EffectKind kind, const std::vector<EffectParameterEstimate>& p) {
-  switch (kind) {
-    case EffectKind::CoulombFriction:
-      return "Coulomb friction of " + plusMinus(p[0]) + " N m on the motor side";
-    case EffectKind::Backlash:
-      return "backlash in the gear, a dead zone of half-width " + plusMinus(p[0], 1e3) + " mrad (arm side)";
-    case EffectKind::NonlinearSpring:
-      return "a stiffening gear spring, k delta (1 + beta delta^2) with beta = " + plusMinus(p[0]) + " 1/rad^2";
-    case EffectKind::InputDelay:
-      return "an input delay of " + plusMinus(p[0], 1e3) + " ms between the torque reference and the applied torque";
-    case EffectKind::TorqueRipple:
-      return "torque ripple of " + plusMinus(p[0]) + " N m, " + number(p[1].value) + " periods per motor revolution";
-    case EffectKind::ExtraMass:
-      return "an extra mass: " + plusMinus(p[1], 100.0) + " % of the outermost inertia on a spring resonating at " +
-             number(p[0].value) + " +- " + number(p[0].std, 2) + " rad/s";
-    default: break;  // not a candidate (DiscoveryOptions::isValid)
-  }
-  return toString(kind);
-}
-
 std::string roundEvidence(const Context& ctx, const DiscoveryRound& r, const CandidateWork* winner) {
   const DiscoveryOptions& o = *ctx.options;
   const std::string modelName = r.effects.empty() ? "base model" : "model";
@@ -187,7 +185,7 @@ std::string roundEvidence(const Context& ctx, const DiscoveryRound& r, const Can
     return s;
   }
   const CandidateFit& b = winner->fit;
-  std::string s = describeEffect(b.kind, b.parameters);
+  std::string s = effectDefinition(b.kind).describe(b.parameters);
   s[0] = static_cast<char>(std::toupper(static_cast<unsigned char>(s[0])));
   s += "; the " + modelName + "'s residual correlates with the effect's simulated share, rho = " + number(b.rho, 2);
   if (b.kind == EffectKind::CoulombFriction)
@@ -205,7 +203,8 @@ std::string roundEvidence(const Context& ctx, const DiscoveryRound& r, const Can
   // the gap opens), so the loss is not the smooth quadratic its finite-difference Jacobian
   // assumes near the optimum: the interval from it can be far narrower than the error (issue
   // 13: a 0.2 mrad gap came out 0.187 +- 0.00028 mrad, 46 standard deviations off).
-  if (b.kind == EffectKind::Backlash || b.kind == EffectKind::InputDelay)
+  if (const std::string size = sizeText(b.size); !size.empty()) s += " Its size: " + size + ".";
+  if (effectDefinition(b.kind).roughLoss())
     s += " The " + std::string(toString(b.kind)) +
          " interval promises too much: the loss is not smooth in that parameter, so the estimate can be off by many "
          "of its standard deviations.";

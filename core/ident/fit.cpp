@@ -76,21 +76,23 @@ FitCheck checkSpec(const FitModelSpec& m) {
         std::string reason;
         if (!f.effect.isValid(&reason)) return refuse(I::InvalidEffect, reason);
         const std::string name = toString(f.effect.kind);
-        if (f.effect.kind == EffectKind::ExtraMass)
-          return refuse(I::EffectChangesStructure, "extra_mass changes the structure; fit the larger structure instead");
+        const EffectDefinition& d = effectDefinition(f.effect);
+        if (d.structural())
+          return refuse(I::EffectChangesStructure, name + " changes the structure; fit the larger structure instead");
         if (seen[static_cast<std::size_t>(f.effect.kind)])
           return refuse(I::EffectTwice, "the effect " + name + " is given twice");
         seen[static_cast<std::size_t>(f.effect.kind)] = true;
-        if ((f.effect.kind == EffectKind::Backlash || f.effect.kind == EffectKind::NonlinearSpring) &&
+        if (d.needsGearSpring() &&
             (m.start->topology().gearStiffness.empty() || m.start->structureName() == "two-mass-theta"))
           return refuse(I::EffectNeedsGearSpring, name + " needs a model with a gear spring (two-mass, three-mass "
                                                          "or four-mass), not " + m.start->structureName());
-        for (std::size_t k = 0; k < effectParameters(f.effect.kind).size(); ++k) anyFree = anyFree || f.free[k];
+        for (std::size_t k = 0; k < f.effect.values.size(); ++k) anyFree = anyFree || f.isFree(k);
       }
       for (const auto& f : m.effects)
-        if (f.effect.kind == EffectKind::EncoderSkew && !m.armOutput)
-          return refuse(I::EncoderSkewNeedsArm, "encoder_skew shifts what the arm encoder reads: it goes with the "
-                                                "arm as an output (--outputs motor,arm)");
+        if (effectDefinition(f.effect).needsArmEncoder() && !m.armOutput)
+          return refuse(I::EncoderSkewNeedsArm, std::string(toString(f.effect.kind)) +
+                                                    " changes what the arm encoder reads: it goes with the arm as an "
+                                                    "output (--outputs motor,arm)");
       if (m.armOutput && m.start->options().output != ModelOutput::MotorVelocity)
         return refuse(I::ArmOutputNeedsVelocity, "the arm as a second output goes with the motor velocity as the first");
       if (!m.effects.empty() && m.start->options().armAcceleration)

@@ -108,7 +108,7 @@ void fitNonlinear(const FitOptions& o, FitResult& r, const ProgressCallback& pro
   if (speed > 0.0 && std::isfinite(speed)) {
     r.smoothingSpeed = 0.01 * speed;
     for (auto& f : effects)
-      if (f.effect.kind == EffectKind::CoulombFriction && f.scaleSmoothing && !f.free[1]) {
+      if (f.effect.kind == EffectKind::CoulombFriction && f.scaleSmoothing && !f.isFree(1)) {
         f.effect.values[1] = r.smoothingSpeed;
         char buf[160];
         std::snprintf(buf, sizeof buf, "coulomb_friction's smoothing speed v_s = %.3g, 1 %% of the data's RMS "
@@ -185,7 +185,7 @@ void keepNonlinear(NonlinearPemResult&& e, const FitOptions& o, const PhysicalMo
     r.parameters.push_back({p.name, p.unit, p.value, p.std, p.lower, p.upper, p.free, ""});
   }
   for (const auto& fx : e.effects)
-    for (std::size_t k = 0; k < effectParameters(fx.kind).size(); ++k, ++row) {
+    for (std::size_t k = 0; k < fx.values.size(); ++k, ++row) {
       const auto& p = e.parameters[row];
       r.parameters.push_back({p.name, p.unit, p.value, p.std, p.lower, p.upper, p.free, toString(fx.kind)});
     }

@@ -138,7 +138,7 @@ std::vector<std::string> fitParameterLabels(const FitModelSpec& spec) {
   if (spec.start)
     for (const auto& p : spec.start->parameters()) out.push_back(p.name);
   for (const auto& f : spec.effects)
-    for (const auto& info : effectParameters(f.effect.kind))
+    for (const auto& info : effectParameters(f.effect))
       out.push_back(fitParameterLabel(info.name, toString(f.effect.kind)));
   return out;
 }
@@ -149,9 +149,9 @@ std::vector<std::string> freeParameterLabels(const FitModelSpec& spec) {
     for (const auto& p : spec.start->parameters())
       if (p.free) out.push_back(p.name);
   for (const auto& f : spec.effects) {
-    const auto& info = effectParameters(f.effect.kind);
-    for (std::size_t k = 0; k < info.size() && k < f.free.size(); ++k)
-      if (f.free[k]) out.push_back(fitParameterLabel(info[k].name, toString(f.effect.kind)));
+    const auto info = effectParameters(f.effect);
+    for (std::size_t k = 0; k < info.size(); ++k)
+      if (f.isFree(k)) out.push_back(fitParameterLabel(info[k].name, toString(f.effect.kind)));
   }
   return out;
 }
@@ -161,7 +161,7 @@ std::string fitParameterNames(const FitModelSpec& spec) {
   if (spec.start)
     for (const auto& p : spec.start->parameters()) out += (out.empty() ? "" : ", ") + p.name;
   for (const auto& f : spec.effects)
-    for (const auto& info : effectParameters(f.effect.kind)) out += (out.empty() ? "" : ", ") + info.name;
+    for (const auto& info : effectParameters(f.effect)) out += (out.empty() ? "" : ", ") + info.name;
   return out;
 }
 
@@ -169,7 +169,7 @@ FitParameterRef findFitParameter(const FitModelSpec& spec, const std::string& te
   FitParameterRef ref;
   for (std::size_t e = 0; e < spec.effects.size(); ++e) {
     const EffectKind kind = spec.effects[e].effect.kind;
-    const auto& info = effectParameters(kind);
+    const auto info = effectParameters(spec.effects[e].effect);
     for (std::size_t k = 0; k < info.size(); ++k)
       if (text == info[k].name || text == fitParameterLabel(info[k].name, toString(kind))) {
         ref.effect = static_cast<int>(e);
@@ -195,7 +195,7 @@ bool setFreeParameters(FitModelSpec& spec, const std::vector<std::string>& names
   auto model = editableCopy(*spec.start);
   for (const auto& p : model->parameters()) model->setFree(p.name, false);
   std::vector<FitEffect> effects = spec.effects;
-  for (auto& f : effects) f.free = {false, false};
+  for (auto& f : effects) f.free.assign(f.effect.values.size(), false);
   for (const auto& n : names) {
     const FitParameterRef ref = findFitParameter(spec, n);
     if (!ref.found()) {
@@ -249,7 +249,7 @@ bool applyParameterOption(FitOptions& options, ParameterOption kind, const std::
     const auto k = static_cast<std::size_t>(ref.value);
     if (v) f.effect.values[k] = v->value;
     if (v && k == 1) f.scaleSmoothing = false;
-    if (kind == ParameterOption::Fix) f.free[k] = false;
+    if (kind == ParameterOption::Fix && k < f.free.size()) f.free[k] = false;
     if (std::string reason; !f.effect.isValid(&reason)) return fail(reason);
     spec.effects[static_cast<std::size_t>(ref.effect)] = f;
     return true;

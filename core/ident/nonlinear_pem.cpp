@@ -44,7 +44,8 @@ int defaultSubsteps(double Ts) { return std::max(2, static_cast<int>(std::ceil(T
 
 bool predictOutput(const NonlinearPlant& plant, const NonlinearSeries& s, int substeps,
                    const LoadObserver& observer, PredictedOutput output, std::vector<double>& yhat,
-                   std::vector<double>* deflection, std::vector<double>* armDeflection) {
+                   std::vector<double>* deflection, std::vector<double>* armDeflection,
+                   const PredictorVisitor* visit) {
   const std::size_t N = s.u.size();
   if (N == 0) return false;
   const bool hasAngle = s.phi.size() == N;
@@ -112,6 +113,7 @@ bool predictOutput(const NonlinearPlant& plant, const NonlinearSeries& s, int su
       correction = gain * (kp * e + ki * integral);
     }
     const double t = static_cast<double>(k) * Ts;
+    if (visit) (*visit)(k, x, u[k] + correction, torqueAt(t + 0.5 * h));
     for (int i = 0; i < substeps; ++i) plant.step(x, t + i * h, h, torqueAt, 0.0);
   }
   if (output == PredictedOutput::DifferentiatedAngle) yhat = differentiate(phiHat, Ts);
@@ -303,9 +305,13 @@ std::vector<NonlinearCoordinate> baseCoordinates(const PhysicalModel& m) {
   return out;
 }
 
-FitEffect FitEffect::defaults(EffectKind k) {
+FitEffect FitEffect::defaults(EffectKind k) { return of(Effect::withDefaults(k)); }
+
+FitEffect FitEffect::of(const Effect& e) {
   FitEffect f;
-  f.effect = Effect::withDefaults(k);
+  f.effect = e;
+  f.free.clear();
+  for (const auto& p : effectParameters(e)) f.free.push_back(p.freeInFit);
   return f;
 }
 
@@ -328,29 +334,31 @@ bool NonlinearPemOptions::isValid(std::string* why) const {
 
 namespace {
 
-// Effect values positive by nature (a smoothing speed, a number of periods) are searched as
-// logarithms; the others as non-negative values scaled by their size.
+// Effect values are searched as their registry domain says: logarithms for values positive
+// by nature (a smoothing speed, a number of periods), scaled values for those of either sign
+// (a phase, a skew, a ripple's sine and cosine coefficients), non-negative scaled values for
+// the others.
 NonlinearCoordinate effectCoordinate(int effect, int index, const Effect& e) {
   NonlinearCoordinate c;
   c.base = false;
   c.effect = effect;
   c.index = index;
-  const bool positive = (e.kind == EffectKind::CoulombFriction && index == 1) ||
-                        (e.kind == EffectKind::TorqueRipple && index == 1);
+  const EffectParameterInfo info = effectParameters(e)[static_cast<std::size_t>(index)];
   const double v = e.values[static_cast<std::size_t>(index)];
-  // A phase or a skew takes either sign.
-  const bool signed_ = (e.kind == EffectKind::Gravity && index == 1) || e.kind == EffectKind::EncoderSkew;
-  if (positive) {
-    c.map = CoordinateMap::Log;
-  } else if (signed_) {
-    c.map = CoordinateMap::Scaled;
-    c.scale = std::max(std::abs(v), e.kind == EffectKind::Gravity ? 1.0 : 1e-3);
-  } else {
-    c.map = CoordinateMap::NonNegative;
-    c.scale = std::max(std::abs(v), std::abs(effectParameters(e.kind)[static_cast<std::size_t>(index)].defaultValue));
-    if (!(c.scale > 0.0)) c.scale = 1.0;  // a value that starts (and defaults) at zero
+  const double typical = std::max(std::abs(v), std::abs(info.defaultValue));
+  switch (info.domain) {
+    case ValueDomain::Positive: c.map = CoordinateMap::Log; break;
+    case ValueDomain::Signed:
+      c.map = CoordinateMap::Scaled;
+      c.scale = typical > 0.0 ? typical : (info.unit == "s" ? 1e-3 : 1.0);
+      break;
+    case ValueDomain::NonNegative:
+    case ValueDomain::Fraction:
+      c.map = CoordinateMap::NonNegative;
+      c.scale = typical > 0.0 ? typical : 1.0;  // a value that starts (and defaults) at zero
+      break;
   }
-  c.rough = e.kind == EffectKind::Backlash || e.kind == EffectKind::InputDelay;
+  c.rough = effectDefinition(e).roughLoss();
   return c;
 }
 
@@ -370,8 +378,9 @@ NonlinearPemResult nonlinearPem(const PhysicalModel& start, const std::vector<Fi
                                   "the same positive sample time");
   std::vector<Effect> values;
   for (const auto& f : effects) {
-    if (f.effect.kind == EffectKind::ExtraMass)
-      throw std::invalid_argument("nonlinearPem: extra_mass changes the structure; fit the larger structure");
+    if (effectDefinition(f.effect).structural())
+      throw std::invalid_argument(std::string("nonlinearPem: ") + toString(f.effect.kind) +
+                                  " changes the structure; fit the larger structure");
     values.push_back(f.effect);
   }
   std::unique_ptr<PhysicalModel> base(static_cast<PhysicalModel*>(start.clone().release()));
@@ -383,8 +392,8 @@ NonlinearPemResult nonlinearPem(const PhysicalModel& start, const std::vector<Fi
   pr.effects = values;
   pr.coords = baseCoordinates(*base);
   for (std::size_t i = 0; i < effects.size(); ++i)
-    for (std::size_t k = 0; k < effectParameters(effects[i].effect.kind).size(); ++k)
-      if (effects[i].free[k])
+    for (std::size_t k = 0; k < effects[i].effect.values.size(); ++k)
+      if (effects[i].isFree(k))
         pr.coords.push_back(effectCoordinate(static_cast<int>(i), static_cast<int>(k), effects[i].effect));
   if (pr.coords.empty()) throw std::invalid_argument("nonlinearPem: no free parameter");
   for (const auto& s : experiments) pr.series.push_back(&s);
@@ -442,7 +451,7 @@ NonlinearPemResult nonlinearPem(const PhysicalModel& start, const std::vector<Fi
     row(ps[i].name, ps[i].unit, ps[i].value, j);
   }
   for (std::size_t e = 0; e < R.effects.size(); ++e) {
-    const auto& info = effectParameters(R.effects[e].kind);
+    const auto info = effectParameters(R.effects[e]);
     for (std::size_t k = 0; k < info.size(); ++k) {
       const int j = coordOf(false, static_cast<int>(e), static_cast<int>(k));
       if (j >= 0) R.effectFree.emplace_back(static_cast<int>(e), static_cast<int>(k));

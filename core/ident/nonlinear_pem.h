@@ -11,6 +11,7 @@
 // the discovery workflow (core/discovery), which builds its own problems from these parts.
 #include <array>
 #include <atomic>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <string>
@@ -95,9 +96,14 @@ NonlinearSeries nonlinearSeries(const PreparedData& data, SampleRange range, boo
 // deflection, when given, receives the gear deflection at every sample; armDeflection the
 // deflection r phi_m - phi_a as the arm encoder reads it (NonlinearPlant::armDeflection plus
 // encoder_skew's T_o times the arm's speed).
+// visit, when given, sees the plant's state at every sample with the torque reference asked
+// for there and the one applied (after the input delay and with the observer's correction).
+using PredictorVisitor =
+    std::function<void(std::size_t k, const NonlinearPlant::State& x, double torqueNow, double torqueApplied)>;
 bool predictOutput(const NonlinearPlant& plant, const NonlinearSeries& s, int substeps,
                    const LoadObserver& observer, PredictedOutput output, std::vector<double>& yhat,
-                   std::vector<double>* deflection = nullptr, std::vector<double>* armDeflection = nullptr);
+                   std::vector<double>* deflection = nullptr, std::vector<double>* armDeflection = nullptr,
+                   const PredictorVisitor* visit = nullptr);
 
 // Runge-Kutta steps per sample for a step of at most 0.25 ms (and at least 2).
 int defaultSubsteps(double sampleTime);
@@ -157,14 +163,18 @@ std::vector<NonlinearCoordinate> baseCoordinates(const PhysicalModel& m);
 // An effect in a fit: its (start) values and which of them are estimated.
 struct FitEffect {
   Effect effect;
-  std::array<bool, 2> free{true, false};
+  // Per value of the effect (effectParameters(effect) order): estimated or held.
+  std::vector<bool> free{true, false};
   // coulomb_friction: the fit sets v_s from the data's speed (1 % of the RMS motor speed,
   // whatever its units) instead of keeping the value given; false when v_s was given.
   bool scaleSmoothing = true;
-  // The effect at its defaults with its first value free and the others fixed (v_s of the
-  // Coulomb friction, n of the ripple: a smoothing speed and an integer the data hardly
-  // inform).
+  // The effect at its defaults, its values free as the registry says (EffectParameterInfo::
+  // freeInFit: the sizes, not v_s of the Coulomb friction nor n of the ripple, a smoothing
+  // speed and an integer the data hardly inform).
   static FitEffect defaults(EffectKind k);
+  // The same for an effect's own values (its size: a ripple of several harmonics).
+  static FitEffect of(const Effect& e);
+  bool isFree(std::size_t k) const { return k < free.size() && free[k]; }
 };
 
 struct NonlinearPemOptions {

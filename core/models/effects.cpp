@@ -1,47 +1,65 @@
+// Effect names, parameters, parsing and help lines, all read from the registry
+// (core/models/effect_registry.h); and the defaults every definition shares.
 #include "core/models/effects.h"
 
+#include <array>
 #include <charconv>
 #include <cmath>
+#include <cstdio>
+
+#include "core/models/effect_registry.h"
 
 namespace flexarm {
 
 namespace {
-struct KindName {
-  EffectKind kind;
-  const char* name;
+
+struct Registry {
+  std::vector<std::unique_ptr<EffectDefinition>> definitions;
+  std::vector<EffectKind> kinds;
+  std::vector<std::vector<EffectParameterInfo>> parameters;  // at the default size
 };
-constexpr KindName kKindNames[] = {
-    {EffectKind::CoulombFriction, "coulomb_friction"}, {EffectKind::Backlash, "backlash"},
-    {EffectKind::NonlinearSpring, "nonlinear_spring"}, {EffectKind::InputDelay, "input_delay"},
-    {EffectKind::TorqueRipple, "torque_ripple"},       {EffectKind::ExtraMass, "extra_mass"},
-    {EffectKind::ArmFriction, "arm_friction"},         {EffectKind::AsymmetricCoulomb, "asymmetric_coulomb"},
-    {EffectKind::Gravity, "gravity"},                  {EffectKind::EncoderSkew, "encoder_skew"},
-};
+
+}  // namespace
+
+const EffectDefinition& effectDefinition(EffectKind k) {
+  static const Registry* registry = [] {
+    auto* r = new Registry;
+#define FLEXARM_EFFECT(kind, name, factory)               \
+  r->definitions.push_back(factory());                    \
+  r->definitions.back()->kind_ = EffectKind::kind;        \
+  r->definitions.back()->name_ = name;                    \
+  r->kinds.push_back(EffectKind::kind);
+#include "core/models/effects/effect_list.h"
+#undef FLEXARM_EFFECT
+    for (const auto& d : r->definitions) r->parameters.push_back(d->parameters());
+    return r;
+  }();
+  return *registry->definitions[static_cast<std::size_t>(k)];
+}
+
+namespace {
 
 bool parseNumber(std::string_view s, double& out) {
   const auto res = std::from_chars(s.data(), s.data() + s.size(), out);
   return res.ec == std::errc() && res.ptr == s.data() + s.size() && std::isfinite(out);
 }
+
 }  // namespace
 
-const char* toString(EffectKind k) {
-  for (const auto& kn : kKindNames)
-    if (kn.kind == k) return kn.name;
-  return "coulomb_friction";
-}
+const char* toString(EffectKind k) { return effectDefinition(k).name(); }
 
 std::optional<EffectKind> effectKindFromString(std::string_view s) {
-  for (const auto& kn : kKindNames)
-    if (s == kn.name) return kn.kind;
+  for (EffectKind k : allEffectKinds())
+    if (s == toString(k)) return k;
   return std::nullopt;
 }
 
 const std::vector<EffectKind>& allEffectKinds() {
   static const std::vector<EffectKind> kAll = {
-      EffectKind::CoulombFriction, EffectKind::Backlash,     EffectKind::NonlinearSpring,
-      EffectKind::InputDelay,      EffectKind::TorqueRipple, EffectKind::ExtraMass,
-      EffectKind::ArmFriction,     EffectKind::AsymmetricCoulomb, EffectKind::Gravity,
-      EffectKind::EncoderSkew};
+#define FLEXARM_EFFECT(kind, name, factory) EffectKind::kind,
+#include "core/models/effects/effect_list.h"
+#undef FLEXARM_EFFECT
+  };
   return kAll;
 }
 
@@ -50,53 +68,29 @@ const std::vector<EffectKind>& seedEffectKinds() {
   return kSeed;
 }
 
+std::string effectNames() {
+  std::string s;
+  for (EffectKind k : allEffectKinds()) s += (s.empty() ? "" : ", ") + std::string(toString(k));
+  return s;
+}
+
 const std::vector<EffectParameterInfo>& effectParameters(EffectKind k) {
-  static const std::vector<EffectParameterInfo> kCoulomb = {
-      {"F_c", "N m", 0.05, "Coulomb friction torque on the motor"},
-      {"v_s", "rad/s", 0.1, "motor speed of the smooth sign: F_c tanh(phi_m'/v_s)"}};
-  static const std::vector<EffectParameterInfo> kBacklash = {
-      {"b", "rad", 2e-4, "half-width of the dead zone in the gear spring (arm side)"}};
-  static const std::vector<EffectParameterInfo> kSpring = {
-      {"beta", "1/rad^2", 2e6, "stiffening of the gear spring: k delta (1 + beta delta^2)"}};
-  static const std::vector<EffectParameterInfo> kDelay = {
-      {"T_d", "s", 1e-3, "delay between the torque reference and the applied torque"}};
-  static const std::vector<EffectParameterInfo> kRipple = {
-      {"A", "N m", 0.05, "amplitude of the ripple torque A sin(n phi_m)"},
-      {"n", "1/rev", 6.0, "ripple periods per motor revolution"}};
-  static const std::vector<EffectParameterInfo> kMass = {
-      {"omega", "rad/s", 250.0, "resonance frequency of the added mass on its spring"},
-      {"fraction", "1", 0.3, "part of the outermost mass moved to the added mass"}};
-  static const std::vector<EffectParameterInfo> kArm = {
-      {"f_a", "N m s/rad", 50.0, "viscous friction on the arm side of the gear"},
-      {"F_a", "N m", 0.0, "Coulomb friction on the arm side: F_a tanh(phi_a'/(r v_s))"}};
-  static const std::vector<EffectParameterInfo> kAsymmetric = {
-      {"F_c+", "N m", 0.05, "Coulomb friction on the motor while it turns forwards"},
-      {"F_c-", "N m", 0.05, "Coulomb friction on the motor while it turns backwards"}};
-  static const std::vector<EffectParameterInfo> kGravity = {
-      {"mgl", "N m", 100.0, "gravity torque amplitude m g l on the arm: mgl sin(phi_a + phi_0)"},
-      {"phi_0", "rad", 0.0, "phase of the gravity torque: the arm angle (from the log's zero) plus phi_0 is the angle from the vertical"}};
-  static const std::vector<EffectParameterInfo> kSkew = {
-      {"T_o", "s", 0.0, "time by which the arm encoder's reading lags the motor encoder's"}};
-  switch (k) {
-    case EffectKind::ArmFriction: return kArm;
-    case EffectKind::AsymmetricCoulomb: return kAsymmetric;
-    case EffectKind::Gravity: return kGravity;
-    case EffectKind::EncoderSkew: return kSkew;
-    case EffectKind::CoulombFriction: return kCoulomb;
-    case EffectKind::Backlash: return kBacklash;
-    case EffectKind::NonlinearSpring: return kSpring;
-    case EffectKind::InputDelay: return kDelay;
-    case EffectKind::TorqueRipple: return kRipple;
-    case EffectKind::ExtraMass: return kMass;
-  }
-  return kCoulomb;
+  static const std::vector<std::vector<EffectParameterInfo>> kAll = [] {
+    std::vector<std::vector<EffectParameterInfo>> v;
+    for (EffectKind kind : allEffectKinds()) v.push_back(effectDefinition(kind).parameters());
+    return v;
+  }();
+  return kAll[static_cast<std::size_t>(k)];
+}
+
+std::vector<EffectParameterInfo> effectParameters(const Effect& e) {
+  return effectDefinition(e.kind).parameters(e.values.size());
 }
 
 Effect Effect::withDefaults(EffectKind k) {
   Effect e;
   e.kind = k;
-  const auto& params = effectParameters(k);
-  for (std::size_t i = 0; i < params.size(); ++i) e.values[i] = params[i].defaultValue;
+  for (const auto& p : effectParameters(k)) e.values.push_back(p.defaultValue);
   return e;
 }
 
@@ -105,46 +99,35 @@ bool Effect::isValid(std::string* why) const {
     if (why) *why = std::move(s);
     return false;
   };
-  const auto& params = effectParameters(kind);
-  for (std::size_t i = 0; i < params.size(); ++i)
-    if (!std::isfinite(values[i]))
-      return fail(std::string(toString(kind)) + ": " + params[i].name + " is not finite");
+  const EffectDefinition& d = effectDefinition(kind);
   const std::string name = toString(kind);
-  switch (kind) {
-    case EffectKind::CoulombFriction:
-      if (values[0] < 0.0) return fail(name + ": F_c must be >= 0");
-      if (values[1] <= 0.0) return fail(name + ": v_s must be > 0");
-      break;
-    case EffectKind::Backlash:
-      if (values[0] < 0.0) return fail(name + ": b must be >= 0");
-      break;
-    case EffectKind::NonlinearSpring:
-      if (values[0] < 0.0) return fail(name + ": beta must be >= 0 (a stiffening spring)");
-      break;
-    case EffectKind::InputDelay:
-      if (values[0] < 0.0 || values[0] > 1.0) return fail(name + ": T_d must be in [0, 1] s");
-      break;
-    case EffectKind::TorqueRipple:
-      if (values[0] < 0.0) return fail(name + ": A must be >= 0");
-      if (values[1] <= 0.0) return fail(name + ": n must be > 0");
-      break;
-    case EffectKind::ExtraMass:
-      if (values[0] <= 0.0) return fail(name + ": omega must be > 0");
-      if (!(values[1] > 0.0 && values[1] < 1.0)) return fail(name + ": fraction must be in (0, 1)");
-      break;
-    case EffectKind::ArmFriction:
-      if (values[0] < 0.0 || values[1] < 0.0) return fail(name + ": f_a and F_a must be >= 0");
-      break;
-    case EffectKind::AsymmetricCoulomb:
-      if (values[0] < 0.0 || values[1] < 0.0) return fail(name + ": F_c+ and F_c- must be >= 0");
-      break;
-    case EffectKind::Gravity:
-      if (values[0] < 0.0) return fail(name + ": mgl must be >= 0 (phi_0 turns the direction)");
-      break;
-    case EffectKind::EncoderSkew:
-      if (values[0] < -1.0 || values[0] > 1.0) return fail(name + ": T_o must be in [-1, 1] s");
-      break;
+  if (!d.takesCount(values.size()))
+    return fail(name + ": " + std::to_string(values.size()) + " values is not a size this effect takes");
+  const auto params = d.parameters(values.size());
+  for (std::size_t i = 0; i < params.size(); ++i) {
+    const auto& p = params[i];
+    const double v = values[i];
+    if (!std::isfinite(v)) return fail(name + ": " + p.name + " is not finite");
+    switch (p.domain) {
+      case ValueDomain::NonNegative:
+        if (v < 0.0) return fail(name + ": " + p.name + " must be >= 0");
+        break;
+      case ValueDomain::Positive:
+        if (!(v > 0.0)) return fail(name + ": " + p.name + " must be > 0");
+        break;
+      case ValueDomain::Fraction:
+        if (!(v > 0.0 && v < 1.0)) return fail(name + ": " + p.name + " must be in (0, 1)");
+        break;
+      case ValueDomain::Signed: break;
+    }
+    if (v < p.lower || v > p.upper) {
+      char buf[96];
+      std::snprintf(buf, sizeof buf, " must be in [%g, %g]", p.lower, p.upper);
+      return fail(name + ": " + p.name + buf + (p.unit.empty() || p.unit == "1" ? "" : " " + p.unit));
+    }
   }
+  const std::string problem = d.check(*this);
+  if (!problem.empty()) return fail(name + ": " + problem);
   if (why) why->clear();
   return true;
 }
@@ -154,30 +137,39 @@ std::optional<Effect> parseEffect(std::string_view spec, std::string* why) {
   const std::string_view name = spec.substr(0, colon);
   const auto kind = effectKindFromString(name);
   if (!kind) {
-    if (why) {
-      *why = "unknown effect '" + std::string(name) + "' (expected one of";
-      for (EffectKind k : allEffectKinds()) *why += std::string(" ") + toString(k);
-      *why += ")";
-    }
+    if (why) *why = "unknown effect '" + std::string(name) + "' (expected one of " + effectNames() + ")";
     return std::nullopt;
   }
   Effect e = Effect::withDefaults(*kind);
+  const EffectDefinition& d = effectDefinition(*kind);
   if (colon != std::string_view::npos) {
+    std::vector<double> given;
     std::string_view rest = spec.substr(colon + 1);
-    const std::size_t count = effectParameters(*kind).size();
-    for (std::size_t i = 0;; ++i) {
+    for (;;) {
       const auto comma = rest.find(',');
       const std::string_view field = rest.substr(0, comma);
-      if (i >= count) {
-        if (why) *why = std::string(name) + " takes at most " + std::to_string(count) + " values";
-        return std::nullopt;
-      }
-      if (!parseNumber(field, e.values[i])) {
+      double v = 0.0;
+      if (!parseNumber(field, v)) {
         if (why) *why = std::string(name) + ": '" + std::string(field) + "' is not a number";
         return std::nullopt;
       }
+      given.push_back(v);
       if (comma == std::string_view::npos) break;
       rest = rest.substr(comma + 1);
+    }
+    // Fewer values than the default size: the rest keep their defaults; more: the effect's
+    // own sizes (the ripple's harmonics).
+    if (given.size() > e.values.size()) {
+      if (!d.takesCount(given.size())) {
+        if (why) {
+          *why = std::string(name) + " takes " + std::to_string(e.values.size()) + " values";
+          if (d.withOneMoreTerm(e)) *why += " or more in its own steps (see the help)";
+        }
+        return std::nullopt;
+      }
+      e.values = given;
+    } else {
+      for (std::size_t i = 0; i < given.size(); ++i) e.values[i] = given[i];
     }
   }
   if (!e.isValid(why)) return std::nullopt;
@@ -186,9 +178,8 @@ std::optional<Effect> parseEffect(std::string_view spec, std::string* why) {
 
 std::string toString(const Effect& e) {
   std::string s = toString(e.kind);
-  const auto& params = effectParameters(e.kind);
   char buf[40];
-  for (std::size_t i = 0; i < params.size(); ++i) {
+  for (std::size_t i = 0; i < e.values.size(); ++i) {
     // Shortest text that reads back to the same double.
     const auto res = std::to_chars(buf, buf + sizeof buf, e.values[i]);
     s += (i == 0 ? ":" : ",");
@@ -196,5 +187,127 @@ std::string toString(const Effect& e) {
   }
   return s;
 }
+
+std::string effectHelpLines(int nameColumn, int width) {
+  std::string out;
+  for (EffectKind k : allEffectKinds()) {
+    const EffectDefinition& d = effectDefinition(k);
+    std::string head = "  " + std::string(d.name());
+    std::string defaults;
+    const auto params = d.parameters();
+    for (std::size_t i = 0; i < params.size(); ++i) {
+      head += (i ? "," : ":") + params[i].name;
+      char buf[48];
+      std::snprintf(buf, sizeof buf, "%g", params[i].defaultValue);
+      defaults += (i ? ", " : "") + std::string(buf) +
+                  (params[i].unit.empty() || params[i].unit == "1" ? "" : " " + params[i].unit);
+    }
+    std::string text = d.summary() + " (" + defaults + ")";
+    // Wrap the text at `width` after the name column.
+    std::string line = head;
+    if (static_cast<int>(line.size()) + 1 > nameColumn) {
+      out += line + "\n";
+      line.clear();
+    }
+    line.resize(static_cast<std::size_t>(nameColumn), ' ');
+    std::size_t at = 0;
+    bool first = true;
+    while (at < text.size()) {
+      const std::size_t room = static_cast<std::size_t>(std::max(20, width - nameColumn));
+      std::size_t end = std::min(text.size(), at + room);
+      if (end < text.size()) {
+        const std::size_t space = text.rfind(' ', end);
+        if (space != std::string::npos && space > at) end = space;
+      }
+      if (!first) line.assign(static_cast<std::size_t>(nameColumn), ' ');
+      line += text.substr(at, end - at);
+      out += line + "\n";
+      at = end;
+      while (at < text.size() && text[at] == ' ') ++at;
+      first = false;
+    }
+  }
+  return out;
+}
+
+// Defaults of the definitions.
+
+std::vector<EffectParameterInfo> EffectDefinition::parameters(std::size_t) const { return parameters(); }
+
+bool EffectDefinition::takesCount(std::size_t count) const { return count == parameters().size(); }
+
+std::unique_ptr<PhysicalModel> EffectDefinition::structure(const PhysicalModel&, const Effect&, std::string*) const {
+  return nullptr;
+}
+
+std::vector<EffectSearchCoordinate> EffectDefinition::searchCoordinates(const Effect& e,
+                                                                        const EffectSearchBounds&) const {
+  EffectSearchCoordinate c;
+  c.index = mainParameter();
+  const auto params = parameters(e.values.size());
+  const auto& p = params[static_cast<std::size_t>(c.index)];
+  c.map = p.domain == ValueDomain::Signed ? EffectSearchCoordinate::Map::Signed
+                                          : EffectSearchCoordinate::Map::NonNegative;
+  c.scale = std::abs(p.defaultValue) > 0.0 ? std::abs(p.defaultValue) : 1.0;
+  return {c};
+}
+
+EffectSearchPlan EffectDefinition::searchPlan(const Effect& e0, const EffectSearchBounds&) const {
+  EffectSearchPlan plan;
+  Effect e = e0;
+  const auto m = static_cast<std::size_t>(mainParameter());
+  e.values[m] = 0.5 * effectParameters(kind())[m].defaultValue;
+  plan.starts.push_back(e);
+  return plan;
+}
+
+double EffectDefinition::addedTorque(const Effect& e, const JointSignals& s) const {
+  if (structural()) return NAN;
+  PlantTerms terms;
+  addToPlant(e, terms);
+  double t = 0.0;
+  for (const auto& term : terms.torques)
+    t += term.term->torque(s) * (term.site == TorqueSite::Motor ? 1.0 : s.ratio);
+  return t;
+}
+
+std::string EffectDefinition::magnitudeName() const {
+  return effectParameters(kind())[static_cast<std::size_t>(mainParameter())].name;
+}
+
+Effect EffectDefinition::withMagnitude(const Effect& e, double m) const {
+  Effect out = e;
+  out.values[static_cast<std::size_t>(mainParameter())] = m;
+  return out;
+}
+
+std::string EffectDefinition::displayUnit() const {
+  return effectParameters(kind())[static_cast<std::size_t>(mainParameter())].unit;
+}
+
+EffectSearchPlan startsOverADecade(const Effect& e0, int index, std::initializer_list<double> factors) {
+  EffectSearchPlan plan;
+  const auto i = static_cast<std::size_t>(index);
+  for (double x : factors) {
+    Effect e = e0;
+    e.values[i] = x * effectParameters(e0.kind)[i].defaultValue;
+    plan.starts.push_back(e);
+  }
+  return plan;
+}
+
+namespace effect_text {
+
+std::string number(double v, int digits) {
+  char buf[48];
+  std::snprintf(buf, sizeof buf, "%.*g", digits, v);
+  return buf;
+}
+
+std::string plusMinus(const EffectParameterEstimate& p, double factor) {
+  return number(p.value * factor) + " +- " + number(p.std * factor, 2);
+}
+
+}  // namespace effect_text
 
 }  // namespace flexarm

@@ -9,18 +9,22 @@ NonlinearPlant::NonlinearPlant(const PhysicalModel& model, const std::vector<Eff
     : effects_(effects) {
   std::vector<bool> seen(allEffectKinds().size(), false);
   std::unique_ptr<ParametricModel> current = model.clone();
+  bool gearEffects = false;
+  std::string gearEffectNames;
   for (const Effect& e : effects) {
     std::string why;
     if (!e.isValid(&why)) throw std::invalid_argument(why);
     auto s = seen[static_cast<std::size_t>(e.kind)];
-    if (s) throw std::invalid_argument(std::string("the effect ") + toString(e.kind) +
-                                       " is given twice");
+    if (s) throw std::invalid_argument(std::string("the effect ") + toString(e.kind) + " is given twice");
     s = true;
-    if (e.kind == EffectKind::ExtraMass) {
-      auto bigger = addMass(static_cast<const PhysicalModel&>(*current), e.value(1), e.value(0));
-      if (!bigger)
-        throw std::invalid_argument("extra_mass: the " + current->structureName() +
-                                    " model is the largest structure");
+    const EffectDefinition& d = effectDefinition(e);
+    if (d.needsGearSpring()) {
+      gearEffects = true;
+      gearEffectNames += (gearEffectNames.empty() ? "" : " and ") + std::string(d.name());
+    }
+    if (d.structural()) {
+      auto bigger = d.structure(static_cast<const PhysicalModel&>(*current), e, &why);
+      if (!bigger) throw std::invalid_argument(why);
       current = std::move(bigger);
     }
   }
@@ -35,6 +39,8 @@ NonlinearPlant::NonlinearPlant(const PhysicalModel& model, const std::vector<Eff
   armScale_ = topo.armVelocityState < 0 ? model_->value("r") : 1.0;
   gear_ = topo.gearDeflectionState;
   ratio_ = model_->value("r");
+  kT_ = model_->value("k_T");
+  fm_ = model_->indexOf("f_m") >= 0 ? model_->value("f_m") : 0.0;
   {
     const Eigen::RowVectorXd row = model_->armDeflectionRow();
     for (int i = 0; i < n_; ++i) armDeflection_[static_cast<std::size_t>(i)] = row[i];
@@ -57,45 +63,11 @@ NonlinearPlant::NonlinearPlant(const PhysicalModel& model, const std::vector<Eff
     bl_[static_cast<std::size_t>(arm_)] = 1.0 / model_->value(topo.armInertia);
   }
 
-  coulombSpeed_ = effectParameters(EffectKind::CoulombFriction)[1].defaultValue;
-  for (const Effect& e : effects_) {
-    switch (e.kind) {
-      case EffectKind::CoulombFriction:
-        coulomb_ = e.value(0);
-        coulombSpeed_ = e.value(1);
-        break;
-      case EffectKind::Backlash:
-        backlash_ = e.value(0);
-        gearNonlinear_ = true;
-        break;
-      case EffectKind::NonlinearSpring:
-        beta_ = e.value(0);
-        gearNonlinear_ = true;
-        break;
-      case EffectKind::InputDelay: delay_ = e.value(0); break;
-      case EffectKind::TorqueRipple:
-        rippleAmp_ = e.value(0);
-        ripplePeriods_ = e.value(1);
-        break;
-      case EffectKind::ExtraMass: break;
-      case EffectKind::ArmFriction:
-        armViscous_ = e.value(0);
-        armCoulomb_ = e.value(1);
-        armTorques_ = true;
-        break;
-      case EffectKind::AsymmetricCoulomb:
-        coulombPlus_ = e.value(0);
-        coulombMinus_ = e.value(1);
-        break;
-      case EffectKind::Gravity:
-        gravity_ = e.value(0);
-        gravityPhase_ = e.value(1);
-        armTorques_ = true;
-        break;
-      case EffectKind::EncoderSkew: skew_ = e.value(0); break;
-    }
-  }
-  if (gear_ >= 0 && !topo.gearStiffness.empty()) {
+  for (const Effect& e : effects_) effectDefinition(e).addToPlant(e, terms_);
+  collectTerms();
+  gearNonlinear_ = terms_.gearLaw;
+  const bool hasGear = gear_ >= 0 && !topo.gearStiffness.empty();
+  if (hasGear) {
     // Gear spring distribution s_g = dA/dk_g e_delta and deflection rate delta' = A(delta,:) x.
     const auto dK = model_->derivative(model_->indexOf(topo.gearStiffness));
     k_ = model_->value(topo.gearStiffness);
@@ -109,13 +81,29 @@ NonlinearPlant::NonlinearPlant(const PhysicalModel& model, const std::vector<Eff
         for (int j = 0; j < n_; ++j)
           A0(i, j) -= sg_[static_cast<std::size_t>(i)] *
                       (k_ * (j == gear_ ? 1.0 : 0.0) + d_ * gearRate_[static_cast<std::size_t>(j)]);
-  } else if (gearNonlinear_) {
-    throw std::invalid_argument("backlash and nonlinear_spring need a model with a gear spring "
-                                "(two-mass, three-mass or four-mass), not " +
+  } else if (gearEffects || !gearTerms_.empty()) {
+    throw std::invalid_argument((gearEffectNames.empty() ? std::string("a torque in the gear") : gearEffectNames) +
+                                " need" + (gearEffectNames.find(" and ") == std::string::npos ? "s" : "") +
+                                " a model with a gear spring (two-mass, three-mass or four-mass), not " +
                                 model_->structureName());
   }
   for (int i = 0; i < n_; ++i)
     for (int j = 0; j < n_; ++j) A0_[static_cast<std::size_t>(i * kMaxStates + j)] = A0(i, j);
+}
+
+void NonlinearPlant::collectTerms() {
+  smoothing_ = terms_.smoothingSpeed > 0.0 ? terms_.smoothingSpeed
+                                           : effectParameters(EffectKind::CoulombFriction)[1].defaultValue;
+  motorTerms_.clear();
+  gearTerms_.clear();
+  armTerms_.clear();
+  needs_ = 0u;
+  for (const auto& t : terms_.torques) {
+    (t.site == TorqueSite::Motor ? motorTerms_ : t.site == TorqueSite::Gear ? gearTerms_ : armTerms_)
+        .push_back(t.term.get());
+    needs_ |= t.term->needs();
+  }
+  if (!gearTerms_.empty()) needs_ |= kNeedsGearState;
 }
 
 NonlinearPlant::NonlinearPlant(const NonlinearPlant& o)
@@ -124,23 +112,44 @@ NonlinearPlant::NonlinearPlant(const NonlinearPlant& o)
       n_(o.n_), mv_(o.mv_), arm_(o.arm_), gear_(o.gear_), armScale_(o.armScale_), ratio_(o.ratio_),
       armDeflection_(o.armDeflection_), A0_(o.A0_),
       bu_(o.bu_), bm_(o.bm_), bl_(o.bl_), sg_(o.sg_), gearRate_(o.gearRate_),
-      gearNonlinear_(o.gearNonlinear_), k_(o.k_), d_(o.d_), coulomb_(o.coulomb_),
-      coulombSpeed_(o.coulombSpeed_), backlash_(o.backlash_), beta_(o.beta_), delay_(o.delay_),
-      rippleAmp_(o.rippleAmp_), ripplePeriods_(o.ripplePeriods_), coulombPlus_(o.coulombPlus_),
-      coulombMinus_(o.coulombMinus_), armViscous_(o.armViscous_), armCoulomb_(o.armCoulomb_),
-      gravity_(o.gravity_), gravityPhase_(o.gravityPhase_), skew_(o.skew_), armTorques_(o.armTorques_) {}
+      gearNonlinear_(o.gearNonlinear_), k_(o.k_), d_(o.d_), kT_(o.kT_), fm_(o.fm_), terms_(o.terms_) {
+  collectTerms();
+  smoothing_ = o.smoothing_;
+}
 
-namespace {
 // Gear spring and damper torque with a dead zone of half-width b and stiffening beta: no
 // contact (and no damping) inside the gap.
-double springTorque(double delta, double rate, double k, double d, double b, double beta) {
+double NonlinearPlant::gearSpring(double delta, double rate) const {
+  const double b = terms_.backlash;
   double e = 0.0;
   if (delta > b) e = delta - b;
   else if (delta < -b) e = delta + b;
   else return 0.0;
-  return k * e * (1.0 + beta * e * e) + d * rate;
+  return k_ * e * (1.0 + terms_.stiffening * e * e) + d_ * rate;
 }
-}  // namespace
+
+double NonlinearPlant::gearRate(const double* x) const {
+  double rate = 0.0;
+  for (int j = 0; j < n_; ++j) rate += gearRate_[static_cast<std::size_t>(j)] * x[j];
+  return rate;
+}
+
+void NonlinearPlant::fillSignals(const double* x, JointSignals& s, unsigned needs) const {
+  s.motorVelocity = x[mv_];
+  s.motorAngle = x[n_];
+  s.armVelocity = arm_ == mv_ ? armScale_ * x[mv_] : x[arm_];
+  s.smoothingSpeed = smoothing_;
+  s.ratio = ratio_;
+  if (needs & kNeedsArmAngle) {
+    double deflection = 0.0;
+    for (int i = 0; i < n_; ++i) deflection += armDeflection_[static_cast<std::size_t>(i)] * x[i];
+    s.armAngle = ratio_ * x[n_] - deflection;
+  }
+  if ((needs & kNeedsGearState) && gear_ >= 0) {
+    s.gearDeflection = x[gear_];
+    s.gearRate = gearRate(x);
+  }
+}
 
 void NonlinearPlant::derivative(const double* x, double u, double load, double* dx) const {
   const int n = n_;
@@ -150,33 +159,20 @@ void NonlinearPlant::derivative(const double* x, double u, double load, double* 
     for (int j = 0; j < n; ++j) s += row[j] * x[j];
     dx[i] = s + bu_[static_cast<std::size_t>(i)] * u + bl_[static_cast<std::size_t>(i)] * load;
   }
-  double motorTorque = 0.0;
-  if (coulomb_ != 0.0) motorTorque -= coulomb_ * std::tanh(x[mv_] / coulombSpeed_);
-  if (coulombPlus_ != 0.0 || coulombMinus_ != 0.0) {
-    const double t = std::tanh(x[mv_] / coulombSpeed_);
-    motorTorque -= (t > 0.0 ? coulombPlus_ : coulombMinus_) * t;
-  }
-  if (armTorques_) {
-    // Arm-side friction (its smoothing speed is the motor's through the gear) and gravity,
-    // acting where the load does.
-    const double va = arm_ == mv_ ? armScale_ * x[mv_] : x[arm_];
-    double arm = -armViscous_ * va;
-    if (armCoulomb_ != 0.0) arm -= armCoulomb_ * std::tanh(va / (ratio_ * coulombSpeed_));
-    if (gravity_ != 0.0) {
-      double deflection = 0.0;
-      for (int i = 0; i < n; ++i) deflection += armDeflection_[static_cast<std::size_t>(i)] * x[i];
-      arm -= gravity_ * std::sin(ratio_ * x[n] - deflection + gravityPhase_);
-    }
-    for (int i = 0; i < n; ++i) dx[i] += bl_[static_cast<std::size_t>(i)] * arm;
-  }
-  if (rippleAmp_ != 0.0) motorTorque += rippleAmp_ * std::sin(ripplePeriods_ * x[n]);
-  if (motorTorque != 0.0)
-    for (int i = 0; i < n; ++i) dx[i] += bm_[static_cast<std::size_t>(i)] * motorTorque;
-  if (gearNonlinear_) {
-    double rate = 0.0;
-    for (int j = 0; j < n; ++j) rate += gearRate_[static_cast<std::size_t>(j)] * x[j];
-    const double tg = springTorque(x[gear_], rate, k_, d_, backlash_, beta_);
-    for (int i = 0; i < n; ++i) dx[i] += sg_[static_cast<std::size_t>(i)] * tg;
+  if (!terms_.torques.empty() || gearNonlinear_) {
+    JointSignals s;
+    fillSignals(x, s, needs_ | (gearNonlinear_ ? kNeedsGearState : 0u));
+    double motor = 0.0, arm = 0.0, gear = 0.0;
+    for (const TorqueTerm* t : motorTerms_) motor += t->torque(s);
+    for (const TorqueTerm* t : armTerms_) arm += t->torque(s);
+    for (const TorqueTerm* t : gearTerms_) gear += t->torque(s);
+    if (gearNonlinear_) gear += gearSpring(s.gearDeflection, s.gearRate);
+    if (motor != 0.0)
+      for (int i = 0; i < n; ++i) dx[i] += bm_[static_cast<std::size_t>(i)] * motor;
+    if (arm != 0.0)
+      for (int i = 0; i < n; ++i) dx[i] += bl_[static_cast<std::size_t>(i)] * arm;
+    if (gear != 0.0)
+      for (int i = 0; i < n; ++i) dx[i] += sg_[static_cast<std::size_t>(i)] * gear;
   }
   dx[n] = x[mv_];
 }
@@ -202,9 +198,8 @@ double NonlinearPlant::armAngle(const State& x) const { return ratio_ * motorAng
 void NonlinearPlant::setSmoothingSpeed(double speed) {
   if (!(speed > 0.0) || !std::isfinite(speed))
     throw std::invalid_argument("NonlinearPlant: the smoothing speed must be positive");
-  for (const Effect& e : effects_)
-    if (e.kind == EffectKind::CoulombFriction) return;  // its own v_s rules
-  coulombSpeed_ = speed;
+  if (terms_.smoothingSpeed > 0.0) return;  // an effect's own v_s rules
+  smoothing_ = speed;
 }
 
 double NonlinearPlant::armVelocity(const State& x) const {
@@ -213,10 +208,27 @@ double NonlinearPlant::armVelocity(const State& x) const {
 
 double NonlinearPlant::gearTorque(const State& x) const {
   if (gear_ < 0 || k_ == 0.0) return 0.0;
-  double rate = 0.0;
-  for (int j = 0; j < n_; ++j) rate += gearRate_[static_cast<std::size_t>(j)] * x[j];
-  return springTorque(x[static_cast<std::size_t>(gear_)], rate, k_, d_, backlash_, beta_);
+  const double delta = x[static_cast<std::size_t>(gear_)], rate = gearRate(x.data());
+  double t = gearNonlinear_ ? gearSpring(delta, rate) : k_ * delta + d_ * rate;
+  if (!gearTerms_.empty()) {
+    JointSignals s;
+    fillSignals(x.data(), s, needs_);
+    for (const TorqueTerm* term : gearTerms_) t += term->torque(s);
+  }
+  return t;
 }
+
+JointSignals NonlinearPlant::jointSignals(const State& x, double torqueNow, double torqueApplied) const {
+  JointSignals s;
+  fillSignals(x.data(), s, kNeedsArmAngle | kNeedsGearState);
+  s.gearStiffness = k_;
+  s.gearDamping = d_;
+  s.torqueNow = kT_ * torqueNow;
+  s.torqueApplied = kT_ * torqueApplied;
+  return s;
+}
+
+double NonlinearPlant::motorFriction(const State& x) const { return fm_ * x[static_cast<std::size_t>(mv_)]; }
 
 bool TorqueResponseOptions::isValid(std::string* why) const {
   if (substeps < 1) {

@@ -1,10 +1,12 @@
 #pragma once
 // A physical model with effects switched on, as the nonlinear ODE
-//   x' = A0 x + b_u k_T... (B of the model) u(t - T_d) + b_m (tau_ripple - tau_coulomb)
-//        + s_g T_g(delta, delta') + b_L tau_load,   phi_m' = x_mv,
+//   x' = A0 x + b_u k_T... (B of the model) u(t - T_d) + b_m tau_motor
+//        + s_g (T_g(delta, delta') + tau_gear) + b_L (tau_load + tau_arm),   phi_m' = x_mv,
 // where T_g is the gear spring torque (linear, with dead zone and/or stiffening), s_g its
 // distribution over the velocity rows (dA/dk_g), b_m the motor torque column and b_L the
-// arm-side load column. The state is the model's core state (seed coordinates) followed by
+// arm-side load column; tau_motor, tau_gear and tau_arm are the sums of the effects' torque
+// terms at each site (core/models/effect_registry.h: each effect's own file says what it adds
+// where). The state is the model's core state (seed coordinates) followed by
 // phi_m. Integration is classical Runge-Kutta with fine steps, without heap allocation.
 #include <array>
 #include <cstddef>
@@ -13,6 +15,7 @@
 #include <string>
 #include <vector>
 
+#include "core/models/effect_registry.h"
 #include "core/models/effects.h"
 #include "core/models/physical_models.h"
 
@@ -35,7 +38,7 @@ class NonlinearPlant {
   const std::vector<Effect>& effects() const { return effects_; }
   int states() const { return n_ + 1; }
   int motorAngleState() const { return n_; }
-  double inputDelay() const { return delay_; }
+  double inputDelay() const { return terms_.inputDelay; }
 
   // x' for the applied (already delayed) torque reference u and the arm-side load torque.
   void derivative(const double* x, double u, double load, double* dx) const;
@@ -61,7 +64,12 @@ class NonlinearPlant {
   // 0.1, coulomb_friction's default). Throws std::invalid_argument unless positive.
   void setSmoothingSpeed(double speed);
   // The time by which the arm encoder's reading lags the motor's (encoder_skew; 0 without).
-  double encoderSkew() const { return skew_; }
+  double encoderSkew() const { return terms_.encoderSkew; }
+  // The joint's signals at state x (every one, for an effect's size), with the motor torque
+  // k_T u asked for now and applied.
+  JointSignals jointSignals(const State& x, double torqueNow, double torqueApplied) const;
+  // The motor's own viscous friction torque f_m phi_m' (N m) at x.
+  double motorFriction(const State& x) const;
 
  private:
   std::unique_ptr<PhysicalModel> model_;
@@ -73,13 +81,16 @@ class NonlinearPlant {
   std::array<double, kMaxStates * kMaxStates> A0_{};  // row-major, n x n
   State bu_{}, bm_{}, bl_{}, sg_{}, gearRate_{};
   bool gearNonlinear_ = false;
-  double k_ = 0.0, d_ = 0.0;
-  double coulomb_ = 0.0, coulombSpeed_ = 1.0, backlash_ = 0.0, beta_ = 0.0, delay_ = 0.0;
-  double rippleAmp_ = 0.0, ripplePeriods_ = 0.0;
-  double coulombPlus_ = 0.0, coulombMinus_ = 0.0;           // asymmetric_coulomb
-  double armViscous_ = 0.0, armCoulomb_ = 0.0;              // arm_friction
-  double gravity_ = 0.0, gravityPhase_ = 0.0, skew_ = 0.0;  // gravity, encoder_skew
-  bool armTorques_ = false;
+  double k_ = 0.0, d_ = 0.0, kT_ = 1.0, fm_ = 0.0;
+  double smoothing_ = 0.1;  // the smooth signs' motor speed
+  PlantTerms terms_;        // what the effects set up
+  // The torque terms by site (raw pointers into terms_), and the signals they read.
+  std::vector<const TorqueTerm*> motorTerms_, gearTerms_, armTerms_;
+  unsigned needs_ = 0u;
+  void collectTerms();
+  double gearSpring(double delta, double rate) const;
+  double gearRate(const double* x) const;
+  void fillSignals(const double* x, JointSignals& s, unsigned needs) const;
 };
 
 template <class TorqueAt>

@@ -1,5 +1,7 @@
 #include "core/session/discovery_part.h"
 
+#include "core/discovery/discovery_json.h"
+
 #include <cmath>
 
 #include "core/session/fit_request.h"
@@ -14,7 +16,6 @@ namespace {
 
 const char* kStructures[] = {"two-mass", "three-mass", "four-mass"};
 
-json number(double v) { return jsonNumber(v); }
 
 // The effect names listed under key, if the key is there (else out is left as it is); false
 // with a sentence when the value is not a list or names an unknown effect.
@@ -75,15 +76,6 @@ bool dataRefFromJson(const json& j, DiscoveryDataRef& d, std::string* why, const
   return true;
 }
 
-json scoreToJson(const DiscoveryScore& s) {
-  return {{"fit_percent", number(s.fitPercent)},
-          {"fit_percent_validation", number(s.fitPercentValidation)},
-          {"fit_percent_nrmse", number(s.fitPercentNrmse)},
-          {"fit_percent_validation_nrmse", number(s.fitPercentValidationNrmse)},
-          {"rms_estimation", number(s.rmsEstimation)},
-          {"rms_validation", number(s.rmsValidation)}};
-}
-
 bool scoreFromJson(const json& j, DiscoveryScore& s, std::string* why, const std::string& where) {
   if (!j.is_object()) {
     if (why) *why = where + "must be an object";
@@ -95,15 +87,6 @@ bool scoreFromJson(const json& j, DiscoveryScore& s, std::string* why, const std
          readNumber(j, "fit_percent_validation_nrmse", s.fitPercentValidationNrmse, false, why, where) &&
          readNumber(j, "rms_estimation", s.rmsEstimation, true, why, where) &&
          readNumber(j, "rms_validation", s.rmsValidation, true, why, where);
-}
-
-json parametersToJson(const std::vector<EffectParameterEstimate>& ps) {
-  json list = json::array();
-  for (const auto& p : ps)
-    list.push_back({{"name", p.name}, {"unit", p.unit}, {"value", number(p.value)},
-                    {"std", number(p.std)}, {"lower", number(p.lower)}, {"upper", number(p.upper)},
-                    {"estimated", p.estimated}});
-  return list;
 }
 
 bool parametersFromJson(const json& j, std::vector<EffectParameterEstimate>& ps, std::string* why,
@@ -120,12 +103,65 @@ bool parametersFromJson(const json& j, std::vector<EffectParameterEstimate>& ps,
         !readNumber(p, "std", e.std, true, why, where) ||
         !readNumber(p, "lower", e.lower, true, why, where) ||
         !readNumber(p, "upper", e.upper, true, why, where) ||
-        !readFlag(p, "estimated", e.estimated, why, where)) {
+        !readFlag(p, "estimated", e.estimated, why, where) || !readFlag(p, "derived", e.derived, why, where)) {
       if (why && !p.is_object()) *why = where + "each parameter must be an object";
       return false;
     }
     ps.push_back(e);
   }
+  return true;
+}
+
+// One estimate under key (absent: left as it is).
+bool readEstimate(const json& j, const char* key, EffectParameterEstimate& p, std::string* why, const std::string& where) {
+  if (!j.contains(key) || j[key].is_null()) return true;
+  std::vector<EffectParameterEstimate> one;
+  if (!parametersFromJson(json::array({j[key]}), one, why, where + key + ": ")) return false;
+  p = one.front();
+  return true;
+}
+
+bool readSize(const json& j, EffectSize& s, std::string* why, const std::string& where) {
+  if (!j.contains("size") || j["size"].is_null()) return true;
+  const json& z = j["size"];
+  if (!z.is_object()) {
+    if (why) *why = where + "size must be an object";
+    return false;
+  }
+  return readNumber(z, "torque_rms", s.torqueRms, false, why, where) &&
+         readNumber(z, "friction_rms", s.frictionRms, false, why, where) &&
+         readNumber(z, "spring_rms", s.springRms, false, why, where);
+}
+
+// A confirmation: an object (as discoveryResultJson writes it) or, in sessions stored before
+// it, its text alone.
+bool readConfirmation(const json& j, Confirmation& c, std::string* why, const std::string& where) {
+  if (!j.contains("confirmation") || j["confirmation"].is_null()) return true;
+  const json& x = j["confirmation"];
+  if (x.is_string()) {
+    c.text = x.get<std::string>();
+    c.ran = !c.text.empty();
+    return true;
+  }
+  if (!x.is_object()) {
+    if (why) *why = where + "confirmation must be an object";
+    return false;
+  }
+  const std::string cw = where + "confirmation: ";
+  if (!readFlag(x, "ran", c.ran, why, cw) || !readFlag(x, "confirmed", c.confirmed, why, cw) ||
+      !readText(x, "held_out_data", c.heldOutData, false, why, cw) ||
+      !readNumber(x, "rms_before", c.rmsBefore, false, why, cw) ||
+      !readNumber(x, "rms_after", c.rmsAfter, false, why, cw) ||
+      !readNumber(x, "held_out_z", c.heldOutZ, false, why, cw) ||
+      !readFlag(x, "held_out_passes", c.heldOutPasses, why, cw) || !readText(x, "test", c.test, false, why, cw) ||
+      !readNumber(x, "value", c.value, false, why, cw) || !readNumber(x, "std", c.std, false, why, cw) ||
+      !readNumber(x, "z", c.z, false, why, cw) || !readNumber(x, "fitted", c.fitted, false, why, cw) ||
+      !readText(x, "unit", c.unit, false, why, cw) || !readFlag(x, "specific_passes", c.specificPasses, why, cw) ||
+      !readText(x, "text", c.text, false, why, cw))
+    return false;
+  if (x.contains("rivals") && x["rivals"].is_array())
+    for (const auto& r : x["rivals"])
+      if (r.is_string()) c.rivals.push_back(r.get<std::string>());
   return true;
 }
 
@@ -297,49 +333,46 @@ class DiscoveryPart : public SessionPart {
       ladder.rows.push_back({"0", "base", formatFixed(r.found.front().before.fitPercentValidation, 2),
                              formatSignificant(r.found.front().before.rmsValidation), "-"});
       std::string model = "base";
-      json steps = json::array();
       for (std::size_t i = 0; i < r.found.size(); ++i) {
         const FoundEffect& f = r.found[i];
         model += " + " + std::string(toString(f.kind));
         ladder.rows.push_back({std::to_string(i + 1), model, formatFixed(f.after.fitPercentValidation, 2),
                                formatSignificant(f.after.rmsValidation), f.confirmation.confirmed ? "yes" : "no"});
-        steps.push_back({{"effect", toString(f.kind)}, {"confirmed", f.confirmation.confirmed},
-                         {"rms_validation", number(f.after.rmsValidation)}});
         if (!f.confirmation.text.empty())
           s.paragraphs.push_back(std::string(toString(f.kind)) + ": " + f.confirmation.text);
       }
       s.tables.push_back(ladder);
-      s.values["steps"] = steps;
-      s.values["stop_reason"] = r.stopReason;
+    }
+    if (!r.alsoTried.empty()) {
+      // What was tried and rejected, apart from the effects found.
+      ReportTable tried{"Also tried (not named)", {"Round", "Effect", "Size", "Torque share", "Why not"}, {}};
+      for (const auto& t : r.alsoTried)
+        tried.rows.push_back({std::to_string(t.round + 1), toString(t.kind),
+                              t.magnitude.name.empty() ? "-" : t.magnitude.name + " = " + formatSignificant(t.magnitude.value),
+                              t.size.measured() ? formatFixed(100.0 * t.size.share(), 2) + " %" : "-", t.reason});
+      s.tables.push_back(tried);
     }
     if (!r.disagreement.summary.empty())
       s.paragraphs.push_back("Where the base model disagrees: " + r.disagreement.summary);
 
     const CandidateFit* best = r.best >= 0 ? &r.candidates[static_cast<std::size_t>(r.best)] : nullptr;
-    json params = json::object();
     if (best) {
       ReportTable t{"Parameters of " + effect + " (99 % interval)",
                     {"Parameter", "Value", "Std", "Lower", "Upper", "Unit"}, {}};
       for (const auto& p : best->parameters) {
         t.rows.push_back({p.name, formatSignificant(p.value), p.estimated ? formatSignificant(p.std, 3) : "held",
                           formatSignificant(p.lower), formatSignificant(p.upper), p.unit});
-        params[p.name] = {{"value", number(p.value)}, {"std", number(p.std)}, {"unit", p.unit}};
       }
       s.tables.push_back(t);
     }
     ReportTable cand{"Candidates", {"Effect", "Loss (est.)", "RMS val. (rad/s)", "AIC - base", "F / threshold",
                                     "Significant", "Reason"}, {}};
-    json candJson = json::array();
     for (const auto& c : r.candidates) {
       cand.rows.push_back({toString(c.kind), formatSignificant(c.lossEst),
                            r.hasValidation ? formatSignificant(c.score.rmsValidation) : "-",
                            std::isfinite(c.aic) ? formatFixed(c.aic - r.baseAic, 1) : "-",
                            formatSignificant(c.fStatistic, 3) + " / " + formatSignificant(c.fThreshold, 3),
                            c.significant ? "yes" : "no", c.reason});
-      candJson.push_back({{"effect", toString(c.kind)}, {"loss_est", number(c.lossEst)},
-                          {"rms_val", r.hasValidation ? number(c.score.rmsValidation) : json()},
-                          {"aic", number(c.aic)}, {"f", number(c.fStatistic)},
-                          {"f_threshold", number(c.fThreshold)}, {"significant", c.significant}});
     }
     s.tables.push_back(cand);
 
@@ -362,16 +395,9 @@ class DiscoveryPart : public SessionPart {
                              formatFixed(100.0 * (1.0 - r.augmented.rmsValidation / r.base.rmsValidation), 0) +
                              " % lower).");
 
-    s.values["effect"] = effect;
-    json tied = json::array();
-    for (EffectKind k : r.tied) tied.push_back(toString(k));
-    s.values["tied"] = tied;
-    s.values["effect_parameters"] = params;
-    s.values["evidence"] = r.evidence;
-    s.values["base"] = scoreToJson(r.base);
-    s.values["augmented"] = scoreToJson(r.augmented);
-    s.values["has_validation"] = r.hasValidation;
-    s.values["candidates"] = candJson;
+    // The data: the result as every output writes it (discoveryResultJson).
+    const json result = discoveryResultJson(r);
+    for (auto it = result.begin(); it != result.end(); ++it) s.values[it.key()] = it.value();
 
     const DiscoveryTrace& t = r.hasValidation ? r.validation : r.estimation;
     const std::string where = r.hasValidation ? "validation" : "estimation";
@@ -493,47 +519,57 @@ std::optional<DiscoveryRequest> discoveryRequestFromJson(const json& j, std::str
   return q;
 }
 
-json discoveryResultToJson(const DiscoveryResult& r) {
-  json tied = json::array();
-  for (EffectKind k : r.tied) tied.push_back(toString(k));
-  json candidates = json::array();
-  for (const auto& c : r.candidates)
-    candidates.push_back({{"effect", toString(c.kind)},
-                          {"parameters", parametersToJson(c.parameters)},
-                          {"parameter_count", c.parameterCount},
-                          {"loss_est", number(c.lossEst)},
-                          {"aic", number(c.aic)},
-                          {"f", number(c.fStatistic)},
-                          {"f_threshold", number(c.fThreshold)},
-                          {"score", scoreToJson(c.score)},
-                          {"significant", c.significant},
-                          {"reason", c.reason}});
-  json found = json::array();
-  for (const auto& f : r.found)
-    found.push_back({{"effect", toString(f.kind)},
-                     {"spec", toString(f.effect)},
-                     {"parameters", parametersToJson(f.parameters)},
-                     {"evidence", f.evidence},
-                     {"confirmed", f.confirmation.confirmed},
-                     {"confirmation", f.confirmation.text},
-                     {"before", scoreToJson(f.before)},
-                     {"after", scoreToJson(f.after)}});
-  return {{"effect", r.effect ? toString(*r.effect) : "none"},
-          {"effects", found},
-          {"stop_reason", r.stopReason},
-          {"validation_data", r.validationData},
-          {"tied", tied},
-          {"evidence", r.evidence},
-          {"disagreement", r.disagreement.summary},
-          {"has_validation", r.hasValidation},
-          {"sample_time", number(r.sampleTime)},
-          {"base_loss", number(r.baseLoss)},
-          {"base_aic", number(r.baseAic)},
-          {"base", scoreToJson(r.base)},
-          {"augmented", scoreToJson(r.augmented)},
-          {"best", r.best},
-          {"candidates", candidates}};
+json discoveryResultToJson(const DiscoveryResult& r) { return discoveryResultJson(r); }
+
+namespace {
+
+// The candidates listed under "candidates" (required).
+bool candidatesFromJson(const json& j, std::vector<CandidateFit>& out, std::string* why, const std::string& where) {
+  if (!j.contains("candidates") || !j["candidates"].is_array()) {
+    if (why) *why = where + "candidates must be a list";
+    return false;
+  }
+  for (const auto& c : j["candidates"]) {
+    CandidateFit f;
+    std::string name, spec, termination;
+    const std::string cw = where + "candidate: ";
+    if (!c.is_object() || !readText(c, "effect", name, true, why, cw)) {
+      if (why && !c.is_object()) *why = cw + "must be an object";
+      return false;
+    }
+    auto k = effectKindFromString(name);
+    if (!k) {
+      if (why) *why = cw + "unknown effect '" + name + "'";
+      return false;
+    }
+    f.kind = *k;
+    f.termination = Termination::Converged;
+    if ((c.contains("parameters") && !parametersFromJson(c["parameters"], f.parameters, why, cw)) ||
+        !(c.contains("spec") && c["spec"].is_null() ? true : readText(c, "spec", spec, false, why, cw)) ||
+        !readText(c, "termination", termination, false, why, cw) ||
+        !readWhole(c, "parameter_count", f.parameterCount, why, cw) ||
+        !readNumber(c, "loss_est", f.lossEst, true, why, cw) ||
+        !readNumber(c, "aic", f.aic, false, why, cw) || !readNumber(c, "f", f.fStatistic, false, why, cw) ||
+        !readNumber(c, "f_threshold", f.fThreshold, false, why, cw) ||
+        !readNumber(c, "held_out_z", f.heldOutZ, false, why, cw) || !readNumber(c, "rho", f.rho, false, why, cw) ||
+        !readNumber(c, "survival_f", f.survivalF, false, why, cw) ||
+        !readFlag(c, "interval_excludes_zero", f.intervalExcludesZero, why, cw) ||
+        !readFlag(c, "significant", f.significant, why, cw) || !readText(c, "reason", f.reason, false, why, cw) ||
+        !readFlag(c, "matters", f.matters, why, cw) || !readEstimate(c, "magnitude", f.magnitude, why, cw) ||
+        !readSize(c, f.size, why, cw) || !readConfirmation(c, f.confirmation, why, cw) ||
+        (c.contains("score") && !scoreFromJson(c["score"], f.score, why, cw + "score: ")))
+      return false;
+    if (!termination.empty())
+      if (const auto t = terminationFromString(termination)) f.termination = *t;
+    std::string reason;
+    if (!spec.empty())
+      if (auto e = parseEffect(spec, &reason)) f.effect = *e;
+    out.push_back(f);
+  }
+  return true;
 }
+
+}  // namespace
 
 std::optional<DiscoveryResult> discoveryResultFromJson(const json& j, std::string* why) {
   const std::string where = "the discovery result: ";
@@ -555,7 +591,8 @@ std::optional<DiscoveryResult> discoveryResultFromJson(const json& j, std::strin
   if (!readEffectList(j, "tied", "tied must be a list", "unknown tied effect ", r.tied, why,
                       where) ||
       !readText(j, "stop_reason", r.stopReason, false, why, where) ||
-      !readText(j, "validation_data", r.validationData, false, why, where))
+      !readText(j, "validation_data", r.validationData, false, why, where) ||
+      !readText(j, "fit_basis", r.fitBasis, false, why, where))
     return std::nullopt;
   if (j.contains("effects")) {
     if (!j["effects"].is_array()) {
@@ -580,62 +617,114 @@ std::optional<DiscoveryResult> discoveryResultFromJson(const json& j, std::strin
       if ((e.contains("parameters") && !parametersFromJson(e["parameters"], f.parameters, why, ew)) ||
           !readText(e, "evidence", f.evidence, false, why, ew) ||
           !readFlag(e, "confirmed", f.confirmation.confirmed, why, ew) ||
-          !readText(e, "confirmation", f.confirmation.text, false, why, ew) ||
+          !readConfirmation(e, f.confirmation, why, ew) ||
+          !readEstimate(e, "magnitude", f.magnitude, why, ew) || !readSize(e, f.size, why, ew) ||
           (e.contains("before") && !scoreFromJson(e["before"], f.before, why, ew + "before: ")) ||
           (e.contains("after") && !scoreFromJson(e["after"], f.after, why, ew + "after: ")))
         return std::nullopt;
-      f.confirmation.ran = !f.confirmation.text.empty();
       r.found.push_back(std::move(f));
     }
   }
+  // The disagreement: an object with its summary (sessions stored before: the summary).
+  const bool disagreementObject = j.contains("disagreement") && j["disagreement"].is_object();
   if (!readText(j, "evidence", r.evidence, false, why, where) ||
-      !readText(j, "disagreement", r.disagreement.summary, false, why, where) ||
+      (disagreementObject ? !readText(j["disagreement"], "summary", r.disagreement.summary, false, why, where)
+                          : !readText(j, "disagreement", r.disagreement.summary, false, why, where)) ||
       !readFlag(j, "has_validation", r.hasValidation, why, where) ||
+      !readFlag(j, "held_out_split", r.heldOutSplit, why, where) ||
       !readNumber(j, "sample_time", r.sampleTime, false, why, where) ||
+      !readNumber(j, "seconds", r.seconds, false, why, where) ||
       !readNumber(j, "base_loss", r.baseLoss, false, why, where) ||
       !readNumber(j, "base_aic", r.baseAic, false, why, where) ||
       !readWhole(j, "best", r.best, why, where))
     return std::nullopt;
+  if (j.contains("base") && j["base"].is_object() &&
+      (!readNumber(j["base"], "loss", r.baseLoss, false, why, where + "base: ") ||
+       !readNumber(j["base"], "aic", r.baseAic, false, why, where + "base: ")))
+    return std::nullopt;
+  if (j.contains("also_tried") && j["also_tried"].is_array())
+    for (const auto& t : j["also_tried"]) {
+      DiscoveryResult::Rejected x;
+      std::string name, spec;
+      const std::string tw = where + "also tried: ";
+      if (!t.is_object() || !readText(t, "effect", name, true, why, tw) ||
+          !(t.contains("spec") && t["spec"].is_null() ? true : readText(t, "spec", spec, false, why, tw)) ||
+          !readWhole(t, "round", x.round, why, tw) || !readText(t, "reason", x.reason, false, why, tw) ||
+          !readEstimate(t, "magnitude", x.magnitude, why, tw) || !readSize(t, x.size, why, tw))
+        return std::nullopt;
+      const auto k = effectKindFromString(name);
+      if (!k) {
+        if (why) *why = tw + "unknown effect '" + name + "'";
+        return std::nullopt;
+      }
+      x.kind = *k;
+      std::string reason;
+      if (!spec.empty())
+        if (auto e = parseEffect(spec, &reason)) x.effect = *e;
+      r.alsoTried.push_back(std::move(x));
+    }
   if (!j.contains("base") || !scoreFromJson(j["base"], r.base, why, where + "base: ") ||
       !j.contains("augmented") || !scoreFromJson(j["augmented"], r.augmented, why, where + "augmented: ")) {
     if (why && (!j.contains("base") || !j.contains("augmented"))) *why = where + "base and augmented scores are needed";
     return std::nullopt;
   }
-  if (!j.contains("candidates") || !j["candidates"].is_array()) {
-    if (why) *why = where + "candidates must be a list";
+  if (!candidatesFromJson(j, r.candidates, why, where)) return std::nullopt;
+  // The run's end, the final model's effects, every round.
+  std::string termination;
+  if (!readText(j, "termination", termination, false, why, where) ||
+      !readText(j, "message", r.message, false, why, where))
     return std::nullopt;
-  }
-  for (const auto& c : j["candidates"]) {
-    CandidateFit f;
-    std::string name;
-    const std::string cw = where + "candidate: ";
-    if (!c.is_object() || !readText(c, "effect", name, true, why, cw)) {
-      if (why && !c.is_object()) *why = cw + "must be an object";
+  if (!termination.empty()) {
+    const auto t = terminationFromString(termination);
+    if (!t) {
+      if (why) *why = where + "unknown termination '" + termination + "'";
       return std::nullopt;
     }
-    auto k = effectKindFromString(name);
-    if (!k) {
-      if (why) *why = cw + "unknown effect '" + name + "'";
-      return std::nullopt;
-    }
-    f.kind = *k;
-    f.termination = Termination::Converged;
-    if ((c.contains("parameters") && !parametersFromJson(c["parameters"], f.parameters, why, cw)) ||
-        !readWhole(c, "parameter_count", f.parameterCount, why, cw) ||
-        !readNumber(c, "loss_est", f.lossEst, true, why, cw) ||
-        !readNumber(c, "aic", f.aic, false, why, cw) || !readNumber(c, "f", f.fStatistic, false, why, cw) ||
-        !readNumber(c, "f_threshold", f.fThreshold, false, why, cw) ||
-        !readFlag(c, "significant", f.significant, why, cw) || !readText(c, "reason", f.reason, false, why, cw) ||
-        (c.contains("score") && !scoreFromJson(c["score"], f.score, why, cw + "score: ")))
-      return std::nullopt;
-    r.candidates.push_back(f);
+    r.termination = *t;
   }
+  if (j["base"].contains("parameter_count") && !readWhole(j["base"], "parameter_count", r.baseParameterCount, why, where))
+    return std::nullopt;
+  if (j["augmented"].contains("effects") && !readEffects(j["augmented"], "effects", r.augmentedEffects, why, where))
+    return std::nullopt;
+  if (disagreementObject) {
+    const json& d = j["disagreement"];
+    const std::string dw = where + "disagreement: ";
+    if (!readFlag(d, "white", r.disagreement.tests.white, why, dw) ||
+        !readFlag(d, "independent", r.disagreement.tests.independent, why, dw) ||
+        !readNumber(d, "residual_peak_rad_s", r.disagreement.spectrumPeakRadS, false, why, dw) ||
+        !readNumber(d, "correlation_sign_velocity", r.disagreement.correlationSignVelocity, false, why, dw) ||
+        !readNumber(d, "rms_low_speed", r.disagreement.rmsLowSpeed, false, why, dw) ||
+        !readNumber(d, "rms_high_speed", r.disagreement.rmsHighSpeed, false, why, dw))
+      return std::nullopt;
+    if (d.contains("resonances_rad_s") && d["resonances_rad_s"].is_array())
+      for (const auto& w : d["resonances_rad_s"])
+        if (w.is_number()) r.disagreement.resonancesRadS.push_back(w.get<double>());
+  }
+  if (j.contains("rounds") && j["rounds"].is_array())
+    for (const auto& d : j["rounds"]) {
+      DiscoveryRound round;
+      const std::string rw = where + "round: ";
+      std::string named;
+      if (!d.is_object() || !readEffects(d, "effects", round.effects, why, rw) ||
+          !readText(d, "effect", named, false, why, rw) || !readWhole(d, "best", round.best, why, rw) ||
+          !readText(d, "decision", round.decision, false, why, rw) ||
+          !readText(d, "evidence", round.evidence, false, why, rw) ||
+          !readEffectList(d, "tied", "tied must be a list", "unknown tied effect ", round.tied, why, rw) ||
+          !readNumber(d, "aic", round.aic, false, why, rw) ||
+          (d.contains("score") && !scoreFromJson(d["score"], round.score, why, rw + "score: ")) ||
+          !candidatesFromJson(d, round.candidates, why, rw))
+        return std::nullopt;
+      if (!named.empty() && named != "none") round.effect = effectKindFromString(named);
+      r.rounds.push_back(std::move(round));
+    }
   if (r.best < -1 || r.best >= static_cast<int>(r.candidates.size())) {
     if (why) *why = where + "best must index a candidate (or be -1)";
     return std::nullopt;
   }
   // The named candidate's confirmation is the first effect's, stored with it.
-  if (r.best >= 0 && !r.found.empty() && r.found.front().kind == r.candidates[static_cast<std::size_t>(r.best)].kind)
+  // (sessions stored before candidates kept their own).
+  if (r.best >= 0 && !r.found.empty() && r.found.front().kind == r.candidates[static_cast<std::size_t>(r.best)].kind &&
+      !r.candidates[static_cast<std::size_t>(r.best)].confirmation.ran)
     r.candidates[static_cast<std::size_t>(r.best)].confirmation = r.found.front().confirmation;
   return r;
 }

@@ -80,9 +80,9 @@ std::string methodParagraph(const FitRequest& r) {
   for (const auto& p : o.model.start->parameters())
     if (p.free) free += (free.empty() ? "" : ", ") + p.name + " from " + formatSignificant(p.value);
   for (const auto& f : o.model.effects)
-    for (std::size_t k = 0; k < effectParameters(f.effect.kind).size(); ++k)
-      if (f.free[k])
-        free += (free.empty() ? "" : ", ") + effectParameters(f.effect.kind)[k].name + " (" +
+    for (std::size_t k = 0; k < f.effect.values.size(); ++k)
+      if (f.isFree(k))
+        free += (free.empty() ? "" : ", ") + effectParameters(f.effect)[k].name + " (" +
                 toString(f.effect.kind) + ") from " + formatSignificant(f.effect.values[k]);
   return o.model.name() + (o.model.nonlinear() ? " nonlinear" : "") +
          " grey-box model (5.3), prediction-error fit (5.7) in " +

@@ -132,7 +132,7 @@ json fitRequestToJson(const FitRequest& r) {
     json free = json::array(), scaled = json::array();
     for (const auto& f : o.model.effects) {
       effects.push_back(f.effect);
-      free.push_back({f.free[0], f.free[1]});
+      free.push_back(f.free);
       scaled.push_back(f.scaleSmoothing);
     }
     j["start"] = modelToJson(r.name, *o.model.start, effects);
@@ -198,21 +198,23 @@ std::optional<FitRequest> fitRequestFromJson(const json& j, std::string* why) {
     // first value free, the others fixed).
     const json* free = j.contains("effects_free") ? &j["effects_free"] : nullptr;
     if (free && (!free->is_array() || free->size() != spec->effects.size()))
-      return fail(where + "effects_free must list one pair of flags per effect of the start model");
+      return fail(where + "effects_free must list the flags of every effect of the start model");
     // Whether each effect's smoothing speed follows the data (absent, as sessions stored before
     // it did: the value stored).
     const json* scaled = j.contains("effects_scale_smoothing") ? &j["effects_scale_smoothing"] : nullptr;
     if (scaled && (!scaled->is_array() || scaled->size() != spec->effects.size()))
       return fail(where + "effects_scale_smoothing must list one flag per effect of the start model");
     for (std::size_t i = 0; i < spec->effects.size(); ++i) {
-      FitEffect f = FitEffect::defaults(spec->effects[i].kind);
-      f.effect = spec->effects[i];
+      FitEffect f = FitEffect::of(spec->effects[i]);
       f.scaleSmoothing = scaled && (*scaled)[i].is_boolean() && (*scaled)[i].get<bool>();
       if (free) {
         const json& flags = (*free)[i];
-        if (!flags.is_array() || flags.size() != 2 || !flags[0].is_boolean() || !flags[1].is_boolean())
-          return fail(where + "effects_free must list one pair of flags per effect of the start model");
-        f.free = {flags[0].get<bool>(), flags[1].get<bool>()};
+        // One flag per value of the effect (sessions stored before effects took more than two
+        // values hold a pair for every effect: the flags past its values are ignored).
+        bool flagsOk = flags.is_array() && !flags.empty();
+        for (std::size_t k = 0; flagsOk && k < flags.size(); ++k) flagsOk = flags[k].is_boolean();
+        if (!flagsOk) return fail(where + "effects_free must list the flags of every effect of the start model");
+        for (std::size_t k = 0; k < f.free.size() && k < flags.size(); ++k) f.free[k] = flags[k].get<bool>();
       }
       o.model.effects.push_back(f);
     }

@@ -91,7 +91,7 @@ class ModelsPart : public SessionPart {
     s.paragraphs.push_back(model.description() + ".");
     std::string fx;
     for (const auto& e : spec.effects) {
-      const auto& info = effectParameters(e.kind);
+      const auto info = effectParameters(e);
       fx += (fx.empty() ? "" : "; ") + std::string(toString(e.kind)) + " (";
       for (std::size_t i = 0; i < info.size(); ++i)
         fx += (i ? ", " : "") + info[i].name + " = " + formatSignificant(e.values[i]) +

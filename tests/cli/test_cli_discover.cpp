@@ -16,6 +16,13 @@ using nlohmann::json;
 
 namespace {
 const std::string kRipple = std::string(FLEXARM_SAMPLE_DIR) + "/effect_torque_ripple.csv";
+
+// The estimate named `name` of a parameter list (discoveryResultJson's shape).
+json param(const json& list, const std::string& name) {
+  for (const auto& p : list)
+    if (p["name"] == name) return p;
+  return json();
+}
 }  // namespace
 
 // The sample log hides a torque ripple of A = 0.05 N m, 6 periods per motor revolution
@@ -26,23 +33,27 @@ TEST(CliDiscover, NamesTheRippleOfTheSampleLogWithItsEvidence) {
                              "coulomb_friction,torque_ripple", "--json"});
   ASSERT_EQ(r.code, 0) << r.err;
   const json j = json::parse(r.out);
-  for (const char* key : {"effect", "effect_parameters", "evidence", "candidates", "base",
-                          "augmented", "seconds"})
+  for (const char* key : {"schema", "effect", "effects", "also_tried", "evidence", "candidates", "base",
+                          "augmented", "fit_percent_definition"})
     EXPECT_TRUE(j.contains(key)) << key;
   EXPECT_EQ(j["effect"], "torque_ripple") << j["evidence"];
   const auto truth = json::parse(
       readAll(std::string(FLEXARM_SAMPLE_DIR) + "/effect_torque_ripple.truth.json"));
-  const double A = truth["effects"][0]["parameters"]["A"]["value"].get<double>();
-  const auto& a = j["effect_parameters"]["A"];
+  const double A = truth["effects"][0]["parameters"]["a_1"]["value"].get<double>();
+  ASSERT_FALSE(j["effects"].empty()) << j["evidence"];
+  const json a = param(j["effects"][0]["parameters"], "A_1");
+  ASSERT_TRUE(a.is_object()) << j["effects"][0]["parameters"];
   EXPECT_GT(a["std"].get<double>(), 0.0);
   EXPECT_LE(std::abs(a["value"].get<double>() - A), 3.0 * a["std"].get<double>()) << a;
-  EXPECT_EQ(j["effect_parameters"]["n"]["value"].get<double>(), 6.0);
+  EXPECT_EQ(param(j["effects"][0]["parameters"], "n")["value"].get<double>(), 6.0);
+  EXPECT_EQ(j["effects"][0]["magnitude"]["name"], "A_1");
+  EXPECT_GT(j["effects"][0]["size"]["share"].get<double>(), 0.02);
   // The augmented model's effect as `flexarm fit --effect` refines it.
   ASSERT_EQ(j["augmented"]["effects"].size(), 1u);
   EXPECT_EQ(j["augmented"]["effects"][0].get<std::string>().rfind("torque_ripple:", 0), 0u);
   ASSERT_EQ(j["candidates"].size(), 2u);
   for (const auto& c : j["candidates"]) {
-    for (const char* key : {"effect", "loss_est", "rms_val", "aic", "significant"})
+    for (const char* key : {"effect", "loss_est", "score", "aic", "significant", "magnitude", "size"})
       EXPECT_TRUE(c.contains(key)) << key;
     EXPECT_EQ(c["significant"].get<bool>(), c["effect"] == "torque_ripple") << c["reason"];
   }
@@ -77,9 +88,9 @@ TEST(CliDiscover, UntilNoneFindsTheRippleAndStops) {
   }
   EXPECT_LT(j["effects"][0]["after"]["rms_validation"].get<double>(),
             j["effects"][0]["before"]["rms_validation"].get<double>());
-  const auto& a = j["effects"][0]["parameters"]["A"];
-  EXPECT_LE(a["lower"].get<double>(), 0.05);
-  EXPECT_GE(a["upper"].get<double>(), 0.05);
+  const json a = param(j["effects"][0]["parameters"], "A_1");
+  EXPECT_LE(a["lower"].get<double>(), 0.05) << a;
+  EXPECT_GE(a["upper"].get<double>(), 0.05) << a;
   ASSERT_EQ(j["rounds"].size(), 2u);
   EXPECT_EQ(j["rounds"][1]["effect"], "none");
   EXPECT_EQ(j["rounds"][1]["candidates"].size(), 1u);  // the ripple is in the model
@@ -146,9 +157,9 @@ TEST(CliDiscover, TheRefineLineIsAFitThatRuns) {
   const json j = json::parse(f.out);
   bool found = false;
   for (const auto& e : j["effects"]) {
-    if (e["name"] != "torque_ripple" || !e["parameters"].contains("A")) continue;
+    if (e["name"] != "torque_ripple" || !e["parameters"].contains("a_1")) continue;
     found = true;
-    const auto& p = e["parameters"]["A"];
+    const auto& p = e["parameters"]["a_1"];
     EXPECT_TRUE(p["free"].get<bool>()) << p;
     EXPECT_TRUE(p["std"].is_number() && std::isfinite(p["std"].get<double>()) && p["std"].get<double>() > 0.0) << p;
     const auto ripple = line.find("--effect torque_ripple:");

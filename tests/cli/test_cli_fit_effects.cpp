@@ -83,6 +83,9 @@ TEST(CliFitEffects, BadEffectsAreUsageErrorsAndHelpDocumentsThem) {
   EXPECT_NE(r.err.find("no parameter 'n'"), std::string::npos) << r.err;
   r = runFlexarm({"fit", "--help"});
   EXPECT_EQ(r.code, 0);
-  EXPECT_NE(r.out.find("--effect NAME[:V1[,V2]]"), std::string::npos);
-  EXPECT_NE(r.out.find("nonlinear_spring:beta"), std::string::npos);
+  EXPECT_NE(r.out.find("--effect NAME[:V1,...]"), std::string::npos);
+  // Every effect of the registry, with its parameters, in the help (one list for every verb).
+  for (const char* line : {"  coulomb_friction:F_c,v_s", "  nonlinear_spring:beta", "  torque_ripple:a_1,n,b_1",
+                           "  asymmetric_coulomb:F_c+,F_c-", "  encoder_skew:T_o"})
+    EXPECT_NE(r.out.find(line), std::string::npos) << line;
 }

@@ -65,10 +65,10 @@ class DiscoveryPanelTest : public QObject {
     QVERIFY2(panel_->evidenceText().contains("rad/s"), qPrintable(panel_->evidenceText()));
     // One row per candidate; the winner's row says "yes".
     QTableWidget* t = panel_->candidatesTable();
-    QCOMPARE(t->rowCount(), 6);
+    QCOMPARE(t->rowCount(), 9);  // every candidate of the registry but encoder_skew (no arm encoder)
     bool winnerSignificant = false;
     for (int r = 0; r < t->rowCount(); ++r)
-      if (t->item(r, 0)->text() == kEffect) winnerSignificant = t->item(r, 5)->text().startsWith("yes");
+      if (t->item(r, 0)->text() == kEffect) winnerSignificant = t->item(r, 6)->text().startsWith("yes");
     QVERIFY(winnerSignificant);
     // Residual plots hold the base residual; the augmented curve waits for "Add to model".
     QVERIFY(panel_->residualTimePlot()->graph(0)->dataCount() > 1000);
@@ -121,12 +121,13 @@ class DiscoveryPanelTest : public QObject {
     QCOMPARE(fit->dataCount(), 2);
     QVERIFY(fit->data()->at(1)->value > fit->data()->at(0)->value);
     // Two steps: the one that named the ripple (its overlay shows the model with it), and the
-    // last, where nothing more was missing (five candidates, no overlay after it).
+    // last, where nothing more was missing (the registry's candidates less the ripple and the
+    // arm encoder's skew, no overlay after it).
     QCOMPARE(panel_->stepBox()->count(), 2);
     QVERIFY(panel_->overlayPlot()->graph(2)->dataCount() > 1000);
-    QCOMPARE(panel_->candidatesTable()->rowCount(), 6);
+    QCOMPARE(panel_->candidatesTable()->rowCount(), 9);
     panel_->selectStep(1);
-    QCOMPARE(panel_->candidatesTable()->rowCount(), 5);
+    QCOMPARE(panel_->candidatesTable()->rowCount(), 8);
     QCOMPARE(panel_->overlayPlot()->graph(2)->dataCount(), 0);
     QVERIFY2(panel_->evidenceText().startsWith("No missing effect"), qPrintable(panel_->evidenceText()));
     panel_->selectStep(0);
@@ -146,7 +147,7 @@ class DiscoveryPanelTest : public QObject {
       QCOMPARE(row, 0);
       QVERIFY2(t->rowHeight(row) < t->viewport()->height(),
                qPrintable(QString("row %1 px, table %2 px").arg(t->rowHeight(row)).arg(t->viewport()->height())));
-      QVERIFY2(t->item(row, 6)->toolTip().contains("onfirmed on"), qPrintable(t->item(row, 6)->toolTip()));
+      QVERIFY2(t->item(row, 7)->toolTip().contains("onfirmed on"), qPrintable(t->item(row, 7)->toolTip()));
     }
     QVERIFY(seen);
     flexarm::test::saveShot(panel_->grab().toImage(), "discovery_panel_ladder");

@@ -70,6 +70,8 @@ void print(const LoopOutcome& o) {
     std::printf("  val RMS %.4g -> %.4g\n      %s\n", f.before.rmsValidation, f.after.rmsValidation,
                 f.confirmation.text.c_str());
   }
+  for (const auto& t : o.r.alsoTried)
+    std::printf("   also tried (round %d) %-17s %s\n", t.round + 1, toString(t.kind), t.reason.c_str());
   for (std::size_t i = 0; i < o.r.rounds.size(); ++i)
     for (const auto& c : o.r.rounds[i].candidates)
       std::printf("      round %zu %-17s F %.1f/%.1f z %.2f surv %.1f %s\n", i + 1, toString(c.kind), c.fStatistic,
@@ -186,8 +188,8 @@ TEST(DiscoveryLoop, CleanLogsNameNothing) {
 // The confirmation tells an effect from its look-alike: on a backlash log where the only
 // candidate is the stiffening spring (a gear that also grows stiffer with the deflection),
 // the spring passes the F-test and is named, but its own signature, regressed beside the
-// dead zone's on the held-out data, does not confirm it; the backlash itself is confirmed on
-// the same log.
+// dead zone's on the held-out data, does not confirm it, and the loop ends with it; the
+// backlash itself is confirmed on the same log.
 TEST(DiscoveryLoop, ConfirmationRejectsALookAlike) {
   LoopCase c{{test::effectOf(EffectKind::Backlash, 4e-4)}, 44};
   c.candidates = {EffectKind::NonlinearSpring};
@@ -200,6 +202,8 @@ TEST(DiscoveryLoop, ConfirmationRejectsALookAlike) {
   EXPECT_FALSE(lookAlike.confirmed) << lookAlike.text;
   EXPECT_EQ(lookAlike.text.rfind("not confirmed", 0), 0u) << lookAlike.text;
   EXPECT_NE(spring.r.evidence.find("Not confirmed"), std::string::npos) << spring.r.evidence;
+  // An effect that is not confirmed ends the list.
+  EXPECT_NE(spring.r.stopReason.find("not confirmed"), std::string::npos) << spring.r.stopReason;
   c.candidates = {EffectKind::Backlash};
   const LoopOutcome gap = runLoop(c, 1);
   print(gap);

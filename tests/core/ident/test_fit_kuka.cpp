@@ -29,7 +29,7 @@ FitOptions kukaFit(int axis) {
   o.model.start = std::shared_ptr<const PhysicalModel>(std::move(m));
   o.model.armOutput = true;
   FitEffect skew = FitEffect::defaults(EffectKind::EncoderSkew);
-  skew.effect.values = {0.003, 0.0};
+  skew.effect.values = {0.003};
   o.model.effects = {skew};
   if (axis != 1) {  // axes 2 and 3 lift the arm
     FitEffect gravity = FitEffect::defaults(EffectKind::Gravity);

@@ -7,6 +7,7 @@
 #include <random>
 
 #include "core/models/analysis.h"
+#include "core/models/effect_registry.h"
 #include "core/models/nonlinear_plant.h"
 
 namespace flexarm {
@@ -39,6 +40,85 @@ TEST(Effects, NamesRoundTrip) {
   ASSERT_TRUE(e);
   EXPECT_EQ(e->value(0), 0.1);
   EXPECT_EQ(e->value(1), 6.0);
+  EXPECT_EQ(e->value(2), 0.0);  // the cosine coefficient: A sin(n phi_m), as before phases
+  // More harmonics come in pairs after b_1; an even count is refused.
+  const auto two = parseEffect("torque_ripple:0.1,4,0.02,0.03,-0.01", &why);
+  ASSERT_TRUE(two) << why;
+  EXPECT_EQ(two->values.size(), 5u);
+  EXPECT_EQ(effectParameters(*two)[3].name, "a_2");
+  EXPECT_EQ(effectParameters(*two)[4].name, "b_2");
+  EXPECT_EQ(parseEffect(toString(*two), &why)->values, two->values);
+  EXPECT_FALSE(parseEffect("torque_ripple:0.1,4,0.02,0.03", &why));
+  EXPECT_FALSE(parseEffect("coulomb_friction:0.1,0.1,3", &why));
+  // Signs the physics allows: a sine/cosine coefficient and a phase either way, friction
+  // never below zero, a skew either way within a second.
+  EXPECT_TRUE(parseEffect("torque_ripple:-0.1,6,-0.2", &why)) << why;
+  EXPECT_FALSE(parseEffect("coulomb_friction:-0.01", &why));
+  EXPECT_FALSE(parseEffect("asymmetric_coulomb:0.1,-0.1", &why));
+  EXPECT_TRUE(parseEffect("encoder_skew:-0.003", &why)) << why;
+  EXPECT_FALSE(parseEffect("encoder_skew:2", &why));
+  EXPECT_TRUE(parseEffect("gravity:50,-2.5", &why)) << why;
+}
+
+// Every effect of the registry has what the plant, fit, simulate, discovery and the help
+// lists read: a name that parses back, parameters with units and meanings whose defaults are
+// valid, a help line, a description of its estimates and a confirmation signature.
+TEST(Effects, EveryRegisteredEffectIsComplete) {
+  const std::string help = effectHelpLines();
+  for (EffectKind k : allEffectKinds()) {
+    const EffectDefinition& d = effectDefinition(k);
+    EXPECT_EQ(d.kind(), k);
+    EXPECT_NE(help.find("  " + std::string(toString(k)) + ":"), std::string::npos) << toString(k);
+    const Effect e = Effect::withDefaults(k);
+    std::string why;
+    EXPECT_TRUE(e.isValid(&why)) << why;
+    for (const auto& p : effectParameters(k)) {
+      EXPECT_FALSE(p.name.empty());
+      EXPECT_FALSE(p.meaning.empty()) << p.name;
+      EXPECT_LE(p.lower, p.defaultValue) << p.name;
+      EXPECT_GE(p.upper, p.defaultValue) << p.name;
+    }
+    EXPECT_FALSE(d.summary().empty());
+    EXPECT_FALSE(d.signature().empty());
+    std::vector<EffectParameterEstimate> est;
+    for (const auto& p : effectParameters(e)) est.push_back({p.name, p.unit, p.defaultValue, 0.0, 0.0, 0.0, true, false});
+    for (const auto& q : d.derivedQuantities(e)) est.push_back({q.name, q.unit, q.value(e.values), 0.0, 0.0, 0.0, true, true});
+    EXPECT_FALSE(d.describe(est).empty()) << toString(k);
+    // Its size scales: withMagnitude gives the size asked for.
+    if (!d.structural() && std::abs(d.magnitude(e)) > 0.0) {
+      EXPECT_NEAR(d.magnitude(d.withMagnitude(e, 0.5 * d.magnitude(e))), 0.5 * d.magnitude(e),
+                  1e-12 * std::abs(d.magnitude(e)))
+          << toString(k);
+    }
+  }
+}
+
+// The ripple as the physics has it: several harmonics of the order n, each with its phase
+// against the encoder's zero, on the motor: sum_k A_k sin(k n phi_m + psi_k) with
+// a_k = A_k cos psi_k, b_k = A_k sin psi_k.
+TEST(Effects, RippleHarmonicsWithPhasesActOnTheMotor) {
+  auto rigid = makeModel("rigid");
+  const double r = rigid->value("r"), J = rigid->value("J_m") + r * r * rigid->value("J_a");
+  const double n = 4.0, A1 = 0.3, psi1 = 2.1, A2 = 0.12, psi2 = -0.7;
+  Effect ripple = Effect::withDefaults(EffectKind::TorqueRipple);
+  ripple.values = {A1 * std::cos(psi1), n, A1 * std::sin(psi1), A2 * std::cos(psi2), A2 * std::sin(psi2)};
+  const NonlinearPlant plant(*rigid, {ripple});
+  const NonlinearPlant free(*rigid, {});
+  const EffectDefinition& d = effectDefinition(EffectKind::TorqueRipple);
+  const auto derived = d.derivedQuantities(ripple);
+  ASSERT_EQ(derived.size(), 4u);
+  EXPECT_NEAR(derived[0].value(ripple.values), A1, 1e-12);
+  EXPECT_NEAR(derived[1].value(ripple.values), psi1, 1e-12);
+  EXPECT_NEAR(derived[2].value(ripple.values), A2, 1e-12);
+  EXPECT_NEAR(derived[3].value(ripple.values), psi2, 1e-12);
+  NonlinearPlant::State x{}, dx{}, d0{};
+  for (double phi : {0.0, 0.3, 1.7, -2.9, 10.4}) {
+    x[1] = phi;  // rigid: phi_m' then phi_m
+    plant.derivative(x.data(), 0.0, 0.0, dx.data());
+    free.derivative(x.data(), 0.0, 0.0, d0.data());
+    const double tau = A1 * std::sin(n * phi + psi1) + A2 * std::sin(2 * n * phi + psi2);
+    EXPECT_NEAR((dx[0] - d0[0]) * J, tau, 1e-12) << phi;
+  }
 }
 
 TEST(Effects, PlantWithoutEffectsIsTheLinearModel) {

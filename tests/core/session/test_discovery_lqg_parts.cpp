@@ -120,8 +120,10 @@ TEST(DiscoveryPart, RequestAndResultSurviveTheirJson) {
   f.effect = Effect::withDefaults(EffectKind::Backlash);
   f.parameters = c.parameters;
   f.evidence = "a gap";
+  f.confirmation.ran = true;
   f.confirmation.confirmed = true;
   f.confirmation.text = "confirmed on the validation data";
+  r.candidates[0].confirmation = f.confirmation;  // the named candidate keeps its own
   f.before.rmsValidation = 0.3;
   f.after.rmsValidation = 0.1;
   r.found = {f};
@@ -210,10 +212,13 @@ TEST(SessionParts, SaveReopenReplayGivesTheSameVerdictAndLqgNumbers) {
   EXPECT_LT((*d)["augmented"]["rms_validation"].get<double>(),
             0.9 * (*d)["base"]["rms_validation"].get<double>());
   // The ripple amplitude A (N m) within 3 std of the value that generated the log.
-  const double amplitude = (*d)["effect_parameters"]["A"]["value"].get<double>();
-  const double sd = (*d)["effect_parameters"]["A"]["std"].get<double>();
+  ASSERT_FALSE((*d)["effects"].empty());
+  const json& magnitude = (*d)["effects"][0]["magnitude"];
+  EXPECT_EQ(magnitude["name"], "A_1");
+  const double amplitude = magnitude["value"].get<double>();
+  const double sd = magnitude["std"].get<double>();
   EXPECT_GT(sd, 0.0);
-  EXPECT_NEAR(amplitude, truthOf("A"), 3.0 * sd);
+  EXPECT_NEAR(amplitude, std::abs(truthOf("a_1")), 3.0 * sd);
 
   const json* l = values(a, kLqgTitle);
   ASSERT_NE(l, nullptr);

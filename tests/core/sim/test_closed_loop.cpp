@@ -204,7 +204,7 @@ TEST(ClosedLoop, TorqueRippleGivesALineAtItsMultipleOfMotorSpeed) {
   o.disturbance.loadTorqueStd = 0.0;
   o.disturbance.encoderCountsPerRev = 0;
   Effect r = Effect::withDefaults(EffectKind::TorqueRipple);
-  r.values = {0.1, 6.0};
+  r.values = {0.1, 6.0, 0.0};  // 0.1 sin(6 phi_m)
   const auto with = simulateClosedLoop(*m, {r}, o), without = simulateClosedLoop(*m, {}, o);
   auto tail = [](const std::vector<double>& v) {
     return std::vector<double>(v.begin() + 2000, v.end());  // after the start-up transient
