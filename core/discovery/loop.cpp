@@ -262,6 +262,68 @@ DiscoveryResult discoverMissingEffect(const PhysicalModel& base, const IdData& e
     ModelFit polished = fitModel(ctx, current.model, current.effects, bounds, o.baseIterations, o.threads);
     if (polished.ok() && polished.loss <= current.loss) current = std::move(polished);
   }
+  // 4. What the final model still needs: an effect named early can have stood in for one named
+  // later (a delay for a stiffening spring whose first fit had not found its level), and shrink
+  // to nothing once that one is in. Each effect of the final model is set to its null value
+  // (the others as fitted, nothing refitted, so the held-out residual rises at least as much as
+  // after a refit without it); one whose absence raises the held-out residual by less than a
+  // candidate must lower it to be named (minValidationImprovement) is dropped, reported as
+  // tried, and the others refitted without it.
+  while (R.found.size() > 1 && !cancelled && current.ok()) {
+    if (cancel.load()) {
+      cancelled = true;
+      break;
+    }
+    auto heldOutRms = [&](const std::vector<Effect>& effects) -> double {
+      std::vector<double> y;
+      try {
+        const NonlinearPlant plant(*current.model, effects);
+        if (!predictOutput(plant, ctx.valSeries(), ctx.substeps, ctx.observer, PredictedOutput::DifferentiatedAngle, y))
+          return INFINITY;
+      } catch (const std::invalid_argument&) {
+        return INFINITY;
+      }
+      return rms(ctx.valY, ctx.pickVal(y));
+    };
+    const double with = heldOutRms(current.effects);
+    if (!std::isfinite(with)) break;
+    std::size_t weakest = current.effects.size();
+    double weakestRms = INFINITY, weakestGain = INFINITY;
+    for (std::size_t e = 0; e < current.effects.size(); ++e) {
+      const EffectDefinition& d = effectDefinition(current.effects[e]);
+      // Only effects the loop named are weighed (the start effects were the engineer's), and
+      // no structural one (a mass changes the base itself).
+      bool named = false;
+      for (const auto& f : R.found) named = named || f.kind == current.effects[e].kind;
+      if (d.structural() || !named) continue;
+      std::vector<Effect> without = current.effects;
+      without[e] = d.withMagnitude(without[e], 0.0);
+      const double rmsWithout = heldOutRms(without);
+      const double gain = std::isfinite(rmsWithout) && rmsWithout > 0.0 ? 1.0 - with / rmsWithout : INFINITY;
+      if (gain < weakestGain) weakestGain = gain, weakest = e, weakestRms = rmsWithout;
+    }
+    if (weakest >= current.effects.size() || weakestGain >= o.minValidationImprovement) break;
+    const EffectKind dropped = current.effects[weakest].kind;
+    ctx.report(-1.0, std::string("refitting the final model without ") + toString(dropped));
+    std::vector<Effect> rest = current.effects;
+    rest.erase(rest.begin() + static_cast<long>(weakest));
+    const EffectBounds bounds = effectBounds(ctx.est, current.deflection, *current.model, rest);
+    ModelFit refit = fitModel(ctx, current.model, rest, bounds, o.baseIterations, o.threads);
+    if (!refit.ok()) break;
+    const auto at = std::find_if(R.found.begin(), R.found.end(), [&](const FoundEffect& f) { return f.kind == dropped; });
+    int namedIn = 0;
+    for (std::size_t i = 0; i < R.rounds.size(); ++i)
+      if (R.rounds[i].effect == dropped) namedIn = static_cast<int>(i);
+    DiscoveryResult::Rejected t{namedIn, dropped, current.effects[weakest], current.magnitudes[weakest], at != R.found.end() ? at->size : EffectSize{}, ""};
+    t.reason = "named in round " + std::to_string(namedIn + 1) + ", but adds nothing once the effects named after it "
+               "are in: set to 0 in the final model, the held-out residual RMS goes only from " + number(with) +
+               " to " + number(weakestRms) + " rad/s (" + number(100.0 * weakestGain, 2) + " %, at least " +
+               number(100.0 * o.minValidationImprovement, 2) + " % needed); dropped and the rest refitted";
+    R.alsoTried.push_back(std::move(t));
+    if (at != R.found.end()) R.found.erase(at);
+    R.stopReason += "; " + std::string(toString(dropped)) + " dropped from the final model (it adds nothing once the others are in)";
+    current = std::move(refit);
+  }
   // The final model: every effect found with the values of the last refit.
   for (auto& f : R.found)
     for (std::size_t e = 0; e < current.effects.size(); ++e)
