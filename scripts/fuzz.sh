@@ -6,6 +6,7 @@
 #   bash scripts/fuzz.sh [--seconds N] [--seed N] [TARGET...]
 #
 # TARGET: fuzz_csv fuzz_table fuzz_mat fuzz_mat73 fuzz_session fuzz_cli_options fuzz_diagnose_log
+#         fuzz_manifest fuzz_store
 # (default: all).
 # The corpus grows in $FUZZ_DIR/corpus/TARGET (default build-fuzz/); crashing inputs are kept
 # in $FUZZ_DIR/artifacts. BUILD_DIR reuses an existing build configured with FLEXARM_FUZZ=ON
@@ -23,7 +24,8 @@ while [ $# -gt 0 ]; do
     *) targets+=("$1"); shift ;;
   esac
 done
-[ ${#targets[@]} -gt 0 ] || targets=(fuzz_csv fuzz_table fuzz_mat fuzz_mat73 fuzz_session fuzz_cli_options fuzz_diagnose_log)
+[ ${#targets[@]} -gt 0 ] || targets=(fuzz_csv fuzz_table fuzz_mat fuzz_mat73 fuzz_session fuzz_cli_options fuzz_diagnose_log
+  fuzz_manifest fuzz_store)
 
 build="${BUILD_DIR:-$here/build-fuzz}"
 fuzzdir="${FUZZ_DIR:-$build}"
@@ -54,6 +56,31 @@ mkdir -p "$fuzzdir/corpus/fuzz_cli_options"
 printf 'x\0--model\0arx:2,2,1\0--range\0002:10\0--max-iterations\00050' > "$fuzzdir/corpus/fuzz_cli_options/seed-fit"
 printf 'x\0--input-column\0003\0--sample-time=0.01\0--format\0table\0--fix\0backlash:2e-4' \
   > "$fuzzdir/corpus/fuzz_cli_options/seed-log"
+mkdir -p "$fuzzdir/corpus/fuzz_manifest"
+printf '# flexarm-fleet: 1\nrobot,axis,time,log,temperature_c,role\nR01,1,2026-03-01T06:00:00Z,R01/a.csv,24.5,reference\nR01,1,2026-03-02T06:00,R01/b.csv,,\nR02,3,2026-03-02,../x.csv,,\n' \
+  > "$fuzzdir/corpus/fuzz_manifest/seed-plant"
+printf '\xef\xbb\xbf# flexarm-fleet: 1\nlog,time,axis,robot\nb.csv,2026-03-05T06:00,2,R07\n' > "$fuzzdir/corpus/fuzz_manifest/seed-bom"
+# A store as FlexArm lays it out (its schema read from core/fleet/store.cpp), one log in it;
+# the first byte selects the store half of the target.
+mkdir -p "$fuzzdir/corpus/fuzz_store"
+python3 - "$here/core/fleet/store.cpp" "$fuzzdir/corpus/fuzz_store" <<'PY' || true
+import re, sqlite3, sys, os, tempfile
+schema = re.search(r'R"sql\((.*?)\)sql"', open(sys.argv[1]).read(), re.S).group(1)
+path = os.path.join(tempfile.mkdtemp(), "s.sqlite")
+db = sqlite3.connect(path)
+db.executescript(schema)
+a, r = "a" * 64, "0" * 64
+db.execute("INSERT INTO meta VALUES('schema_version', '1')")
+db.execute("INSERT INTO logs VALUES(?, ?, 'R01', 1, '2026-03-01', 20513.25, 'a.csv', 25, '', 1, 'ok', 'none', NULL, 0.1, 1)", (a, r))
+for i, (n, v) in enumerate([("k_T", 0.5), ("J_a", 1.7), ("f_m", 0.036)]):
+    db.execute("INSERT INTO estimates VALUES(?, ?, ?, ?, 0.01, ?, ?)", (a, r, n, v, v, i))
+db.commit(); db.close()
+open(os.path.join(sys.argv[2], "seed-store"), "wb").write(b"\x01" + open(path, "rb").read())
+open(os.path.join(sys.argv[2], "seed-result"), "wb").write(
+    b'\x00{"sha256":"' + a.encode() + b'","reference_sha256":"' + r.encode() +
+    b'","ok":true,"message":"","verdict":"none","verdict_time_s":null,"seconds":0.1,'
+    b'"estimates":[{"name":"k_T","value":0.5,"std":0.01,"reference":0.5}]}')
+PY
 mkdir -p "$fuzzdir/artifacts"
 tmp="$(mktemp -d)"
 trap 'rm -rf "$tmp"' EXIT

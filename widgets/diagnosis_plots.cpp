@@ -157,7 +157,7 @@ void DiagnosisPanel::buildPlots() {
                            ? tr("calibrated: %1").arg(QString::fromStdString(shownRun_->calibration->message))
                            : storedCalibration_.is_object()
                                  ? tr("calibrated: %1").arg(QString::fromStdString(storedCalibration_.value("message", std::string())))
-                                 : QString::fromStdString(defaultThresholdsProvenance());
+                                 : QString::fromStdString(thresholdsProvenance(r.options));
   thresholds_->setText(tr("Thresholds (sigma units, CUSUM alpha_2, level): %1. %2. Reference: %3. "
                           "Temperature: %4. %5")
                            .arg(th.join("; "), from, QString::fromStdString(r.referenceSource),

@@ -1,3 +1,4 @@
+#include <cstdio>
 #include <charconv>
 #include <cmath>
 #include <ostream>
@@ -149,12 +150,40 @@ long ArgParser::integer(const std::string& name) const {
   return static_cast<long>(wholeNumber(text(name)).value_or(0));
 }
 
+namespace {
+
+// A value as a message quotes it: at most 100 characters.
+std::string quotedValue(const std::string& v) {
+  return "'" + (v.size() > 100 ? v.substr(0, 100) + "...' (" + std::to_string(v.size()) + " characters)" : v + "'");
+}
+
+std::string shortNumber(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%g", v);
+  return buf;
+}
+
+}  // namespace
+
+bool ArgParser::number(const std::string& name, double& out, double min, double max) {
+  auto v = value(name);
+  if (!v) return true;
+  const auto x = finiteNumber(*v);
+  if (!x || *x < min || *x > max) {
+    error_ = "--" + name + " expects a number from " + shortNumber(min) + " to " + shortNumber(max) + ", got " +
+             quotedValue(*v);
+    return false;
+  }
+  out = *x;
+  return true;
+}
+
 bool ArgParser::number(const std::string& name, double& out) {
   auto v = value(name);
   if (!v) return true;
   const auto x = finiteNumber(*v);
   if (!x) {
-    error_ = "--" + name + " expects a number, got '" + *v + "'";
+    error_ = "--" + name + " expects a number, got " + quotedValue(*v);
     return false;
   }
   out = *x;
@@ -167,7 +196,7 @@ bool ArgParser::integer(const std::string& name, long& out) {
   long x = 0;
   auto res = std::from_chars(v->data(), v->data() + v->size(), x);
   if (res.ec != std::errc() || res.ptr != v->data() + v->size()) {
-    error_ = "--" + name + " expects an integer, got '" + *v + "'";
+    error_ = "--" + name + " expects an integer, got " + quotedValue(*v);
     return false;
   }
   out = x;
@@ -180,7 +209,7 @@ bool ArgParser::integer(const std::string& name, int& out, int min, int max) {
   const auto x = wholeNumber(*v);
   if (!x || *x < min || *x > max) {
     error_ = "--" + name + " expects a whole number from " + std::to_string(min) + " to " +
-             std::to_string(max) + ", got '" + *v + "'";
+             std::to_string(max) + ", got " + quotedValue(*v);
     return false;
   }
   out = static_cast<int>(*x);

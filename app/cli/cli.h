@@ -139,6 +139,8 @@ class ArgParser {
   // An integer in [min, max]: anything else (a fraction, 1e12, a value that overflows) is
   // refused with a sentence naming the allowed range, never wrapped.
   bool integer(const std::string& name, int& out, int min, int max);
+  // A finite number in [min, max], else refused with a sentence naming the option and range.
+  bool number(const std::string& name, double& out, double min, double max);
 
  private:
   OptionTable table_;

@@ -241,11 +241,14 @@ int runDiagnose(const std::vector<std::string>& argv, std::ostream& out, std::os
     }
   }
   double lambda = options.estimator.lambda, k = 0.0;
-  if (!args.number("lambda", lambda) || !args.number("k", k) ||
-      !args.number("alpha1", options.cusumAlpha1) || !args.number("alpha2", options.cusumAlpha2) ||
-      !args.number("hypothesis-threshold", options.hypothesisThreshold) ||
-      !args.number("confirm", options.confirmS) || !args.number("settle", options.settleS) ||
-      !args.number("mismatch-ratio", options.mismatchRatio))
+  // Ranges a diagnosis can use: a threshold of 1e308 sigma would never raise an alarm and
+  // report "no fault" on any log.
+  if (!args.number("lambda", lambda, 0.5, 1.0) || !args.number("k", k, 0.1, 100.0) ||
+      !args.number("alpha1", options.cusumAlpha1, 0.0, 1000.0) ||
+      !args.number("alpha2", options.cusumAlpha2, 0.01, 10000.0) ||
+      !args.number("hypothesis-threshold", options.hypothesisThreshold, 0.01, 100.0) ||
+      !args.number("confirm", options.confirmS, 0.0, 3600.0) || !args.number("settle", options.settleS, 0.0, 3600.0) ||
+      !args.number("mismatch-ratio", options.mismatchRatio, 1.0001, 1e6))
     return usage(args.error());
   if (args.flag("no-model-check")) options.checkModel = false;
   for (const auto& [key, target] : {std::pair{"temperature", &options.monitoredTemperatureC},
@@ -349,11 +352,11 @@ int runDiagnose(const std::vector<std::string>& argv, std::ostream& out, std::os
   if (args.flag("json")) {
     auto j = diagnosisResultJson(r);
     if (run.calibration) j["calibration"] = calibrationJson(*run.calibration);
-    else j["thresholds_provenance"] = defaultThresholdsProvenance();
+    else j["thresholds_provenance"] = thresholdsProvenance(r.options);
     out << j.dump(2) << "\n";
   } else {
     if (run.calibration) out << calibrationText(*run.calibration);
-    else out << "Thresholds: " << defaultThresholdsProvenance() << "\n";
+    else out << "Thresholds: " << thresholdsProvenance(r.options) << "\n";
     out << r.summary() << "\n";
     if (r.termination != Termination::Converged) out << r.message << "\n";
     if (r.modelCheck.checked && !r.modelCheck.mismatch) out << r.modelCheck.message << "\n";

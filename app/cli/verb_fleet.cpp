@@ -4,6 +4,7 @@
 // flexarm simulate --fleet DIR --robots N --days D ...    (the simulated plant)
 #include "app/cli/verb_fleet.h"
 
+#include <algorithm>
 #include <cstdio>
 #include <filesystem>
 #include <nlohmann/json.hpp>
@@ -40,7 +41,10 @@ const char* kFleetHelp =
     "                        next stop (default 14)\n"
     "  --alpha A             f_m's relative change per degC, when known (default: estimated from\n"
     "                        each axis' healthy logs)\n"
-    "  --limit N             analyse at most N new logs in this run\n"
+    "  --limit N             analyse at most N new logs in this run (N >= 1)\n"
+    "  --max-rows N          refuse a manifest of more than N rows (default 500000)\n"
+    "  --allow-logs-outside  read logs outside the manifest's folder too (by default a row\n"
+    "                        naming ../x, /etc/... or a link leading out is refused)\n"
     "  --report FILE         write the fleet report (.pdf or .html)\n"
     "  --json                print the result as JSON\n\n"
     "Slurm (--engine slurm): the logs go out in chunks, one array task each, run as\n"
@@ -80,8 +84,8 @@ std::string axisLine(const FleetAxisReport& a) {
 }  // namespace
 
 int runFleet(const std::vector<std::string>& argv, std::ostream& out, std::ostream& err) {
-  ArgParser args({"json", "help"},
-                 {"db", "engine", "jobs", "model", "threshold", "next-stop", "alpha", "limit", "report", "task",
+  ArgParser args({"json", "help", "allow-logs-outside"},
+                 {"db", "engine", "jobs", "model", "threshold", "next-stop", "alpha", "limit", "max-rows", "report", "task",
                   "out", "slurm-dir", "logs-per-task", "max-tasks", "sbatch-arg", "slurm-timeout", "flexarm"});
   const std::string pre = "flexarm fleet: ";
   auto usage = [&](const std::string& why) {
@@ -119,11 +123,17 @@ int runFleet(const std::vector<std::string>& argv, std::ostream& out, std::ostre
     o.engine = *engine;
   }
   int logsPerTask = o.slurm.logsPerTask, maxTasks = 0;
-  if (!args.integer("jobs", o.jobs, 0, 1024) || !args.integer("limit", o.limit, 0, 1 << 30) ||
+  ManifestReadOptions readOptions;
+  readOptions.allowLogsOutside = args.flag("allow-logs-outside");
+  int maxRows = static_cast<int>(readOptions.maxRows);
+  if (!args.integer("jobs", o.jobs, 0, 1024) || !args.integer("limit", o.limit, 1, 1 << 30) ||
+      !args.integer("max-rows", maxRows, 1, 100000000) ||
       !args.integer("logs-per-task", logsPerTask, 1, 1000000) || !args.integer("max-tasks", maxTasks, 0, 1000000) ||
-      !args.number("threshold", o.trend.threshold) || !args.number("next-stop", o.trend.nextStopDays) ||
-      !args.number("slurm-timeout", o.slurm.timeoutS))
+      !args.number("threshold", o.trend.threshold, 1e-3, 10.0) ||
+      !args.number("next-stop", o.trend.nextStopDays, 0.0, 3650.0) ||
+      !args.number("slurm-timeout", o.slurm.timeoutS, 1.0, 30 * 86400.0))
     return usage(args.error());
+  readOptions.maxRows = static_cast<std::size_t>(maxRows);
   o.slurm.logsPerTask = logsPerTask;
   o.slurm.maxTasksAtOnce = maxTasks;
   if (auto a = args.value("alpha")) {
@@ -138,7 +148,7 @@ int runFleet(const std::vector<std::string>& argv, std::ostream& out, std::ostre
   if (!o.isValid(&why)) return usage(why);
 
   ManifestError merr;
-  const auto manifest = readFleetManifest(args.positional()[0], &merr);
+  const auto manifest = readFleetManifest(args.positional()[0], &merr, readOptions);
   if (!manifest) {
     err << pre << merr.toString() << "\n";
     return kExitBadInput;
@@ -163,10 +173,16 @@ int runFleet(const std::vector<std::string>& argv, std::ostream& out, std::ostre
     }
   }
   if (args.flag("json")) {
-    out << fleetRunJson(run).dump(2) << "\n";
+    auto j = fleetRunJson(run);
+    j["logs_outside_allowed"] = readOptions.allowLogsOutside;
+    out << j.dump(2) << "\n";
   } else {
     out << run.message << " in " << run.seconds << " s (" << toString(run.engine) << " engine).\n";
-    for (const auto& f : run.failures) out << "failed: " << f.log << ": " << f.message << "\n";
+    if (readOptions.allowLogsOutside) out << "Logs outside the manifest's folder were allowed (--allow-logs-outside).\n";
+    for (std::size_t i = 0; i < std::min(run.failures.size(), kListedFailures); ++i)
+      out << "failed: " << run.failures[i].log << ": " << run.failures[i].message << "\n";
+    if (run.failures.size() > kListedFailures)
+      out << "... and " << run.failures.size() - kListedFailures << " more failures (--json counts them)\n";
     for (const auto& a : run.axes) out << axisLine(a) << "\n";
   }
   return kExitOk;

@@ -268,6 +268,12 @@ DiagnosisResult diagnose(const DiagnosisReference& reference, const IdData& log,
   // Read as the reference was: the two predictors settle on different values.
   const auto data = diagnosisSignals(log, reference.predictor, &why);
   if (!data) return refuse(why);
+  if (const double span = log.samples() > 1 ? (static_cast<double>(log.samples()) - 1.0) * log.sampleTime : 0.0;
+      options.settleS >= span) {
+    char buf[160];
+    std::snprintf(buf, sizeof buf, "no alarm is raised in the first %g s (the settling time), and the log lasts %g s", options.settleS, span);
+    return refuse(buf);
+  }
   // f_m compared at the monitored log's temperature.
   const LogTemperature monitored = logTemperature(log);
   if (!monitored.problem.empty() && !options.monitoredTemperatureC) return refuse(monitored.problem);

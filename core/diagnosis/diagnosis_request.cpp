@@ -1,5 +1,7 @@
 #include "core/diagnosis/diagnosis_request.h"
 
+#include <cstdio>
+
 #include <algorithm>
 #include <stdexcept>
 
@@ -87,6 +89,39 @@ std::string defaultThresholdsProvenance() {
          "study of 240 simulated runs the decision at these thresholds raised no false alarm in "
          "0.3 h of fault-free runs (at most 10 false alarms per hour at 95 %) and isolated 99 % "
          "of 20 % faults within 5 s, median delay 0.85 s";
+}
+
+std::string thresholdsProvenance(const DiagnosisOptions& o) {
+  const DiagnosisOptions d;
+  std::vector<std::string> changed;
+  auto number = [](double v) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%g", v);
+    return std::string(buf);
+  };
+  auto check = [&](const char* name, double value, double standard) {
+    if (value != standard) changed.push_back(std::string(name) + " = " + number(value));
+  };
+  check("k (classical)", o.classicalK, d.classicalK);
+  check("k (robust)", o.robustK, d.robustK);
+  check("alpha_1", o.cusumAlpha1, d.cusumAlpha1);
+  check("alpha_2", o.cusumAlpha2, d.cusumAlpha2);
+  check("hypothesis threshold", o.hypothesisThreshold, d.hypothesisThreshold);
+  check("joint k", o.jointK, d.jointK);
+  check("settle", o.settleS, d.settleS);
+  check("confirm", o.confirmS, d.confirmS);
+  if (o.window != d.window || (o.window == HypothesisWindow::Sliding && o.windowS != d.windowS))
+    changed.push_back("the hypothesis window");
+  if (o.classicalScales != d.classicalScales || o.robustScales != d.robustScales || o.cusumScales != d.cusumScales)
+    changed.push_back("the per-parameter factors");
+  if (o.parameters != d.parameters || o.inverted != d.inverted) changed.push_back("the monitored parameters");
+  if (o.tests != d.tests || o.decision != d.decision) changed.push_back("the tests");
+  if (changed.empty()) return defaultThresholdsProvenance();
+  std::string list;
+  for (std::size_t i = 0; i < changed.size(); ++i) list += (i ? ", " : "") + changed[i];
+  return "set by hand (" + list +
+         "), not the calibrated design values: their false-alarm rate and isolation were not "
+         "measured (--calibrate measures them on this reference)";
 }
 
 }  // namespace flexarm

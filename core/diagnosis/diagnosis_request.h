@@ -50,5 +50,9 @@ DiagnosisRun runDiagnosisRequest(const DiagnosisRequest& request, const IdData& 
 // Where the default thresholds come from and the false-alarm rate they were calibrated for,
 // in one sentence (reports and the command line print it beside the thresholds).
 std::string defaultThresholdsProvenance();
+// Where the thresholds of `options` come from: the sentence above when they are the calibrated
+// defaults; else which ones were set by hand and that their false-alarm rate and isolation
+// were not measured (the calibration's figures do not carry over to other thresholds).
+std::string thresholdsProvenance(const DiagnosisOptions& options);
 
 }  // namespace flexarm

@@ -63,7 +63,18 @@ bool SlurmOptions::isValid(std::string* why) const {
   if (executable.empty()) return fail("the Slurm engine needs the flexarm executable the tasks run");
   if (logsPerTask < 1 || logsPerTask > 1000000) return fail("logs per Slurm task must lie between 1 and 1000000");
   if (maxTasksAtOnce < 0) return fail("the tasks at once must be 0 (no limit) or more");
-  if (!(timeoutS > 0.0) || !(pollS > 0.0)) return fail("the Slurm timeout and poll interval must be positive");
+  if (!(timeoutS > 0.0 && timeoutS <= 30 * 86400.0))
+    return fail("the Slurm timeout (--slurm-timeout) must lie between 0 and 2592000 s (30 days)");
+  if (!(pollS > 0.0 && pollS <= 3600.0)) return fail("the Slurm poll interval must lie between 0 and 3600 s");
+  auto plain = [](const std::string& s) {
+    for (unsigned char c : s)
+      if (c < 0x20 || c == 0x7f) return false;
+    return true;
+  };
+  if (!plain(workDir)) return fail("--slurm-dir holds a line break or another control character; give a plain path");
+  if (!plain(executable)) return fail("--flexarm holds a line break or another control character; give a plain path");
+  for (const auto& a : sbatchArguments)
+    if (!plain(a)) return fail("an --sbatch-arg holds a line break or another control character");
   return true;
 }
 
@@ -113,19 +124,30 @@ FleetRunResult runFleet(const FleetManifest& manifest, FleetStore& store, const 
   // What is new: every log whose (bytes, reference) pair the store lacks. A file whose size,
   // modification time and inode are as when it was last hashed keeps its checksum.
   const auto stored = store.storedKeys();
+  if (const auto bad = store.readError()) {  // what it skips must be what it holds
+    run.message = *bad;
+    store.finishRun({run.runId, "", "", toString(options.engine), manifest.path, 0, 0, 0, secondsSince(begin)}, nullptr);
+    return run;
+  }
   std::vector<std::pair<std::string, std::pair<FleetStore::FileStamp, std::string>>> hashed;
+  std::map<std::string, std::string> hashedNow;  // path -> SHA-256, this run
   auto hashOf = [&](const std::string& path, std::string* error) -> std::optional<std::string> {
+    if (auto it = hashedNow.find(path); it != hashedNow.end()) return it->second;
+    auto remember = [&](std::optional<std::string> sha) {
+      if (sha) hashedNow[path] = *sha;
+      return sha;
+    };
     struct stat st {};
     if (::stat(path.c_str(), &st) == 0 && S_ISREG(st.st_mode)) {
       const FleetStore::FileStamp stamp{static_cast<long long>(st.st_size),
                                         static_cast<long long>(st.st_mtim.tv_sec) * 1000000000LL + st.st_mtim.tv_nsec,
                                         static_cast<long long>(st.st_ino)};
-      if (auto known = store.knownSha256(path, stamp)) return known;
+      if (auto known = store.knownSha256(path, stamp)) return remember(known);
       auto sha = sha256OfFile(path, error);
       if (sha) hashed.push_back({path, {stamp, *sha}});
-      return sha;
+      return remember(sha);
     }
-    return sha256OfFile(path, error);
+    return remember(sha256OfFile(path, error));
   };
   fleet::WorkChunk fits, logs;
   fits.options = logs.options = options.analysis;
@@ -134,6 +156,10 @@ FleetRunResult runFleet(const FleetManifest& manifest, FleetStore& store, const 
   std::map<std::string, std::vector<std::size_t>> waiting;  // reference SHA -> its log jobs
   std::map<std::string, std::string> referenceSha;     // axis key -> reference SHA
   int newLogs = 0;
+  // Rows whose logs have the same bytes (the same file twice, or a copy) against the same
+  // reference are one recording: the first row is analysed and stored, each other one is
+  // reported with the row it repeats, every run alike.
+  std::map<std::pair<std::string, std::string>, const FleetEntry*> firstRow;
   for (const auto& axis : manifest.axes) {
     const FleetEntry& ref = manifest.entries[axis.referenceEntry];
     const auto refSha = hashOf(ref.path, &why);
@@ -152,6 +178,13 @@ FleetRunResult runFleet(const FleetManifest& manifest, FleetStore& store, const 
       const auto sha = hashOf(e.path, &why);
       if (!sha) {
         failEntry(e, e.path + ": " + why);
+        continue;
+      }
+      const auto [first, isNew] = firstRow.emplace(std::make_pair(*sha, *refSha), &e);
+      if (!isNew) {
+        failEntry(e, "line " + std::to_string(e.line) + " names a log of the same bytes as line " +
+                         std::to_string(first->second->line) + " (" + first->second->log +
+                         "): one recording is analysed and stored once; remove one of the rows");
         continue;
       }
       if (stored.count({*sha, *refSha})) {
@@ -280,6 +313,10 @@ FleetRunResult runFleet(const FleetManifest& manifest, FleetStore& store, const 
     if (!a || referenceSha[axis.key()] != a->referenceSha256) continue;
     run.axes.push_back(axisReport(store, *a, options.trend));
   }
+  if (const auto bad = store.readError()) {  // a trend of part of the logs is not reported as whole
+    run.termination = Termination::Failed;
+    run.message = *bad;
+  }
   return run;
 }
 
@@ -344,8 +381,11 @@ json fleetRunJson(const FleetRunResult& r) {
     maintenance.push_back({{"robot", a->robot}, {"axis", a->axis}, {"parameter", a->trend.parameter},
                            {"status", a->trend.status}, {"days_to_threshold", optionalJson(a->trend.daysToThreshold)},
                            {"suggestion", a->trend.suggestion}});
-  for (const auto& f : r.failures)
+  // At most kListedFailures are listed (a manifest of missing files would print them all).
+  for (std::size_t i = 0; i < std::min(r.failures.size(), kListedFailures); ++i) {
+    const auto& f = r.failures[i];
     failures.push_back({{"robot", f.robot}, {"axis", f.axis}, {"time", f.time}, {"log", f.log}, {"message", f.message}});
+  }
   return {{"engine", toString(r.engine)},
           {"run", r.runId},
           {"termination", toString(r.termination)},
@@ -355,6 +395,7 @@ json fleetRunJson(const FleetRunResult& r) {
           {"failed", r.failed},
           {"references_fitted", r.referencesFitted},
           {"failures", failures},
+          {"failures_not_listed", r.failures.size() - std::min(r.failures.size(), kListedFailures)},
           {"axes", axes},
           {"maintenance", maintenance},
           {"seconds", r.seconds},

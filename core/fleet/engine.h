@@ -98,6 +98,9 @@ std::vector<FleetAxisReport> fleetTrends(const FleetStore& store, const TrendOpt
 // chunk cannot be read or the result not written.
 bool runFleetTask(const std::string& chunkPath, const std::string& resultPath, std::string* why);
 
+// The failures a run's JSON lists (the rest are counted in failures_not_listed).
+inline constexpr std::size_t kListedFailures = 1000;
+
 // JSON of a run: axes [{robot, axis, status, parameter, since, trend, days_to_threshold,
 // evidence, suggestion}], maintenance, analysed, skipped, failed, failures, seconds.
 nlohmann::json fleetRunJson(const FleetRunResult& r);

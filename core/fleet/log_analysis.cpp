@@ -3,8 +3,10 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <stdexcept>
 
+#include "core/session/json_fields.h"
 #include "core/diagnosis/diagnosis.h"
 #include "core/io/log_io.h"
 #include "core/session/model_json.h"
@@ -57,6 +59,49 @@ const FleetEstimate* FleetLogResult::estimate(const std::string& name) const {
   for (const auto& e : estimates)
     if (e.name == name) return &e;
   return nullptr;
+}
+
+namespace {
+
+bool isSha256(const std::string& s) {
+  return s.size() == 64 && s.find_first_not_of("0123456789abcdef") == std::string::npos;
+}
+
+std::string number(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%g", v);
+  return buf;
+}
+
+}  // namespace
+
+bool isValidFleetLogResult(const FleetLogResult& r, std::string* why) {
+  auto fail = [&](const std::string& s) {
+    if (why) *why = s;
+    return false;
+  };
+  if (!isSha256(r.sha256)) return fail("the log's checksum is not 64 hex digits");
+  if (!isSha256(r.referenceSha256)) return fail("the reference's checksum is not 64 hex digits");
+  // A verdict is none, model_mismatch, or one of the monitored parameters.
+  bool known = r.verdict == "none" || r.verdict == "model_mismatch";
+  for (const auto& e : r.estimates) known = known || (r.ok && e.name == r.verdict);
+  if (!known)
+    return fail("the verdict '" + r.verdict.substr(0, 40) + "' is not none, model_mismatch or a monitored parameter");
+  if (r.verdictTimeS && !(std::isfinite(*r.verdictTimeS) && *r.verdictTimeS >= 0.0))
+    return fail("the verdict's time " + number(*r.verdictTimeS) + " s is not a time in the log");
+  if (!(std::isfinite(r.seconds) && r.seconds >= 0.0)) return fail("the analysis time " + number(r.seconds) + " s is not a duration");
+  if (!r.ok) return true;
+  if (r.estimates.empty() || r.estimates.size() > 16) return fail("an analysed log needs 1 to 16 estimates");
+  for (const auto& e : r.estimates) {
+    if (e.name.empty() || e.name.size() > 32) return fail("an estimate has no name (or one longer than 32 characters)");
+    if (!std::isfinite(e.value) || std::fabs(e.value) > 1e12)
+      return fail("the estimate of " + e.name + " (" + number(e.value) + ") is not a finite value");
+    if (!std::isfinite(e.reference) || std::fabs(e.reference) > 1e12)
+      return fail("the reference value of " + e.name + " (" + number(e.reference) + ") is not a finite value");
+    if (!(std::isfinite(e.std) && e.std > 0.0))
+      return fail("the std of " + e.name + " (" + number(e.std) + ") is not a positive finite number");
+  }
+  return true;
 }
 
 DiagnosisReference fleetReference(const std::string& logPath, const FleetAnalysisOptions& options) {
@@ -154,6 +199,8 @@ FleetLogResult analyseFleetLog(const std::string& logPath, const DiagnosisRefere
     e.reference = p.toModel(d.theta0[i]);
     if (!std::isfinite(e.value) || !std::isfinite(e.std))
       return finish(logPath + ": the estimate of " + e.name + " is not finite");
+    if (!(e.std > 0.0))
+      return finish(logPath + ": the log does not determine " + e.name + " (its std is 0)");
     out.estimates.push_back(e);
   }
   out.verdict = d.verdictName();
@@ -195,7 +242,7 @@ std::optional<FleetLogResult> fleetLogResultFromJson(const json& j, std::string*
     r.seconds = j.at("seconds").get<double>();
     return r;
   } catch (const json::exception& e) {
-    return fail(std::string("a log result is malformed: ") + e.what());
+    return fail(std::string("a log result is malformed: ") + jsonErrorText(e));
   }
 }
 

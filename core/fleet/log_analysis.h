@@ -62,6 +62,12 @@ std::optional<DiagnosisReference> referenceFromJson(const nlohmann::json& j, std
 FleetLogResult analyseFleetLog(const std::string& logPath, const DiagnosisReference& reference,
                                const FleetAnalysisOptions& options);
 
+// Whether a result is one FlexArm could have written: checksums of 64 hex digits, a known
+// verdict (none, model_mismatch or one of its parameters), and for an analysed log every estimate named, finite, with a finite std > 0 (a std
+// of 0 would claim the log decided the value exactly). Checked on what a Slurm task sends
+// back, on what the store is given and on what it gives back; false with a sentence.
+bool isValidFleetLogResult(const FleetLogResult& r, std::string* why);
+
 nlohmann::json fleetLogResultJson(const FleetLogResult& r);
 std::optional<FleetLogResult> fleetLogResultFromJson(const nlohmann::json& j, std::string* why);
 

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <set>
@@ -54,6 +55,40 @@ bool readInt(std::string_view s, std::size_t digits, long& out) {
     out = out * 10 + (c - '0');
   }
   return true;
+}
+
+// A field as a message quotes it: at most 100 characters, control characters as '?'.
+std::string quote(std::string_view s) {
+  std::string out;
+  for (char c : s.substr(0, 100)) out += static_cast<unsigned char>(c) < 0x20 || c == 0x7f ? '?' : c;
+  return "'" + out + (s.size() > 100 ? "...' (" + std::to_string(s.size()) + " characters)" : "'");
+}
+
+bool hasControl(std::string_view s) {
+  for (unsigned char c : s)
+    if (c < 0x20 || c == 0x7f) return true;
+  return false;
+}
+
+// A decimal number, whole (no hex, no inf or nan, nothing after it).
+std::optional<double> decimal(std::string_view s) {
+  if (s.empty() || s.size() > 40 || s.find_first_not_of("0123456789+-.eE") != std::string_view::npos) return std::nullopt;
+  const std::string t(s);
+  char* end = nullptr;
+  const double v = std::strtod(t.c_str(), &end);
+  if (end != t.c_str() + t.size() || !std::isfinite(v)) return std::nullopt;
+  return v;
+}
+
+// Whether `inner`, links resolved, lies inside `folder`.
+bool insideFolder(const std::filesystem::path& inner, const std::filesystem::path& folder) {
+  std::error_code ec;
+  const auto f = std::filesystem::weakly_canonical(std::filesystem::absolute(folder.empty() ? "." : folder, ec), ec);
+  if (ec) return false;
+  const auto p = std::filesystem::weakly_canonical(std::filesystem::absolute(inner, ec), ec);
+  if (ec) return false;
+  const auto rel = p.lexically_relative(f);
+  return !rel.empty() && *rel.begin() != ".." && rel != ".";
 }
 
 }  // namespace
@@ -132,11 +167,17 @@ std::string isoFromDay(double day) {
 }
 
 std::optional<FleetManifest> parseFleetManifest(std::string_view text, const std::string& path,
-                                                ManifestError* error) {
+                                                ManifestError* error, const ManifestReadOptions& options) {
   auto fail = [&](int line, std::string column, std::string problem) -> std::optional<FleetManifest> {
     if (error) *error = {path, line, std::move(column), std::move(problem)};
     return std::nullopt;
   };
+  if (text.size() >= 2 && ((text[0] == '\xff' && text[1] == '\xfe') || (text[0] == '\xfe' && text[1] == '\xff')))
+    return fail(0, "", "is UTF-16 text; save the manifest as UTF-8 (plain text, as a spreadsheet's 'CSV UTF-8')");
+  if (text.rfind("\xef\xbb\xbf", 0) == 0) text.remove_prefix(3);  // a UTF-8 byte-order mark
+  if (const auto nul = text.find('\0'); nul != std::string_view::npos)
+    return fail(static_cast<int>(std::count(text.begin(), text.begin() + static_cast<long>(nul), '\n')) + 1, "",
+                "holds a NUL byte: not a text file (UTF-16, or binary data)");
   FleetManifest m;
   m.path = path;
   const std::filesystem::path folder = std::filesystem::path(path).parent_path();
@@ -157,8 +198,7 @@ std::optional<FleetManifest> parseFleetManifest(std::string_view text, const std
       if (body.rfind("flexarm-fleet:", 0) == 0) {
         const std::string_view v = trim(body.substr(14));
         if (v != "1")
-          return fail(lineNo, "", "manifest version '" + std::string(v) +
-                                      "' is not one this FlexArm reads (version 1)");
+          return fail(lineNo, "", "manifest version " + quote(v) + " is not one this FlexArm reads (version 1)");
         versioned = true;
       }
       continue;
@@ -173,7 +213,7 @@ std::optional<FleetManifest> parseFleetManifest(std::string_view text, const std
                   : name == "log" ? &iLog : name == "temperature_c" ? &iTemp : name == "role" ? &iRole
                   : nullptr;
         if (!slot)
-          return fail(lineNo, name, "unknown column (robot, axis, time, log, temperature_c, role)");
+          return fail(lineNo, name.size() <= 100 && !hasControl(name) ? name : quote(name), "unknown column (robot, axis, time, log, temperature_c, role)");
         if (*slot >= 0) return fail(lineNo, name, "the column appears twice");
         *slot = static_cast<int>(i);
         header.push_back(name);
@@ -182,42 +222,52 @@ std::optional<FleetManifest> parseFleetManifest(std::string_view text, const std
         if (slot < 0) return fail(lineNo, name, "the header lacks this column");
       continue;
     }
+    if (m.entries.size() >= options.maxRows)
+      return fail(lineNo, "", "more than " + std::to_string(options.maxRows) +
+                                  " rows, more than one run is allowed to take on; split the plant into several manifests "
+                                  "or raise the limit (--max-rows)");
     if (fields.size() != header.size())
       return fail(lineNo, "", std::to_string(fields.size()) + " fields, the header has " +
                                   std::to_string(header.size()));
     FleetEntry e;
     e.line = lineNo;
     e.robot = std::string(fields[static_cast<std::size_t>(iRobot)]);
-    if (e.robot.empty() || e.robot.find_first_of("/\\\"") != std::string::npos)
-      return fail(lineNo, "robot", "a robot needs a name without / \\ or \"");
+    if (e.robot.empty() || e.robot.size() > 64 || e.robot.find_first_of("/\\\"") != std::string::npos ||
+        hasControl(e.robot))
+      return fail(lineNo, "robot", quote(e.robot) + ": a robot needs a name of 1 to 64 characters without / \\ \" or control characters");
     {
       const std::string a(fields[static_cast<std::size_t>(iAxis)]);
-      char extra = 0;
-      if (std::sscanf(a.c_str(), "%d%c", &e.axis, &extra) != 1 || e.axis < 1 || e.axis > 64)
-        return fail(lineNo, "axis", "'" + a + "' is not an axis number from 1 to 64");
+      if (a.empty() || a.size() > 2 || a.find_first_not_of("0123456789") != std::string::npos ||
+          (e.axis = std::stoi(a)) < 1 || e.axis > 64)
+        return fail(lineNo, "axis", quote(a) + " is not an axis number from 1 to 64");
     }
     e.time = std::string(fields[static_cast<std::size_t>(iTime)]);
     const auto day = parseIsoDay(e.time);
-    if (!day) return fail(lineNo, "time", "'" + e.time + "' is not an ISO 8601 UTC time (2026-03-01T06:00:00Z)");
+    if (!day) return fail(lineNo, "time", quote(e.time) + " is not an ISO 8601 UTC time (2026-03-01T06:00:00Z)");
     e.day = *day;
     e.log = std::string(fields[static_cast<std::size_t>(iLog)]);
     if (e.log.empty()) return fail(lineNo, "log", "the log's path is empty");
+    if (hasControl(e.log)) return fail(lineNo, "log", quote(e.log) + ": a path with control characters");
     const std::filesystem::path lp(e.log);
     e.path = lp.is_absolute() || folder.empty() ? e.log : (folder / lp).string();
+    if (!options.allowLogsOutside && !insideFolder(e.path, folder))
+      return fail(lineNo, "log", quote(e.log) + " lies outside the manifest's folder " +
+                                     quote(folder.empty() ? "." : folder.string()) +
+                                     " (links resolved); FlexArm reads only the logs beside their manifest unless "
+                                     "told otherwise (--allow-logs-outside)");
     if (iTemp >= 0) {
       const std::string t(fields[static_cast<std::size_t>(iTemp)]);
       if (!t.empty()) {
-        double v = 0.0;
-        char extra = 0;
-        if (std::sscanf(t.c_str(), "%lf%c", &v, &extra) != 1 || !std::isfinite(v) || v < -100.0 || v > 300.0)
-          return fail(lineNo, "temperature_c", "'" + t + "' is not a temperature in degC (-100 to 300)");
-        e.temperatureC = v;
+        const auto v = decimal(t);
+        if (!v || *v < -100.0 || *v > 300.0)
+          return fail(lineNo, "temperature_c", quote(t) + " is not a temperature in degC (-100 to 300)");
+        e.temperatureC = *v;
       }
     }
     if (iRole >= 0) {
       const std::string_view r = fields[static_cast<std::size_t>(iRole)];
       if (r == "reference") e.reference = true;
-      else if (!r.empty()) return fail(lineNo, "role", "'" + std::string(r) + "' is not a role (reference, or empty)");
+      else if (!r.empty()) return fail(lineNo, "role", quote(r) + " is not a role (reference, or empty)");
     }
     if (!seen.insert({e.robot, e.axis, e.time}).second)
       return fail(lineNo, "time", "robot " + e.robot + " axis " + std::to_string(e.axis) +
@@ -252,7 +302,8 @@ std::optional<FleetManifest> parseFleetManifest(std::string_view text, const std
   return m;
 }
 
-std::optional<FleetManifest> readFleetManifest(const std::string& path, ManifestError* error) {
+std::optional<FleetManifest> readFleetManifest(const std::string& path, ManifestError* error,
+                                               const ManifestReadOptions& options) {
   std::error_code ec;
   const auto status = std::filesystem::status(path, ec);
   auto fail = [&](const std::string& problem) -> std::optional<FleetManifest> {
@@ -269,7 +320,7 @@ std::optional<FleetManifest> readFleetManifest(const std::string& path, Manifest
   std::string text(static_cast<std::size_t>(size), '\0');
   f.read(text.data(), static_cast<std::streamsize>(size));
   if (static_cast<std::uintmax_t>(f.gcount()) != size) return fail("could not be read whole");
-  return parseFleetManifest(text, path, error);
+  return parseFleetManifest(text, path, error, options);
 }
 
 std::string fleetManifestText(const std::vector<FleetEntry>& entries) {

@@ -7,7 +7,8 @@
 //     R01,1,2026-03-01T06:00:00Z,R01/ax1/2026-03-01.csv,24.5,reference
 //     R01,1,2026-03-02T06:00:00Z,R01/ax1/2026-03-02.csv,31.0,
 //
-// Paths are relative to the manifest (absolute ones are kept), times are UTC in ISO 8601
+// Paths are relative to the manifest (absolute ones are kept; a log must lie inside the
+// manifest's folder unless ManifestReadOptions::allowLogsOutside), times are UTC in ISO 8601
 // (seconds optional, "Z" or no zone), the temperature (degC) may be empty, and role
 // "reference" marks an axis' healthy reference; without one, the axis' earliest log is. The
 // columns may come in any order; temperature_c and role may be left out.
@@ -56,14 +57,25 @@ struct ManifestError {
   std::string toString() const;
 };
 
+struct ManifestReadOptions {
+  // A log must lie inside the manifest's folder (after links are resolved): a row naming
+  // /etc/passwd or ../../x is refused before anything is read. True lets logs lie anywhere.
+  bool allowLogsOutside = false;
+  // The most rows a manifest may have (a plant of 100 robots x 6 axes x a year is 219 000).
+  std::size_t maxRows = 500000;
+};
+
 // Reads a manifest file (at most 1 GiB); nullopt with the error naming file, line, column and
 // problem for a missing version line, unknown or missing columns, a malformed field, the same
-// robot, axis and time twice, or two references for one axis.
-std::optional<FleetManifest> readFleetManifest(const std::string& path, ManifestError* error);
+// robot, axis and time twice, two references for one axis, a log outside the manifest's
+// folder, more rows than the budget, or text that is not UTF-8 (a UTF-8 byte-order mark is
+// accepted; UTF-16 is named).
+std::optional<FleetManifest> readFleetManifest(const std::string& path, ManifestError* error,
+                                               const ManifestReadOptions& options = {});
 // The same on text in memory; `path` names it in messages and relative logs resolve against
 // its folder.
 std::optional<FleetManifest> parseFleetManifest(std::string_view text, const std::string& path,
-                                                ManifestError* error);
+                                                ManifestError* error, const ManifestReadOptions& options = {});
 
 // "2026-03-01T06:00:00Z" -> days since the epoch; nullopt when malformed.
 std::optional<double> parseIsoDay(std::string_view text);

@@ -10,10 +10,13 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <map>
+#include <optional>
 #include <poll.h>
 #include <set>
 #include <spawn.h>
 #include <sstream>
+#include <sys/stat.h>
 #include <sys/wait.h>
 #include <thread>
 #include <unistd.h>
@@ -102,6 +105,51 @@ std::string tail(const std::string& path, std::size_t bytes) {
   return text.empty() ? "no output" : text;
 }
 
+bool hasControlCharacter(const std::string& s) {
+  for (unsigned char c : s)
+    if (c < 0x20 || c == 0x7f) return true;
+  return false;
+}
+
+// Makes dir (mode 0700), or accepts it when it is already a folder of this user and not a
+// link; exclusive: it must not exist yet. Nothing is followed: a link planted at the name
+// would send the chunks and job.sh (which the nodes run) into its target.
+bool makeOwnFolder(const std::string& dir, bool exclusive, std::string* why) {
+  if (::mkdir(dir.c_str(), 0700) == 0) return true;
+  if (errno != EEXIST) {
+    if (why) *why = "cannot make the Slurm folder " + dir + ": " + std::strerror(errno);
+    return false;
+  }
+  struct stat st {};
+  if (::lstat(dir.c_str(), &st) != 0 || S_ISLNK(st.st_mode)) {
+    if (why) *why = "the Slurm folder " + dir + " is a symbolic link; FlexArm makes this folder itself and does not follow a link";
+    return false;
+  }
+  if (!S_ISDIR(st.st_mode)) {
+    if (why) *why = "the Slurm folder " + dir + " exists and is not a folder";
+    return false;
+  }
+  if (st.st_uid != ::geteuid()) {
+    if (why) *why = "the Slurm folder " + dir + " belongs to another user; FlexArm writes only into its own";
+    return false;
+  }
+  if (exclusive) {
+    if (why) *why = "the Slurm folder " + dir + " exists already (another run's?); FlexArm starts each in a new one";
+    return false;
+  }
+  return true;
+}
+
+// The text a scheduler command printed, cut to one readable line.
+std::string schedulerSays(const CommandResult& r) {
+  std::string s = r.output;
+  for (char& c : s)
+    if (c == '\n' || c == '\r' || c == '\t') c = ' ';
+  while (!s.empty() && s.back() == ' ') s.pop_back();
+  if (s.size() > 300) s = s.substr(0, 300) + "...";
+  return s.empty() ? "no output" : s;
+}
+
 }  // namespace
 
 bool runOnSlurm(const WorkChunk& work, const SlurmOptions& o, const std::string& runDir, const Sinks& sinks,
@@ -112,9 +160,21 @@ bool runOnSlurm(const WorkChunk& work, const SlurmOptions& o, const std::string&
   };
   if (work.size() == 0) return true;
   std::error_code ec;
-  fs::create_directories(runDir, ec);
-  if (ec) return fail("cannot make the Slurm run folder " + runDir + ": " + ec.message());
-  const std::string dir = fs::absolute(runDir).string();
+  const std::string dir = fs::absolute(runDir, ec).lexically_normal().string();
+  if (ec || dir.empty()) return fail("cannot resolve the Slurm folder " + runDir);
+  // The folder's name goes into job.sh: a line break there would add #SBATCH directives.
+  if (hasControlCharacter(dir))
+    return fail("the Slurm folder's name holds a line break or another control character; give --slurm-dir a plain path");
+  // runDir is BASE/run-N/PART: BASE (--slurm-dir, or STORE.slurm) and run-N are made or
+  // reused when they are this user's own folders, PART is always new.
+  {
+    const fs::path part(dir), run = part.parent_path(), base = run.parent_path();
+    if (!base.parent_path().empty()) fs::create_directories(base.parent_path(), ec);
+    std::string e;
+    if (!makeOwnFolder(base.string(), false, &e) || !makeOwnFolder(run.string(), false, &e) ||
+        !makeOwnFolder(part.string(), true, &e))
+      return fail(e);
+  }
 
   // Chunks: many items a task (fits take longer than logs: a quarter as many).
   std::vector<WorkChunk> chunks;
@@ -163,15 +223,18 @@ bool runOnSlurm(const WorkChunk& work, const SlurmOptions& o, const std::string&
   const auto submitted = runCommand(submit, 120.0, &err);
   if (!submitted) return fail(err);
   if (submitted->status != 0)
-    return fail("sbatch refused the job array (" + (submitted->timedOut ? std::string("no answer in 120 s") : submitted->output) +
+    return fail("sbatch refused the job array (" + (submitted->timedOut ? std::string("no answer in 120 s") : schedulerSays(*submitted)) +
                 "); is Slurm running, and can this user submit?");
   std::string jobId = submitted->output.substr(0, submitted->output.find_first_of(";\n"));
   jobId.erase(0, jobId.find_first_not_of(" \t"));
   if (jobId.empty() || jobId.find_first_not_of("0123456789") != std::string::npos)
-    return fail("sbatch gave no job id: " + submitted->output);
+    return fail("sbatch gave no job id: " + schedulerSays(*submitted));
 
   std::set<std::size_t> merged;
   bool stopped = false;
+  // A task's result is checked before anything of it is merged: its format, every id one of
+  // the chunk's own (once), every value as FlexArm writes it. An item whose result is bad is
+  // reported with the reason and the rest of the chunk merged.
   auto merge = [&](std::size_t k) {
     const std::string path = dir + "/result-" + std::to_string(k) + ".json";
     if (!fs::exists(path, ec)) return false;
@@ -183,32 +246,67 @@ bool runOnSlurm(const WorkChunk& work, const SlurmOptions& o, const std::string&
       return false;  // not complete yet (results are renamed into place, so rarely)
     }
     merged.insert(k);
-    std::set<std::size_t> seenFits, seenLogs;
-    for (const auto& r : j.value("fits", json::array())) {
-      ReferenceOutcome out;
-      out.id = r.at("id").get<std::size_t>();
-      out.ok = r.at("ok").get<bool>();
-      out.message = r.at("message").get<std::string>();
-      if (out.ok) out.json = r.at("reference").dump();
-      seenFits.insert(out.id);
-      if (!stopped && !sinks.reference(out)) stopped = true;
+    const std::string task = "the Slurm task " + jobId + "_" + std::to_string(k);
+    if (!j.is_object() || j.value("format", json()) != "flexarm-fleet-result" || j.value("version", json()) != 1) {
+      for (const auto& x : chunks[k].fits) sinks.lost(x.id, true, task + " wrote a file that is not a FlexArm task result");
+      for (const auto& x : chunks[k].logs) sinks.lost(x.id, false, task + " wrote a file that is not a FlexArm task result");
+      return true;
     }
-    for (const auto& r : j.value("logs", json::array())) {
+    std::map<std::size_t, const ReferenceJob*> fitJobs;
+    std::map<std::size_t, const LogJob*> logJobs;
+    for (const auto& x : chunks[k].fits) fitJobs[x.id] = &x;
+    for (const auto& x : chunks[k].logs) logJobs[x.id] = &x;
+    std::set<std::size_t> seenFits, seenLogs;
+    auto idOf = [](const json& r) -> std::optional<std::size_t> {
+      if (!r.is_object() || !r.contains("id") || !r.at("id").is_number_unsigned()) return std::nullopt;
+      return r.at("id").get<std::size_t>();
+    };
+    const json fits = j.value("fits", json::array()), logs = j.value("logs", json::array());
+    for (const auto& r : fits.is_array() ? fits : json::array()) {
+      const auto id = idOf(r);
+      if (!id || !fitJobs.count(*id) || seenFits.count(*id)) continue;  // not one of the chunk's: ignored
+      seenFits.insert(*id);
+      ReferenceOutcome out;
+      out.id = *id;
+      std::string bad;
+      try {
+        out.ok = r.at("ok").get<bool>();
+        out.message = r.at("message").get<std::string>().substr(0, 4096);
+        if (out.ok) {
+          std::string e;
+          if (!referenceFromJson(r.at("reference"), &e)) bad = "its reference is unusable: " + e;
+          out.json = r.at("reference").dump();
+        }
+      } catch (const json::exception&) {
+        bad = "its fields are malformed";
+      }
+      if (!bad.empty()) sinks.lost(*id, true, task + "'s result for it is invalid: " + bad);
+      else if (!stopped && !sinks.reference(out)) stopped = true;
+    }
+    for (const auto& r : logs.is_array() ? logs : json::array()) {
+      const auto id = idOf(r);
+      if (!id || !logJobs.count(*id) || seenLogs.count(*id)) continue;
+      seenLogs.insert(*id);
       std::string e;
       auto result = fleetLogResultFromJson(r, &e);
-      const std::size_t id = r.at("id").get<std::size_t>();
-      seenLogs.insert(id);
-      if (!result) sinks.lost(id, false, e);
-      else if (!stopped && !sinks.log(id, std::move(*result))) stopped = true;
+      if (result && result->referenceSha256 != logJobs.at(*id)->referenceSha256) {
+        e = "it names another reference";
+        result.reset();
+      }
+      if (result && !isValidFleetLogResult(*result, &e)) result.reset();
+      if (result) result->message = result->message.substr(0, 4096);
+      if (!result) sinks.lost(*id, false, task + "'s result for it is invalid: " + e);
+      else if (!stopped && !sinks.log(*id, std::move(*result))) stopped = true;
     }
     for (const auto& x : chunks[k].fits)
-      if (!seenFits.count(x.id)) sinks.lost(x.id, true, "the Slurm task's result lacks it");
+      if (!seenFits.count(x.id)) sinks.lost(x.id, true, task + "'s result lacks it");
     for (const auto& x : chunks[k].logs)
-      if (!seenLogs.count(x.id)) sinks.lost(x.id, false, "the Slurm task's result lacks it");
+      if (!seenLogs.count(x.id)) sinks.lost(x.id, false, task + "'s result lacks it");
     return true;
   };
   const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(o.timeoutS);
-  std::string ending;
+  std::string ending, schedulerError;
+  int failedPolls = 0;
   while (true) {
     for (std::size_t k = 0; k < chunks.size(); ++k)
       if (!merged.count(k)) merge(k);
@@ -225,6 +323,18 @@ bool runOnSlurm(const WorkChunk& work, const SlurmOptions& o, const std::string&
     const bool gone = queued && !queued->timedOut &&
                       ((queued->status == 0 && queued->output.find_first_not_of(" \n") == std::string::npos) ||
                        queued->output.find("Invalid job id") != std::string::npos);
+    // A scheduler that cannot answer ends the wait with its own words (three failures in a
+    // row: one may be a controller restarting), not after the whole timeout.
+    const bool answered = queued && !queued->timedOut && (queued->status == 0 || gone);
+    failedPolls = answered ? 0 : failedPolls + 1;
+    if (failedPolls >= 3) {
+      schedulerError = !queued ? err
+                       : queued->timedOut ? o.squeue + " gave no answer in 30 s"
+                                          : o.squeue + " failed (exit " + std::to_string(queued->status) + "): " +
+                                                schedulerSays(*queued);
+      ending = "the scheduler could not say whether job " + jobId + " runs: " + schedulerError;
+      break;
+    }
     if (gone) {
       for (std::size_t k = 0; k < chunks.size(); ++k)
         if (!merged.count(k)) merge(k);
@@ -242,6 +352,7 @@ bool runOnSlurm(const WorkChunk& work, const SlurmOptions& o, const std::string&
     for (const auto& x : chunks[k].fits) sinks.lost(x.id, true, reason);
     for (const auto& x : chunks[k].logs) sinks.lost(x.id, false, reason);
   }
+  if (!schedulerError.empty()) return fail("the scheduler could not say whether job " + jobId + " runs: " + schedulerError);
   return true;
 }
 

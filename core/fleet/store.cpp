@@ -5,6 +5,7 @@
 #include "core/session/provenance.h"
 
 #include <cerrno>
+#include <cmath>
 #include <cstring>
 #include <fcntl.h>
 #include <filesystem>
@@ -42,45 +43,147 @@ CREATE TABLE IF NOT EXISTS runs(
   manifest TEXT NOT NULL, analysed INTEGER, skipped INTEGER, failed INTEGER, seconds REAL);
 )sql";
 
-// A prepared statement, finalised when it goes out of scope.
+// A prepared statement, finalised when it goes out of scope. A statement that failed to
+// prepare (a table another program changed) does nothing: step() says SQLITE_ERROR and the
+// columns read as empty, so a caller that checks step() never touches a null handle.
 class Statement {
  public:
-  Statement(sqlite3* db, const char* sql) { ok_ = sqlite3_prepare_v2(db, sql, -1, &s_, nullptr) == SQLITE_OK; }
+  // sink, when given, receives the first error (a failed prepare or step) as a sentence.
+  Statement(sqlite3* db, const char* sql, std::string* sink = nullptr) : db_(db), sink_(sink) {
+    ok_ = sqlite3_prepare_v2(db, sql, -1, &s_, nullptr) == SQLITE_OK && s_;
+    if (!ok_) note();
+  }
   ~Statement() { sqlite3_finalize(s_); }
   Statement(const Statement&) = delete;
   Statement& operator=(const Statement&) = delete;
   bool ok() const { return ok_; }
-  void bind(int i, const std::string& v) { sqlite3_bind_text(s_, i, v.data(), static_cast<int>(v.size()), SQLITE_TRANSIENT); }
-  void bind(int i, double v) { sqlite3_bind_double(s_, i, v); }
-  void bind(int i, int v) { sqlite3_bind_int(s_, i, v); }
-  void bind(int i, long v) { sqlite3_bind_int64(s_, i, v); }
+  void bind(int i, const std::string& v) {
+    if (ok_) sqlite3_bind_text(s_, i, v.data(), static_cast<int>(v.size()), SQLITE_TRANSIENT);
+  }
+  void bind(int i, double v) {
+    if (ok_) sqlite3_bind_double(s_, i, v);
+  }
+  void bind(int i, int v) {
+    if (ok_) sqlite3_bind_int(s_, i, v);
+  }
+  void bind(int i, long v) {
+    if (ok_) sqlite3_bind_int64(s_, i, v);
+  }
   void bind(int i, const std::optional<double>& v) {
+    if (!ok_) return;
     if (v) sqlite3_bind_double(s_, i, *v);
     else sqlite3_bind_null(s_, i);
   }
-  int step() { return sqlite3_step(s_); }
+  int step() {
+    if (!ok_) return SQLITE_ERROR;
+    const int rc = sqlite3_step(s_);
+    if (rc != SQLITE_ROW && rc != SQLITE_DONE) note();
+    return rc;
+  }
   void reset() {
+    if (!ok_) return;
     sqlite3_reset(s_);
     sqlite3_clear_bindings(s_);
   }
   std::string text(int c) const {
-    const auto* p = sqlite3_column_text(s_, c);
+    const auto* p = ok_ ? sqlite3_column_text(s_, c) : nullptr;
     return p ? std::string(reinterpret_cast<const char*>(p), static_cast<std::size_t>(sqlite3_column_bytes(s_, c)))
              : std::string();
   }
-  double real(int c) const { return sqlite3_column_double(s_, c); }
-  long integer(int c) const { return static_cast<long>(sqlite3_column_int64(s_, c)); }
+  double real(int c) const { return ok_ ? sqlite3_column_double(s_, c) : 0.0; }
+  long integer(int c) const { return ok_ ? static_cast<long>(sqlite3_column_int64(s_, c)) : 0; }
   std::optional<double> optionalReal(int c) const {
-    if (sqlite3_column_type(s_, c) == SQLITE_NULL) return std::nullopt;
+    if (!ok_ || sqlite3_column_type(s_, c) == SQLITE_NULL) return std::nullopt;
     return sqlite3_column_double(s_, c);
   }
 
  private:
+  void note() {
+    if (sink_ && sink_->empty()) *sink_ = std::string("SQLite says: ") + sqlite3_errmsg(db_);
+  }
+  sqlite3* db_ = nullptr;
+  std::string* sink_ = nullptr;
   sqlite3_stmt* s_ = nullptr;
   bool ok_ = false;
 };
 
+// The tables FlexArm writes and their columns, in order: a store holding anything else (a
+// view, a trigger, a table of other columns) was changed by another program and is refused
+// before any of it runs.
+const std::vector<std::pair<std::string, std::vector<std::string>>>& expectedTables() {
+  static const std::vector<std::pair<std::string, std::vector<std::string>>> t = {
+      {"meta", {"key", "value"}},
+      {"axes", {"robot", "axis", "reference_sha256", "reference_log", "reference_temperature_c", "reference_json"}},
+      {"logs", {"sha256", "reference_sha256", "robot", "axis", "time", "day", "path", "temperature_c", "role", "ok",
+                "message", "verdict", "verdict_time_s", "seconds", "run"}},
+      {"estimates", {"sha256", "reference_sha256", "parameter", "value", "std", "reference", "position"}},
+      {"files", {"path", "size", "mtime_ns", "inode", "sha256"}},
+      {"runs", {"id", "started", "finished", "engine", "manifest", "analysed", "skipped", "failed", "seconds"}}};
+  return t;
+}
+
+std::string shortName(const std::string& s) {
+  std::string out;
+  for (char c : s.substr(0, 60)) out += (static_cast<unsigned char>(c) < 0x20) ? '?' : c;
+  return s.size() > 60 ? out + "..." : out;
+}
+
+// Empty when the store's schema is the one FlexArm writes; else what differs.
+std::string schemaProblem(sqlite3* db) {
+  Statement objects(db, "SELECT type, name, tbl_name, coalesce(sql, '') FROM sqlite_master ORDER BY rowid");
+  if (!objects.ok()) return "its schema cannot be read";
+  const auto& tables = expectedTables();
+  auto known = [&](const std::string& name) {
+    for (const auto& [t, columns] : tables)
+      if (t == name) return true;
+    return false;
+  };
+  std::vector<std::string> present;
+  int rc;
+  while ((rc = objects.step()) == SQLITE_ROW) {
+    const std::string type = objects.text(0), name = objects.text(1), table = objects.text(2), sql = objects.text(3);
+    if (type == "table" && known(name) && sql.rfind("CREATE TABLE", 0) == 0) {
+      present.push_back(name);
+      continue;
+    }
+    if (type == "index" && known(table) && (name == "logs_axis" || name.rfind("sqlite_autoindex_" + table, 0) == 0))
+      continue;
+    return "it holds " + type + " '" + shortName(name) + "', which FlexArm does not write (another program changed it)";
+  }
+  if (rc != SQLITE_DONE) return std::string("its schema cannot be read (SQLite says: ") + sqlite3_errmsg(db) + ")";
+  for (const auto& name : present) {
+    std::vector<std::string> columns;
+    Statement info(db, "SELECT name FROM pragma_table_info(?) ORDER BY cid");
+    info.bind(1, name);
+    while (info.step() == SQLITE_ROW) columns.push_back(info.text(0));
+    for (const auto& [t, expected] : tables)
+      if (t == name && columns != expected)
+        return "its table '" + name + "' has other columns than FlexArm writes (another program changed it)";
+  }
+  return {};
+}
+
 std::string errorOf(sqlite3* db) { return db ? sqlite3_errmsg(db) : "out of memory"; }
+
+// Why a store could not be read, by SQLite's error code: a full disk or a locked file is not
+// "not a store".
+std::string readProblem(sqlite3* db) {
+  const int code = db ? (sqlite3_errcode(db) & 0xff) : SQLITE_NOMEM;
+  switch (code) {
+    case SQLITE_NOTADB:
+    case SQLITE_CORRUPT:
+      return "not a FlexArm fleet store (SQLite says: " + errorOf(db) + ")";
+    case SQLITE_FULL:
+      return "the disk holding it is full (SQLite says: " + errorOf(db) + ")";
+    case SQLITE_BUSY:
+    case SQLITE_LOCKED:
+      return "another program holds it locked (SQLite says: " + errorOf(db) + ")";
+    case SQLITE_NOMEM:
+      return "out of memory while opening it";
+    default:
+      return "cannot be read (SQLite says: " + errorOf(db) + ")";
+  }
+}
 
 }  // namespace
 
@@ -107,45 +210,78 @@ std::unique_ptr<FleetStore> FleetStore::open(const std::string& path, bool writa
     if (store->lockFd_ < 0) return fail("cannot create the writer lock " + lock + ": " + std::strerror(errno));
     if (::flock(store->lockFd_, LOCK_EX | LOCK_NB) != 0)
       return fail("another flexarm fleet is writing to this store (it holds " + lock + "); one writer at a time");
+    // The lock by name misses the same file reached by another name (a hard link): the store
+    // file itself is locked too (flock, apart from SQLite's own POSIX locks), for the run.
+    store->fileFd_ = ::open(path.c_str(), O_RDWR | O_CREAT | O_NOFOLLOW | O_CLOEXEC, 0644);
+    if (store->fileFd_ < 0) return fail(std::string("cannot open the store: ") + std::strerror(errno));
+    if (::flock(store->fileFd_, LOCK_EX | LOCK_NB) != 0)
+      return fail("another flexarm fleet is writing to this store under another name (a link to the same file); "
+                  "one writer at a time");
   }
   const int flags =
       writable ? (SQLITE_OPEN_READWRITE | SQLITE_OPEN_CREATE | SQLITE_OPEN_NOFOLLOW) : SQLITE_OPEN_READONLY;
   if (sqlite3_open_v2(path.c_str(), &store->db_, flags | SQLITE_OPEN_NOMUTEX, nullptr) != SQLITE_OK)
     return fail("cannot open the store: " + errorOf(store->db_));
+  // Nothing another program planted runs inside FlexArm: no triggers, no views, no functions
+  // of the schema, and no writes to SQLite's own tables.
+  sqlite3_db_config(store->db_, SQLITE_DBCONFIG_ENABLE_TRIGGER, 0, nullptr);
+  sqlite3_db_config(store->db_, SQLITE_DBCONFIG_ENABLE_VIEW, 0, nullptr);
+  sqlite3_db_config(store->db_, SQLITE_DBCONFIG_TRUSTED_SCHEMA, 0, nullptr);
+  sqlite3_db_config(store->db_, SQLITE_DBCONFIG_DEFENSIVE, 1, nullptr);
   sqlite3_busy_timeout(store->db_, 10000);
   std::string err;
   // Is it a FlexArm store (or a new file)?
   {
     Statement tables(store->db_, "SELECT count(*) FROM sqlite_master");
-    if (!tables.ok() || tables.step() != SQLITE_ROW)
-      return fail("not a FlexArm fleet store (SQLite says: " + errorOf(store->db_) + ")");
+    if (!tables.ok() || tables.step() != SQLITE_ROW) return fail(readProblem(store->db_));
     const long count = tables.integer(0);
     if (count > 0) {
       Statement v(store->db_, "SELECT value FROM meta WHERE key = 'schema_version'");
       if (!v.ok() || v.step() != SQLITE_ROW) return fail("not a FlexArm fleet store (no schema version)");
       const std::string version = v.text(0);
       if (version != std::to_string(kFleetSchemaVersion))
-        return fail("store schema version " + version + ", this FlexArm reads version " +
+        return fail("store schema version " + shortName(version) + ", this FlexArm reads version " +
                     std::to_string(kFleetSchemaVersion));
+      if (const std::string problem = schemaProblem(store->db_); !problem.empty())
+        return fail("not a FlexArm fleet store as FlexArm wrote it: " + problem + "; FlexArm does not use it");
     } else if (!writable) {
       return fail("an empty file, not a FlexArm fleet store");
     }
   }
   if (writable) {
+    // A writer that did not close cleanly (killed, the machine down) leaves writer_open set:
+    // the next writer checks the whole file before adding to it.
+    if (store->meta("writer_open") == std::optional<std::string>("1")) {
+      Statement check(store->db_, "PRAGMA integrity_check(5)");
+      std::string verdict;
+      while (check.step() == SQLITE_ROW) verdict += (verdict.empty() ? "" : "; ") + check.text(0);
+      if (verdict != "ok")
+        return fail("the store is damaged (SQLite's integrity check: " + shortName(verdict.empty() ? readProblem(store->db_) : verdict) +
+                    "); restore it from a copy or start another store");
+    }
     if (!store->exec("PRAGMA journal_mode=WAL", &err) || !store->exec("PRAGMA synchronous=NORMAL", &err) ||
         !store->exec("BEGIN IMMEDIATE", &err) || !store->exec(kSchema, &err) ||
         !store->exec("INSERT OR IGNORE INTO meta(key, value) VALUES('schema_version', '" +
                          std::to_string(kFleetSchemaVersion) + "')", &err) ||
         !store->exec("INSERT OR IGNORE INTO meta(key, value) VALUES('created', '" + utcNow() + "')", &err) ||
+        !store->exec("INSERT OR REPLACE INTO meta(key, value) VALUES('writer_open', '1')", &err) ||
         !store->exec("COMMIT", &err))
       return fail("cannot prepare the store: " + err);
+    store->writerOpen_ = true;
   }
   return store;
 }
 
 FleetStore::~FleetStore() {
+  if (db_ && writerOpen_) exec("INSERT OR REPLACE INTO meta(key, value) VALUES('writer_open', '0')", nullptr);
   if (db_) sqlite3_close_v2(db_);
+  if (fileFd_ >= 0) ::close(fileFd_);
   if (lockFd_ >= 0) ::close(lockFd_);  // releases the writer lock
+}
+
+std::optional<std::string> FleetStore::readError() const {
+  if (readError_.empty()) return std::nullopt;
+  return path_ + ": the store could not be read whole (" + readError_ + "); it may be damaged";
 }
 
 bool FleetStore::exec(const std::string& sql, std::string* why) const {
@@ -202,7 +338,7 @@ constexpr const char* kAxisColumns =
 }  // namespace
 
 std::optional<StoredAxis> FleetStore::axis(const std::string& robot, int axis) const {
-  Statement s(db_, (std::string(kAxisColumns) + " WHERE robot = ? AND axis = ?").c_str());
+  Statement s(db_, (std::string(kAxisColumns) + " WHERE robot = ? AND axis = ?").c_str(), &readError_);
   if (!s.ok()) return std::nullopt;
   s.bind(1, robot);
   s.bind(2, axis);
@@ -212,7 +348,7 @@ std::optional<StoredAxis> FleetStore::axis(const std::string& robot, int axis) c
 
 std::vector<StoredAxis> FleetStore::axes() const {
   std::vector<StoredAxis> out;
-  Statement s(db_, (std::string(kAxisColumns) + " ORDER BY robot, axis").c_str());
+  Statement s(db_, (std::string(kAxisColumns) + " ORDER BY robot, axis").c_str(), &readError_);
   while (s.ok() && s.step() == SQLITE_ROW) out.push_back(axisRow(s));
   return out;
 }
@@ -234,13 +370,19 @@ bool FleetStore::putAxis(const StoredAxis& a, std::string* why) {
 
 std::set<std::pair<std::string, std::string>> FleetStore::storedKeys() const {
   std::set<std::pair<std::string, std::string>> out;
-  Statement s(db_, "SELECT sha256, reference_sha256 FROM logs");
+  Statement s(db_, "SELECT sha256, reference_sha256 FROM logs", &readError_);
   while (s.ok() && s.step() == SQLITE_ROW) out.emplace(s.text(0), s.text(1));
   return out;
 }
 
 bool FleetStore::putLogs(const std::vector<StoredLog>& logs, long runId, std::string* why) {
   std::string err;
+  for (const auto& l : logs) {
+    if (!isValidFleetLogResult(l.result, &err) || !(std::isfinite(l.day) && std::fabs(l.day) < 1e7)) {
+      if (why) *why = "refused to store the result of " + shortName(l.path) + ": " + (err.empty() ? "its day is not a date" : err);
+      return false;
+    }
+  }
   if (!exec("BEGIN IMMEDIATE", &err)) {
     if (why) *why = "cannot write to the store: " + err;
     return false;
@@ -310,7 +452,7 @@ std::vector<StoredLog> FleetStore::logs(const std::string& robot, int axis,
   sql += " ORDER BY robot, axis, day, sha256";
   std::vector<StoredLog> out;
   {
-    Statement s(db_, sql.c_str());
+    Statement s(db_, sql.c_str(), &readError_);
     if (!robot.empty()) {
       s.bind(1, robot);
       s.bind(2, axis);
@@ -337,13 +479,24 @@ std::vector<StoredLog> FleetStore::logs(const std::string& robot, int axis,
   }
   Statement e(db_,
               "SELECT parameter, value, std, reference FROM estimates WHERE sha256 = ? AND "
-              "reference_sha256 = ? ORDER BY position");
+              "reference_sha256 = ? ORDER BY position",
+              &readError_);
   for (auto& l : out) {
     e.bind(1, l.result.sha256);
     e.bind(2, l.result.referenceSha256);
     while (e.ok() && e.step() == SQLITE_ROW)
       l.result.estimates.push_back({e.text(0), e.real(1), e.real(2), e.real(3)});
     e.reset();
+    // What comes back is checked as what goes in: a row another program changed is shown as
+    // a failure with the reason, never trended.
+    std::string bad;
+    if (l.result.ok && !isValidFleetLogResult(l.result, &bad)) {
+      l.result.ok = false;
+      l.result.message = "the store's row for this log is not one FlexArm wrote (" + bad + "); it is not trended";
+    } else if (!(std::isfinite(l.day) && std::fabs(l.day) < 1e7)) {
+      l.result.ok = false;
+      l.result.message = "the store's row for this log has no valid day; it is not trended";
+    }
   }
   return out;
 }
@@ -389,7 +542,7 @@ bool FleetStore::putSha256(const std::vector<std::pair<std::string, std::pair<Fi
 }
 
 std::size_t FleetStore::logCount() const {
-  Statement s(db_, "SELECT count(*) FROM logs");
+  Statement s(db_, "SELECT count(*) FROM logs", &readError_);
   return s.ok() && s.step() == SQLITE_ROW ? static_cast<std::size_t>(s.integer(0)) : 0;
 }
 
@@ -424,7 +577,8 @@ std::vector<StoredRun> FleetStore::runs() const {
   std::vector<StoredRun> out;
   Statement s(db_,
               "SELECT id, started, coalesce(finished, ''), engine, manifest, coalesce(analysed, 0), "
-              "coalesce(skipped, 0), coalesce(failed, 0), coalesce(seconds, 0) FROM runs ORDER BY id");
+              "coalesce(skipped, 0), coalesce(failed, 0), coalesce(seconds, 0) FROM runs ORDER BY id",
+              &readError_);
   while (s.ok() && s.step() == SQLITE_ROW) {
     StoredRun r;
     r.id = s.integer(0);

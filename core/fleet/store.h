@@ -2,7 +2,7 @@
 // The fleet's store: an SQLite file with every analysed log (by the SHA-256 of its bytes and
 // of its axis' reference log), its estimates and verdict, each axis' reference (theta_0 as
 // JSON) and each run. Schema versioned (meta.schema_version), WAL journal: one process writes
-// (a writer holds FILE.writer locked for its run), any number read while it writes. Each
+// (a writer holds FILE.writer and the file itself locked for its run), any number read while it writes. Each
 // batch of results is one transaction, so a run killed at any point keeps every batch it
 // committed and a rerun skips them. Keep the file on a local disk: SQLite's locking is not
 // safe over a network file system.
@@ -90,6 +90,11 @@ class FleetStore {
   bool putSha256(const std::vector<std::pair<std::string, std::pair<FileStamp, std::string>>>& files, std::string* why);
 
   std::optional<std::string> meta(const std::string& key) const;
+
+  // The first read that failed (a damaged page, a statement SQLite refused) since the store
+  // was opened, as a sentence; a caller that read the store checks it before trusting what it
+  // read as whole.
+  std::optional<std::string> readError() const;
   bool setMeta(const std::string& key, const std::string& value, std::string* why);
 
  private:
@@ -97,6 +102,9 @@ class FleetStore {
   bool exec(const std::string& sql, std::string* why) const;
   sqlite3* db_ = nullptr;
   int lockFd_ = -1;
+  int fileFd_ = -1;          // the store file itself, flock'ed for a writer's run
+  bool writerOpen_ = false;  // meta writer_open is set; cleared on a clean close
+  mutable std::string readError_;
   std::string path_;
 };
 

@@ -15,7 +15,7 @@ namespace {
 
 constexpr double kZ99 = 2.5758;  // two-sided 99 % normal quantile
 
-// Measured on the simulated plant (README, "The plant"): 12 s logs at 1 kHz decimated to 200 Hz.
+// Measured on the simulated plant (docs/plant.md): 12 s logs at 1 kHz decimated to 200 Hz.
 const char* kEstimateCaveat =
     "Sizes, slopes and alpha are those of the recursive estimates against theta_0; on simulated axes "
     "f_m's estimate moved about 1.2 times as much as the arm's f_m (alpha 1.2 for 1.0 %/degC, wear "

@@ -8,6 +8,7 @@
 #include <thread>
 #include <variant>
 
+#include "core/session/json_fields.h"
 #include "core/io/log_io.h"
 
 namespace flexarm::fleet {
@@ -37,7 +38,7 @@ FleetLogResult analyseLog(const LogJob& job, const WorkChunk& chunk) {
     try {
       ref = referenceFromJson(json::parse(it->second), &why);
     } catch (const json::exception& e) {
-      why = e.what();
+      why = jsonErrorText(e);
     }
   } else {
     why = "the chunk lacks the reference " + job.referenceSha256;
@@ -81,7 +82,7 @@ bool chunkFromJson(const json& j, WorkChunk& c, std::string* why) {
                         l.at("reference_sha256").get<std::string>()});
     for (const auto& [sha, ref] : j.at("references").items()) c.references[sha] = ref.dump();
   } catch (const json::exception& e) {
-    if (why) *why = std::string("malformed chunk: ") + e.what();
+    if (why) *why = std::string("malformed chunk: ") + jsonErrorText(e);
     return false;
   }
   return c.options.isValid(why);
@@ -163,7 +164,7 @@ bool runFleetTask(const std::string& chunkPath, const std::string& resultPath, s
   try {
     j = nlohmann::json::parse(text);
   } catch (const nlohmann::json::exception& e) {
-    if (why) *why = chunkPath + ": " + e.what();
+    if (why) *why = chunkPath + ": " + jsonErrorText(e);
     return false;
   }
   if (!fleet::chunkFromJson(j, chunk, &err)) {

@@ -87,7 +87,7 @@ PreparedData prepareFitData(const IdData& data, const FitDataOptions& options) {
   if (in == outCh) return fail("the input and the output are the same channel '" + in->name + "'");
   // Dead data (a stuck encoder, a zero torque, values too large to square) are refused here,
   // before any estimator or diagnosis runs on them.
-  if (std::string dead = deadDataProblem(data, {in->name, outCh->name}); !dead.empty()) return fail(dead);
+  if (std::string dead = deadDataProblem(data, {in->name, outCh->name, columns::kArmAngle}); !dead.empty()) return fail(dead);
   IdData d;
   d.sampleTime = data.sampleTime;
   d.startTime = data.startTime;

@@ -250,9 +250,18 @@ HeadStatus parseHead(std::string_view text, bool whole, const std::string& path,
     const auto it = std::find(h.header.begin(), h.header.end(), name);
     return it == h.header.end() ? -1L : static_cast<long>(it - h.header.begin());
   };
+  // The header is listed to help map a real log's columns; a first line without separated
+  // columns is not a log's header, and is not echoed (it may be the first line of any file).
   std::string headerList;
-  for (std::size_t i = 0; i < h.header.size() && i < 40; ++i) headerList += (i ? ", " : "") + h.header[i];
-  if (h.header.size() > 40) headerList += ", ...";
+  if (h.header.size() < 2 && (h.header.empty() || h.header[0].size() > 40 ||
+                              h.header[0].find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ"
+                                                            "0123456789_ .()[]/-") != std::string::npos)) {
+    headerList = "no separated columns (the first line is not a CSV log's header)";
+  } else {
+    for (std::size_t i = 0; i < h.header.size() && i < 40 && headerList.size() < 300; ++i)
+      headerList += (i ? ", " : "") + (h.header[i].size() > 40 ? h.header[i].substr(0, 40) + "..." : h.header[i]);
+    if (h.header.size() > 40 || headerList.size() >= 300) headerList += ", ...";
+  }
   const bool mapped = !m.time.empty() || !m.input.empty() || !m.output.empty();
   struct Need {
     const std::string& given;

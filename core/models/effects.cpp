@@ -150,7 +150,16 @@ std::optional<Effect> parseEffect(std::string_view spec, std::string* why) {
       const std::string_view field = rest.substr(0, comma);
       double v = 0.0;
       if (!parseNumber(field, v)) {
-        if (why) *why = std::string(name) + ": '" + std::string(field) + "' is not a number";
+        if (why) *why = std::string(name) + ": '" + std::string(field.substr(0, 60)) + "' is not a number";
+        return std::nullopt;
+      }
+      // A value given by hand is one a robot axis can have: beyond 1e15 in SI units (a cubic
+      // spring's N m/rad^3 reach 1e7) is a slip of the keyboard, and a start of 1e308 makes
+      // every fit overflow.
+      if (!(std::fabs(v) <= 1e15)) {
+        char buf[48];
+        std::snprintf(buf, sizeof buf, "%g", v);
+        if (why) *why = std::string(name) + ": " + buf + " is beyond the +-1e15 a robot axis' effect can have";
         return std::nullopt;
       }
       given.push_back(v);

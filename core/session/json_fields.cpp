@@ -61,4 +61,14 @@ bool readWhole(const json& j, const char* key, int& out, std::string* why, const
   return f != Field::Bad;
 }
 
+std::string jsonErrorText(const nlohmann::json::exception& e) {
+  std::string s = e.what();
+  if (s.rfind("[json.exception.", 0) == 0)
+    if (const auto close = s.find("] "); close != std::string::npos) s.erase(0, close + 2);
+  for (char& c : s)
+    if (static_cast<unsigned char>(c) < 0x20) c = ' ';
+  if (s.size() > 160) s = s.substr(0, 160) + "...";
+  return s;
+}
+
 }  // namespace flexarm

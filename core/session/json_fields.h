@@ -20,4 +20,8 @@ bool readFlag(const nlohmann::json& j, const char* key, bool& out, std::string* 
 bool readWhole(const nlohmann::json& j, const char* key, int& out, std::string* why,
                const std::string& where);
 
+// An exception of the JSON library as a sentence: without its "[json.exception.type_error.302]"
+// prefix, at most 160 characters.
+std::string jsonErrorText(const nlohmann::json::exception& e);
+
 }  // namespace flexarm

@@ -46,6 +46,9 @@ std::string deadDataProblem(const IdData& data, const std::vector<std::string>& 
   if (names.empty()) {
     for (ChannelRole role : {ChannelRole::Input, ChannelRole::Output})
       if (const Channel* c = data.withRole(role)) channels.push_back(c);
+    // The arm-side encoder, when logged, is measured data too (its fits use it).
+    if (const Channel* c = data.channel(columns::kArmAngle); c && std::find(channels.begin(), channels.end(), c) == channels.end())
+      channels.push_back(c);
   } else {
     for (const auto& n : names)
       if (const Channel* c = data.channel(n)) channels.push_back(c);

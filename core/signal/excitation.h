@@ -25,7 +25,7 @@ inline constexpr double kMinSignalScale = 1e-140;
 std::string deadSignalProblem(const std::vector<double>& values);
 
 // Checks the named channels of data (a name not in data is skipped) and, when names is empty,
-// the input and output channels by role. Empty when all carry a signal; otherwise a sentence
+// the input and output channels by role and the arm encoder (arm_angle_rad) when logged. Empty when all carry a signal; otherwise a sentence
 // naming the first channel that does not: "the channel torque_ref_nm carries no signal: it is
 // constant (every sample is 0)".
 std::string deadDataProblem(const IdData& data, const std::vector<std::string>& names = {});

@@ -149,7 +149,9 @@ TEST(CliFleet, NamesEachChangeWithinAFewDays) {
       }
     const auto m = fresh("early-" + scenario + ".csv");
     std::ofstream(m) << fleetManifestText(entries);
-    const auto r = runFlexarm({"fleet", m.string(), "--db", fresh("early-" + scenario + ".sqlite").string(), "--json"});
+    // The logs stay in the plant's folder, this manifest elsewhere: --allow-logs-outside.
+    const auto r = runFlexarm({"fleet", m.string(), "--allow-logs-outside", "--db",
+                               fresh("early-" + scenario + ".sqlite").string(), "--json"});
     ASSERT_EQ(r.code, 0) << r.err;
     const json j = json::parse(r.out);
     ASSERT_EQ(j.at("axes").size(), 1u);
@@ -261,7 +263,7 @@ TEST(CliFleet, ABadLogIsReportedAndTheRestGoesOn) {
   std::ofstream(m) << fleetManifestText(entries);
   const auto db = fresh("bad.sqlite");
   fs::copy_file(p.db, db);
-  const auto r = runFlexarm({"fleet", m.string(), "--db", db.string(), "--json"});
+  const auto r = runFlexarm({"fleet", m.string(), "--allow-logs-outside", "--db", db.string(), "--json"});
   ASSERT_EQ(r.code, 0) << r.err;
   const json j = json::parse(r.out);
   EXPECT_EQ(j.at("analysed"), 0);
@@ -277,11 +279,11 @@ TEST(CliFleet, ABadLogIsReportedAndTheRestGoesOn) {
   ASSERT_NE(a, nullptr);
   EXPECT_EQ(a->at("logs"), p.truth.at("days"));
   // Again: the spoiled bytes are known (skipped), the missing file is reported again.
-  const auto again = json::parse(runFlexarm({"fleet", m.string(), "--db", db.string(), "--json"}).out);
+  const auto again = json::parse(runFlexarm({"fleet", m.string(), "--allow-logs-outside", "--db", db.string(), "--json"}).out);
   EXPECT_EQ(again.at("failed"), 1);
   EXPECT_EQ(again.at("skipped"), p.run.at("analysed").get<int>() + 1);
   // Another model's analyses are not mixed into the store.
-  const auto other = runFlexarm({"fleet", m.string(), "--db", db.string(), "--model", "two-mass"});
+  const auto other = runFlexarm({"fleet", m.string(), "--allow-logs-outside", "--db", db.string(), "--model", "two-mass"});
   EXPECT_EQ(other.code, 2);
   EXPECT_NE(other.err.find("holds three-mass analyses"), std::string::npos) << other.err;
   // A manifest that cannot be read ends the run before anything is written.

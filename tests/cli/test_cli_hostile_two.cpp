@@ -13,8 +13,12 @@
 #include <fstream>
 
 #include "cli_test_support.h"
+#include "hostile_support.h"
 
 using flexarm::test::ceilingMb;
+using flexarm::test::confined;
+using flexarm::test::expectConfined;
+using flexarm::test::joined;
 using flexarm::test::kUnderAddressSanitizer;
 using flexarm::test::MeasuredRun;
 using flexarm::test::RunLimits;
@@ -28,32 +32,6 @@ const std::string kHealthy = std::string(FLEXARM_SAMPLE_DIR) + "/diagnosis_no_fa
 
 std::string hostile(const std::string& name) { return std::string(FLEXARM_TEST_DATA_DIR) + "/hostile/" + name; }
 
-
-// A run with a time limit, traced.
-MeasuredRun confined(const std::vector<std::string>& args, int seconds = 60) {
-  RunLimits limits;
-  limits.timeoutSeconds = kUnderAddressSanitizer ? 4 * seconds : seconds;
-  limits.traceFiles = true;
-  return runFlexarmMeasured(args, limits);
-}
-
-std::string joined(const std::vector<std::string>& lines) {
-  std::string s;
-  for (const auto& l : lines) s += l + "\n";
-  return s;
-}
-
-// The exit code, the message, no crash, the memory ceiling, the time limit, and nothing touched
-// outside the test's folder.
-void expectConfined(const MeasuredRun& r, int code, const std::string& needle, long memoryMb) {
-  EXPECT_FALSE(r.timedOut) << "still running at the time limit; " << r.err;
-  EXPECT_EQ(r.code, code) << r.err;
-  EXPECT_NE(r.err.find(needle), std::string::npos) << r.err;
-  EXPECT_EQ(r.err.find("terminate"), std::string::npos) << r.err;
-  EXPECT_LT(r.maxRssMb, ceilingMb(memoryMb)) << r.err;
-  EXPECT_TRUE(r.traced) << "strace is needed to see what the run touched";
-  EXPECT_TRUE(r.outsideAccess.empty()) << joined(r.outsideAccess);
-}
 
 // A session of one log (its checksum unknown: the replay warns) and the given parts.
 void writeSession(const fs::path& path, const std::string& logName, const std::string& logPath,
@@ -317,10 +295,11 @@ TEST(HostileTwo, FleetStoreDoesNotFollowPlantedLinks) {
   const fs::path manifest = dir / "fleet.csv";
   { std::ofstream(manifest) << "# flexarm-fleet: 1\nrobot,axis,time,log\nR01,1,2026-03-01T06:00:00Z," << kHealthy << "\n"; }
   fs::create_symlink(victim, dir / "linked.sqlite");
-  expectConfined(confined({"fleet", manifest.string(), "--db", (dir / "linked.sqlite").string()}), 3,
+  // (The log is the sample's, outside this folder: --allow-logs-outside.)
+  expectConfined(confined({"fleet", manifest.string(), "--allow-logs-outside", "--db", (dir / "linked.sqlite").string()}), 3,
                  "linked.sqlite: is a symbolic link; FlexArm writes only regular files", 100);
   fs::create_symlink(victim, dir / "locked.sqlite.writer");
-  expectConfined(confined({"fleet", manifest.string(), "--db", (dir / "locked.sqlite").string()}), 3,
+  expectConfined(confined({"fleet", manifest.string(), "--allow-logs-outside", "--db", (dir / "locked.sqlite").string()}), 3,
                  "the writer lock " + (dir / "locked.sqlite.writer").string() + " is a symbolic link", 100);
   EXPECT_FALSE(fs::exists(dir / "locked.sqlite"));
   EXPECT_EQ(flexarm::test::readAll(victim.string()), "keep me\n");

@@ -16,6 +16,7 @@
 
 #include "app/main_window.h"
 #include "core/fleet/store.h"
+#include "core/session/sha256.h"
 #include "core/sim/random.h"
 #include "widget_test_support.h"
 #include "widgets/diagnosis_panel.h"
@@ -41,7 +42,8 @@ std::string makeStore() {
   const Axis axes[] = {{"R01", 1, ""}, {"R01", 2, "wear"}, {"R02", 1, "k_T"}, {"R02", 2, ""}};
   std::vector<StoredLog> logs;
   for (const auto& a : axes) {
-    const std::string ref = std::string(a.robot) + std::to_string(a.axis) + "-ref";
+    // Checksums as the store takes them: 64 hex digits.
+    const std::string ref = sha256Hex(std::string(a.robot) + std::to_string(a.axis) + "-ref");
     store->putAxis({a.robot, a.axis, ref, kReference.toStdString(), 24.0, "{}"}, &why);
     for (int d = 0; d < 24; ++d) {
       const double T = 24.0 + 9.0 * std::sin(2.0 * M_PI * (d + a.axis) / 7.0) + 0.5 * rng.normal();
@@ -53,7 +55,7 @@ std::string makeStore() {
       l.temperatureC = d == 0 ? 24.0 : T;
       const bool faulty = std::string(a.change) == "k_T" && d >= 14;
       l.path = (faulty ? kFaultyLog : kHealthyLog).toStdString();
-      l.result.sha256 = ref + "-" + std::to_string(d);
+      l.result.sha256 = sha256Hex(ref + "-" + std::to_string(d));
       l.result.referenceSha256 = ref;
       l.result.ok = true;
       l.result.verdict = faulty ? "k_T" : "none";
@@ -65,7 +67,7 @@ std::string makeStore() {
       logs.push_back(l);
     }
   }
-  store->putLogs(logs, 1, &why);
+  if (!store->putLogs(logs, 1, &why)) qFatal("%s", why.c_str());
   store->setMeta("model", "three-mass", &why);
   return path.string();
 }

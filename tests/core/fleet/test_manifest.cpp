@@ -36,7 +36,11 @@ TEST(FleetManifest, WithoutAReferenceTheEarliestLogIsOneAndColumnsMayBeReordered
       "a.csv,2026-03-04,2,R07\n"
       "/abs/c.csv,2026-03-06T06:00:00Z,1,R07\n";
   ManifestError e;
-  const auto m = parseFleetManifest(text, "fleet.csv", &e);
+  EXPECT_FALSE(parseFleetManifest(text, "fleet.csv", &e));  // /abs lies outside the folder
+  EXPECT_EQ(e.line, 5);
+  ManifestReadOptions anywhere;
+  anywhere.allowLogsOutside = true;
+  const auto m = parseFleetManifest(text, "fleet.csv", &e, anywhere);
   ASSERT_TRUE(m) << e.toString();
   ASSERT_EQ(m->axes.size(), 2u);
   EXPECT_EQ(m->axes[0].axis, 1);

@@ -20,16 +20,20 @@ fs::path scratch(const std::string& name) {
   return p;
 }
 
-StoredLog logOf(const std::string& sha, int day, double kT) {
+// Checksums as FlexArm writes them: 64 hex digits ("a" stands for aaaa...a).
+std::string sha(const std::string& letter) { return std::string(64, letter[0]); }
+const std::string kRef(64, '0');
+
+StoredLog logOf(const std::string& letter, int day, double kT) {
   StoredLog l;
   l.robot = "R01";
   l.axis = 2;
   l.day = 20513.25 + day;
   l.time = "2026-03-0" + std::to_string(day + 1) + "T06:00:00Z";
-  l.path = "R01/ax2/" + sha + ".csv";
+  l.path = "R01/ax2/" + letter + ".csv";
   l.temperatureC = 20.0 + day;
-  l.result.sha256 = sha;
-  l.result.referenceSha256 = "ref";
+  l.result.sha256 = sha(letter);
+  l.result.referenceSha256 = kRef;
   l.result.ok = true;
   l.result.message = "fine";
   l.result.verdict = day > 1 ? "k_T" : "none";
@@ -47,7 +51,7 @@ TEST(FleetStore, IsVersionedInWalAndKeepsWhatItWasGiven) {
     ASSERT_TRUE(store) << why;
     EXPECT_EQ(store->schemaVersion(), kFleetSchemaVersion);
     EXPECT_EQ(store->journalMode(), "wal");
-    ASSERT_TRUE(store->putAxis({"R01", 2, "ref", "R01/ax2/ref.csv", 21.5, "{\"x\":1}"}, &why)) << why;
+    ASSERT_TRUE(store->putAxis({"R01", 2, kRef, "R01/ax2/ref.csv", 21.5, "{\"x\":1}"}, &why)) << why;
     const long run = store->beginRun("local", "m.csv", &why);
     ASSERT_GT(run, 0) << why;
     ASSERT_TRUE(store->putLogs({logOf("b", 1, 1.0), logOf("a", 0, 1.01)}, run, &why)) << why;
@@ -56,16 +60,16 @@ TEST(FleetStore, IsVersionedInWalAndKeepsWhatItWasGiven) {
   }
   auto store = FleetStore::open(path, false, &why);
   ASSERT_TRUE(store) << why;
-  const auto logs = store->logs("R01", 2, "ref");
+  const auto logs = store->logs("R01", 2, kRef);
   ASSERT_EQ(logs.size(), 2u);
-  EXPECT_EQ(logs[0].result.sha256, "a");  // by day
+  EXPECT_EQ(logs[0].result.sha256, sha("a"));  // by day
   EXPECT_EQ(logs[0].result.estimates[0].value, 1.01);
   EXPECT_EQ(logs[1].result.estimates.size(), 3u);
   EXPECT_EQ(logs[1].result.estimates[2].name, "f_m");
   EXPECT_FALSE(logs[0].result.verdictTimeS);
   EXPECT_EQ(logs[1].temperatureC.value_or(0), 21.0);
   EXPECT_EQ(store->axis("R01", 2)->referenceTemperatureC.value_or(0), 21.5);
-  EXPECT_EQ(store->storedKeys().count({"b", "ref"}), 1u);
+  EXPECT_EQ(store->storedKeys().count({sha("b"), kRef}), 1u);
   EXPECT_TRUE(store->logs("R01", 1).empty());
 }
 

@@ -63,5 +63,15 @@ TEST(Excitation, TheFirstDeadChannelIsNamedAndTheDataPreparationRefusesIt) {
   EXPECT_EQ(p.message, deadDataProblem(stuck));
 }
 
+TEST(Excitation, AStuckArmEncoderIsDeadDataToo) {
+  IdData d = log(wave(500, 1.0), wave(500, 2.0));
+  d.setChannel({"arm_angle_rad", "rad", ChannelRole::None, std::vector<double>(500, 0.25)});
+  EXPECT_EQ(deadDataProblem(d), "the channel arm_angle_rad carries no signal: it is constant (every sample is 0.25)");
+  FitDataOptions o;
+  EXPECT_EQ(prepareFitData(d, o).message, deadDataProblem(d));
+  d.setChannel({"arm_angle_rad", "rad", ChannelRole::None, wave(500, 0.5)});
+  EXPECT_EQ(deadDataProblem(d), "");
+}
+
 }  // namespace
 }  // namespace flexarm
