@@ -479,7 +479,7 @@ QList<QPair<QString, QString>> SessionController::staleEstimates() const {
   for (const auto& m : workspace_->models()) {
     if (!m.fitRequest || !m.fitRequest->provenance) continue;
     const std::string other = dataMismatch(*m.fitRequest->provenance, open);
-    if (!other.empty()) stale.append({m.name, QString::fromStdString(other)});
+    if (!other.empty()) stale.append({nameOf(m), QString::fromStdString(other)});
   }
   return stale;
 }
@@ -518,7 +518,7 @@ void SessionController::recomputeNext() {
   while (!recomputeQueue_.isEmpty()) {
     const QString name = recomputeQueue_.takeFirst();
     for (const auto& m : workspace_->models()) {
-      if (m.name != name || !m.fitRequest) continue;
+      if (nameOf(m) != name || !m.fitRequest) continue;
       const FitRequest request = *m.fitRequest;  // the list changes when the fit lands
       window_->statusBar()->showMessage(tr("Recomputing %1 on the open data...").arg(name));
       if (window_->fitPanel()->recompute(request)) return;  // the next starts when it ends

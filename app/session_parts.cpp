@@ -54,7 +54,7 @@ json captureModels(const MainWindow& w) {
   // Physical models only: black-box estimates are recomputed from the data, not stored yet.
   for (const auto& m : w.workspace()->models()) {
     if (!m.model) continue;
-    json j = modelToJson(m.name.toStdString(), *m.model, m.effects);
+    json j = modelToJson(m.name, *m.model, m.effects);
     if (m.fitRequest && m.fitRequest->provenance) j["provenance"] = provenanceToJson(*m.fitRequest->provenance);
     list.push_back(j);
   }
@@ -69,7 +69,8 @@ void restoreModels(const json& section, MainWindow& w) {
     auto spec = modelFromJson(m, &why);
     if (!spec) continue;  // validated when the file was read
     ModelEntry entry;
-    entry.name = QString::fromStdString(spec->name);
+    entry.name = spec->name;
+    entry.origin = ModelOrigin::Session;
     entry.model = spec->model;
     entry.effects = spec->effects;
     ws->insertModelDirect(static_cast<int>(ws->models().size()), entry);
@@ -114,8 +115,9 @@ void restoreFits(const json& section, MainWindow& w) {
     bool attached = false;
     for (std::size_t i = 0; i < ws->models().size() && !attached; ++i) {
       ModelEntry e = ws->models()[i];
-      if (e.name != name || e.fitRequest) continue;
+      if (nameOf(e) != name || e.fitRequest) continue;
       e.fitRequest = shared;
+      e.origin = ModelOrigin::Fit;
       ws->setModelDirect(static_cast<int>(i), e);
       attached = true;
       shown = {*request, static_cast<int>(i)};
@@ -129,7 +131,8 @@ void restoreFits(const json& section, MainWindow& w) {
       continue;
     }
     ModelEntry e;
-    e.name = name;
+    e.name = request->name;
+    e.origin = ModelOrigin::Fit;
     e.polynomial = std::make_shared<const PolynomialModel>(std::move(*estimate));
     e.fitRequest = shared;
     ws->insertModelDirect(static_cast<int>(ws->models().size()), e);

@@ -261,7 +261,7 @@ void ArmPanel::refillSources() {
   const auto& models = workspace_->models();
   for (std::size_t i = 0; i < models.size(); ++i)
     if (models[i].model)
-      source_->addItem((models[i].fitRequest ? tr("Fit: %1") : tr("Model: %1")).arg(models[i].name),
+      source_->addItem((models[i].fitRequest ? tr("Fit: %1") : tr("Model: %1")).arg(nameOf(models[i])),
                        static_cast<int>(i));
   if (external_) source_->addItem(external_->name, kExternalSource);
   int at = source_->findText(wasName);
@@ -337,7 +337,7 @@ void ArmPanel::startSimulation() {
     const ModelEntry& e = workspace_->models()[static_cast<std::size_t>(source)];
     model = e.model;
     effects = e.effects;
-    computingName_ = (e.fitRequest ? tr("%1 (fit)") : tr("%1 (model list)")).arg(e.name);
+    computingName_ = (e.fitRequest ? tr("%1 (fit)") : tr("%1 (model list)")).arg(nameOf(e));
   }
   if (!model) return;
   // The worker reads its own copy of the log: the workspace may replace it meanwhile.

@@ -174,7 +174,7 @@ void bodeCurves(const WorkspaceSnapshot& snapshot, const std::vector<ModelEntry>
     try {
       const FrequencyResponse fr = responseOf(list[i], grid, c.level);
       if (fr.omega.empty()) continue;
-      BodeCurve curve = toCurve(list[i].name, color, fr);
+      BodeCurve curve = toCurve(nameOf(list[i]), color, fr);
       // A click reads the model's own notches and peaks, the numbers the Model panel prints
       // (notchesAndPeaks on the exact response), not the nearest grid point.
       auto magnitudeAt = [&](double w) {
@@ -192,7 +192,7 @@ void bodeCurves(const WorkspaceSnapshot& snapshot, const std::vector<ModelEntry>
       }
       curves.push_back(std::move(curve));
     } catch (const std::exception& e) {
-      notes << QObject::tr("%1: %2").arg(list[i].name, QString::fromStdString(e.what()));
+      notes << QObject::tr("%1: %2").arg(nameOf(list[i]), QString::fromStdString(e.what()));
     }
   }
   if (nonparametric && !data) notes << why;

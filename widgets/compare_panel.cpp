@@ -11,6 +11,7 @@
 #include <map>
 #include <qcustomplot.h>
 
+#include "core/compare/compare.h"
 #include "widgets/background_refresh.h"
 #include "widgets/ident_data.h"
 #include "widgets/plots/envelope_graph.h"
@@ -132,134 +133,82 @@ struct CompareOutcome {
 
 namespace {
 
+// A curve of values over [startTime, startTime + (n - 1) sampleTime], drawn through its
+// envelope; a deflection about its mean in mrad.
+Curve curveOf(const Eigen::VectorXd& v, double startTime, double sampleTime, const QString& name, const QPen& pen,
+              double scale = 1.0) {
+  std::vector<double> values(v.data(), v.data() + v.size());
+  for (double& x : values) x *= scale;
+  Curve c;
+  c.name = name;
+  c.pen = pen;
+  c.startTime = startTime;
+  c.sampleTime = sampleTime;
+  if (!values.empty()) {
+    const auto [lo, hi] = std::minmax_element(values.begin(), values.end());
+    c.lo = *lo;
+    c.hi = *hi;
+  }
+  c.envelope = std::make_shared<const EnvelopePyramid>(values);
+  return c;
+}
 
-
-// Simulates every checked model on the snapshot's data and forms the fit (5.2) of each on
-// the range of `kind`: the whole of the work that grows with the log.
+// Every checked model compared on the snapshot's data by core's runCompare (the comparison
+// `flexarm compare`, the session part and the report make), so that the panel shows the fit
+// the Fit panel and the command line give for the same model and range; then the curves.
 CompareOutcome compareModels(const WorkspaceSnapshot& snapshot, const std::vector<ModelEntry>& list,
-                      const std::vector<bool>& checked, RangeKind kind,
-                      const std::atomic<bool>& stop) {
+                             const std::vector<bool>& checked, RangeKind kind, const std::atomic<bool>& stop) {
   CompareOutcome out;
-  // Models give the motor velocity (the fit pipeline's black-box estimates too, Section 5.2),
-  // unless a physical model's output is the motor angle.
-  bool velocity = false;
-  for (std::size_t i = 0; i < list.size(); ++i)
-    if (checked[i]) velocity = velocity || wantsVelocity(list[i]);
-  // The data at each rate a model needs (black-box models at the rate they were estimated at).
-  std::map<int, std::optional<PreparedData>> rates;
-  QString why;
-  auto at = [&](int factor) -> const std::optional<PreparedData>& {
-    auto it = rates.find(factor);
-    if (it == rates.end()) it = rates.emplace(factor, workspaceData(snapshot, factor, velocity, &why)).first;
-    return it->second;
-  };
-  auto rangeOf = [kind](const PreparedData& d) {
-    const SampleRange r = kind == RangeKind::Validation ? d.validation : d.estimation;
-    return r.empty() ? d.estimation : r;
-  };
-  // A deflection curve is drawn about its mean over the range, in mrad.
-  auto addCurve = [&](const PreparedData& d, const Eigen::VectorXd& v, const QString& name, const QPen& pen,
-                      std::vector<Curve>* to = nullptr, bool deflection = false) {
-    const SampleRange r = rangeOf(d);
-    std::vector<double> values(v.data() + r.begin, v.data() + r.end);
-    if (deflection && !values.empty()) {
-      double mean = 0.0;
-      for (double x : values) mean += x;
-      mean /= static_cast<double>(values.size());
-      for (double& x : values) x = 1e3 * (x - mean);
-    }
-    Curve c;
-    c.name = name;
-    c.pen = pen;
-    c.startTime = d.timeAt(r.begin);
-    c.sampleTime = d.sampleTime;
-    if (!values.empty()) {
-      const auto [lo, hi] = std::minmax_element(values.begin(), values.end());
-      c.lo = *lo;
-      c.hi = *hi;
-    }
-    c.envelope = std::make_shared<const EnvelopePyramid>(values);
-    (to ? *to : out.curves).push_back(std::move(c));
-  };
-  out.velocity = velocity;
-  const auto& base = at(1);
-  if (!base) {
-    out.text = why;
+  if (!snapshot.data || !snapshot.data->input() || !snapshot.data->output()) {
+    out.text = QObject::tr("Open a log with an input and an output channel first.");
     return out;
   }
-  const bool noValidation = kind == RangeKind::Validation && base->validation.empty();
-  QStringList lines, deflection;
-  int colour = 0;
-  // The deflection the encoders measure, through the log's gear ratio (else the first
-  // physical model's r), when the log has an arm-side encoder.
-  double ratio = std::nan("");
-  if (const auto stated = logGearRatio(*snapshot.data)) ratio = *stated;
-  for (std::size_t i = 0; i < list.size() && std::isnan(ratio); ++i)
-    if (checked[i] && list[i].model) ratio = list[i].model->value("r");
-  const Eigen::VectorXd measured = std::isnan(ratio) ? Eigen::VectorXd() : measuredDeflection(*base, ratio);
-  for (std::size_t i = 0; i < list.size() && !stop.load(); ++i) {
-    const QColor color = kColors[colour++ % 6];
-    if (!checked[i]) continue;
-    QString reason;
-    std::optional<Eigen::VectorXd> sim;
-    const int factor = decimationFor(list[i], base->sampleTime);
-    const auto& data = factor > 0 ? at(factor) : base;
-    try {
-      if (factor == 0)
-        reason = QObject::tr("its sample time is no multiple of the data's");
-      else if (data)
-        sim = simulateEntry(list[i], data->u, data->sampleTime, &reason);
-    } catch (const std::exception& e) {
-      reason = QString::fromStdString(e.what());
+  CompareRequest request;
+  request.data = evaluationDataOf(snapshot);
+  request.range = kind == RangeKind::Validation ? DataRange::Validation : DataRange::Estimation;
+  std::vector<std::size_t> shown;  // list index of each compared model
+  for (std::size_t i = 0; i < list.size(); ++i)
+    if (checked[i]) {
+      request.models.push_back(list[i].evaluated());
+      shown.push_back(i);
     }
-    if (!sim || !sim->allFinite()) {
+  CompareResult r;
+  try {
+    r = runCompare(request, [&stop](double, const std::string&) {
+      return stop.load() ? ProgressAction::Abort : ProgressAction::Continue;
+    });
+  } catch (const std::invalid_argument& e) {
+    out.text = QString::fromStdString(e.what());
+    return out;
+  }
+  out.velocity = r.velocity;
+  QStringList lines;
+  for (const auto& line : r.lines()) lines << QString::fromStdString(line);
+  out.text = lines.join("\n");
+  if (!r.ok() && r.models.empty()) return out;
+  for (std::size_t k = 0; k < r.models.size(); ++k) {
+    const ComparedModel& m = r.models[k];
+    const QColor color = kColors[shown[k] % 6];
+    if (!m.compared() || !m.fit) {
       out.fits.push_back(std::nan(""));
       out.fitsNrmse.push_back(std::nan(""));
-      lines << QObject::tr("%1: not simulated (%2)")
-                   .arg(list[i].name, reason.isEmpty() ? QObject::tr("unstable") : reason);
       continue;
     }
-    const SampleRange r = rangeOf(*data);
-    const FitPercents fit = fitPercents(data->y, *sim, static_cast<Eigen::Index>(r.begin),
-                                        static_cast<Eigen::Index>(r.end));
-    out.fits.push_back(fit.seed52);
-    out.fitsNrmse.push_back(fit.nrmse);
-    addCurve(*data, *sim, QObject::tr("%1: %2 % (5.2)").arg(list[i].name).arg(fit.seed52, 0, 'f', 1),
-             QPen(color, 1.2));
-    if (measured.size() && list[i].model && &data == &base) {
-      const Eigen::VectorXd predicted =
-          simulateDeflection(*list[i].model, data->u, data->sampleTime, encoderSkewOf(list[i].effects));
-      const SampleRange r2 = rangeOf(*data);
-      const auto b = static_cast<Eigen::Index>(r2.begin), n = static_cast<Eigen::Index>(r2.size());
-      const Eigen::VectorXd m = measured.segment(b, n).array() - measured.segment(b, n).mean();
-      const Eigen::VectorXd p = predicted.segment(b, n).array() - predicted.segment(b, n).mean();
-      const FitPercents df = fitPercents(m, p);
-      addCurve(*data, predicted, QObject::tr("%1: %2 % (5.2)").arg(list[i].name).arg(df.seed52, 0, 'f', 1),
-               QPen(color, 1.2), &out.deflection, true);
-      deflection << QObject::tr("%1: deflection %2 % (5.2), %3 % NRMSE")
-                        .arg(list[i].name)
-                        .arg(df.seed52, 0, 'f', 1)
-                        .arg(df.nrmse, 0, 'f', 1);
-    }
-    lines << QObject::tr("%1: fit %2 % (5.2), %3 % NRMSE%4").arg(list[i].name).arg(fit.seed52, 0, 'f', 1)
-                 .arg(fit.nrmse, 0, 'f', 1)
-                 .arg(factor > 1 ? QObject::tr(" (at %1 Hz)").arg(1.0 / data->sampleTime, 0, 'g', 4) : QString());
+    out.fits.push_back(m.fit->percent.seed52);
+    out.fitsNrmse.push_back(m.fit->percent.nrmse);
+    const QString name = QString::fromStdString(m.name);
+    out.curves.push_back(curveOf(m.output, m.startTime, m.sampleTime,
+                                 QObject::tr("%1: %2 % (5.2)").arg(name).arg(m.fit->percent.seed52, 0, 'f', 1),
+                                 QPen(color, 1.2)));
+    if (m.deflection)
+      out.deflection.push_back(curveOf(m.deflection->predicted, m.startTime, m.sampleTime,
+                                       QObject::tr("%1: %2 % (5.2)").arg(name).arg(m.deflection->figure.percent.seed52, 0, 'f', 1),
+                                       QPen(color, 1.2), 1e3));
   }
-  addCurve(*base, base->y, QObject::tr("measured"), QPen(QColor(20, 20, 20), 1.0));  // on top
-  if (!out.deflection.empty()) {
-    addCurve(*base, measured, QObject::tr("measured"), QPen(QColor(20, 20, 20), 1.0), &out.deflection, true);
-    lines << QObject::tr("The deflection r phi_m - phi_a the arm-side encoder measures (r = %1), predicted from "
-                         "the torque by each model's linear part (with its encoder_skew), each about its mean:")
-                 .arg(ratio, 0, 'g', 6)
-          << deflection;
-  }
-  lines.prepend(QObject::tr("Fit of the simulated output on the %1 data (%2), as the seed's (5.2) "
-                            "1 - sum e^2/sum (y - mean y)^2 and as MATLAB compare's NRMSE 1 - |e|/|y - mean y|:")
-                    .arg(noValidation ? QObject::tr("estimation (no validation range set)")
-                                      : kind == RangeKind::Validation ? QObject::tr("validation")
-                                                                      : QObject::tr("estimation"),
-                         QString::fromStdString(base->note())));
-  out.text = lines.join("\n");
+  const QPen measured(QColor(20, 20, 20), 1.0);
+  out.curves.push_back(curveOf(r.measured, r.startTime, r.sampleTime, QObject::tr("measured"), measured));  // on top
+  if (!out.deflection.empty() && r.measuredDeflection.size())
+    out.deflection.push_back(curveOf(r.measuredDeflection, r.startTime, r.sampleTime, QObject::tr("measured"), measured, 1e3));
   return out;
 }
 

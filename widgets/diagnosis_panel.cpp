@@ -272,7 +272,7 @@ void DiagnosisPanel::refillReferences() {
   const auto& models = workspace_->models();
   for (std::size_t i = 0; i < models.size(); ++i)
     if (models[i].model && models[i].model->indexOf("k_T") >= 0 && models[i].model->indexOf("f_m") >= 0)
-      reference_->addItem(models[i].name, static_cast<int>(i));
+      reference_->addItem(nameOf(models[i]), static_cast<int>(i));
   for (const char* s : {"three-mass", "two-mass", "four-mass"})
     reference_->addItem(tr("%1 (nominal)").arg(s), QString(s));
   const int k = reference_->findText(keep);

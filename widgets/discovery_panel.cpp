@@ -239,7 +239,7 @@ void DiscoveryPanel::refillModels() {
     if (!m.model || m.model->topology().gearStiffness.empty() ||
         m.model->structureName() == "two-mass-theta")
       continue;
-    base_->addItem(m.name, static_cast<int>(i));
+    base_->addItem(nameOf(m), static_cast<int>(i));
   }
   for (const char* s : kStructures)
     base_->addItem(tr("%1 (nominal)").arg(s), QString(s));
@@ -703,7 +703,8 @@ void DiscoveryPanel::addToModel() {
   QString label = baseName_;
   label.remove(tr(" (nominal)"));
   for (const auto& f : result_->found) label += QString(" + ") + toString(f.kind);
-  entry.name = label;
+  entry.name = label.toStdString();
+  entry.origin = ModelOrigin::Discovery;
   // An extra mass becomes the larger structure: the model list and the fit take it so.
   auto merged = mergedModel(*result_->augmentedModel, result_->augmentedEffects);
   entry.model = std::shared_ptr<const PhysicalModel>(std::move(merged.first));

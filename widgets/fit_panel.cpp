@@ -283,7 +283,7 @@ void FitPanel::refillModels() {
   const auto& list = workspace_->models();
   for (std::size_t i = 0; i < list.size(); ++i)
     if (list[i].model)
-      model_->addItem(tr("%1 (model list)").arg(list[i].name), QString("list:%1").arg(i));
+      model_->addItem(tr("%1 (model list)").arg(nameOf(list[i])), QString("list:%1").arg(i));
   for (const auto& s : modelStructureNames())
     model_->addItem(tr("%1, nominal values").arg(QString::fromStdString(s)),
                     QString::fromStdString(s));
@@ -497,7 +497,7 @@ std::optional<FitOptions> FitPanel::options(QString* name, std::vector<Experimen
       const auto i = key.mid(5).toUInt();
       if (i < workspace_->models().size()) {
         base = workspace_->models()[i].model;
-        *name = workspace_->models()[i].name;
+        *name = nameOf(workspace_->models()[i]);
       }
     } else {
       base = makeModel(key.toStdString());
@@ -639,23 +639,25 @@ void FitPanel::onFinished() {
     entry.effects = r.effects;
     entry.covariance = r.covariance;
     entry.covarianceIndices = r.freeIndices;
-    entry.name = out.name;
+    entry.smoothingSpeed = r.smoothingSpeed;
+    entry.name = out.name.toStdString();
     last_ = {r.physical, r.data.estimationInput(), r.data.estimationOutput(), r.data.sampleTime};
   } else {
     entry.polynomial = r.polynomial;
-    entry.name = QString::fromStdString(r.polynomial->name());
+    entry.name = r.polynomial->name();
   }
   QStringList lines;
-  for (const auto& line : fitSummaryLines(r, entry.name.toStdString(),
+  for (const auto& line : fitSummaryLines(r, entry.name,
                                           fitLogNamesOf(*out.request, out.request->provenance->log)))
     lines << QString::fromStdString(line);
   // The estimate joins the shared list under a name no other entry has, naming its data:
   // "three-mass estimate 2 (chirp.csv 0.5-12 s)".
   std::vector<std::string> taken;
-  for (const auto& m : workspace_->models()) taken.push_back(m.name.toStdString());
+  for (const auto& m : workspace_->models()) taken.push_back(m.name);
   const QString name = QString::fromStdString(
-      uniqueResultName((entry.name + tr(" estimate")).toStdString(), *out.request->provenance, taken));
-  entry.name = name;
+      uniqueResultName(entry.name + " estimate", *out.request->provenance, taken));
+  entry.name = name.toStdString();
+  entry.origin = ModelOrigin::Fit;
   out.request->name = name.toStdString();
   out.request->stored = storedFitOf(r);
   entry.fitRequest = out.request;

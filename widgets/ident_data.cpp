@@ -1,5 +1,6 @@
 #include "widgets/ident_data.h"
 
+#include <QFileInfo>
 #include <QListWidget>
 #include <cmath>
 
@@ -21,9 +22,9 @@ void fillModelChecklist(QListWidget* list, const std::vector<ModelEntry>& models
   const QSignalBlocker block(list);
   list->clear();
   for (const auto& m : models) {
-    auto* item = new QListWidgetItem(m.name, list);
+    auto* item = new QListWidgetItem(nameOf(m), list);
     item->setFlags(Qt::ItemIsEnabled | Qt::ItemIsUserCheckable);
-    item->setCheckState(unchecked.contains(m.name) ? Qt::Unchecked : Qt::Checked);
+    item->setCheckState(unchecked.contains(nameOf(m)) ? Qt::Unchecked : Qt::Checked);
   }
 }
 
@@ -58,8 +59,12 @@ QString outputAxisLabel(const Workspace& workspace, bool velocityOutput) {
 }
 
 WorkspaceSnapshot snapshotOf(const Workspace& workspace) {
-  return {workspace.currentShared(), workspace.range(RangeKind::Estimation),
-          workspace.range(RangeKind::Validation)};
+  return {workspace.currentShared(), workspace.range(RangeKind::Estimation), workspace.range(RangeKind::Validation),
+          QFileInfo(workspace.logPath()).fileName().toStdString()};
+}
+
+EvaluationData evaluationDataOf(const WorkspaceSnapshot& snapshot) {
+  return {snapshot.data, snapshot.estimation, snapshot.validation, snapshot.name};
 }
 
 std::optional<PreparedData> workspaceData(const Workspace& workspace, int decimation, bool velocityOutput,
@@ -90,43 +95,6 @@ std::optional<PreparedData> workspaceData(const WorkspaceSnapshot& snapshot, int
     return std::nullopt;
   }
   return d;
-}
-
-int decimationFor(const ModelEntry& entry, double dataSampleTime) {
-  if (entry.model || !entry.polynomial || !(dataSampleTime > 0.0)) return 1;
-  const double ratio = entry.polynomial->sampleTime / dataSampleTime;
-  const long k = std::lround(ratio);
-  return k >= 1 && std::abs(ratio - static_cast<double>(k)) < 1e-6 * ratio ? static_cast<int>(k) : 0;
-}
-
-bool wantsVelocity(const ModelEntry& entry) {
-  return !entry.model || entry.model->options().output == ModelOutput::MotorVelocity;
-}
-
-namespace {
-bool sameRate(const PolynomialModel& m, double sampleTime, QString* why) {
-  if (std::abs(m.sampleTime - sampleTime) <= 1e-9 * sampleTime) return true;
-  if (why)
-    *why = QObject::tr("estimated at %1 s, the data are sampled at %2 s")
-               .arg(m.sampleTime)
-               .arg(sampleTime);
-  return false;
-}
-}  // namespace
-
-std::optional<Eigen::VectorXd> simulateEntry(const ModelEntry& entry, const Eigen::VectorXd& u,
-                                             double sampleTime, QString* why) {
-  if (entry.model) return simulate(*entry.model, u, sampleTime);
-  if (!entry.polynomial || !sameRate(*entry.polynomial, sampleTime, why)) return std::nullopt;
-  return simulate(*entry.polynomial, u);
-}
-
-std::optional<Eigen::VectorXd> residualsOf(const ModelEntry& entry, const Eigen::VectorXd& u,
-                                           const Eigen::VectorXd& y, double sampleTime,
-                                           QString* why) {
-  if (entry.model) return predictionErrors(*entry.model, Eigen::VectorXd(), u, y, sampleTime);
-  if (!entry.polynomial || !sameRate(*entry.polynomial, sampleTime, why)) return std::nullopt;
-  return predictionErrors(*entry.polynomial, u, y);
 }
 
 FrequencyResponse responseOf(const ModelEntry& entry, const std::vector<double>& omega,

@@ -8,6 +8,7 @@
 
 #include <Eigen/Dense>
 
+#include "core/compare/compare.h"
 #include "core/ident/evaluation.h"
 #include "core/ident/fit.h"
 #include "widgets/workspace.h"
@@ -29,8 +30,11 @@ bool isModelChecked(const QListWidget* list, std::size_t index);
 struct WorkspaceSnapshot {
   std::shared_ptr<const IdData> data;
   std::optional<TimeRange> estimation, validation;
+  std::string name;  // the log's file name
 };
 WorkspaceSnapshot snapshotOf(const Workspace& workspace);
+// The snapshot as core's evaluations (runCompare, runResiduals) take their data.
+EvaluationData evaluationDataOf(const WorkspaceSnapshot& snapshot);
 
 // The workspace's current data prepared as the fit pipeline prepares them (prepareFitData,
 // core/ident/fit_data.h): the workspace's estimation and validation ranges, decimation behind
@@ -50,27 +54,6 @@ QString outputAxisLabel(const Workspace& workspace, bool velocityOutput);
 // The workspace's current data and ranges as the experiments of a fit: the estimation range
 // (the whole log without one) and, when one is set, the validation range of the same log.
 void useWorkspaceData(const Workspace& workspace, FitOptions& options);
-
-// The decimation that brings data sampled at dataSampleTime to the rate the entry works at:
-// 1 for physical (continuous-time) models, T_model / T_data for black-box estimates, 0 when
-// that is not a whole number.
-int decimationFor(const ModelEntry& entry, double dataSampleTime);
-
-// True when the entry's output is the motor velocity (every physical model of the list with
-// the default output; black-box estimates say nothing and count as such).
-bool wantsVelocity(const ModelEntry& entry);
-
-// Output simulated from zero initial state: the ZOH simulation of a physical model (5.3), or
-// B/(A F) u of a black-box one. nullopt with a reason when a black-box model was estimated at
-// another sample time than the data's.
-std::optional<Eigen::VectorXd> simulateEntry(const ModelEntry& entry, const Eigen::VectorXd& u,
-                                             double sampleTime, QString* why);
-
-// Residuals for the correlation tests: one-step prediction errors of a black-box model (4.5),
-// output errors y - G u of a physical one (K = 0).
-std::optional<Eigen::VectorXd> residualsOf(const ModelEntry& entry, const Eigen::VectorXd& u,
-                                           const Eigen::VectorXd& y, double sampleTime,
-                                           QString* why);
 
 // Frequency response at omega (rad/s) with bands at `level` where the entry has a covariance
 // (estimateResponse of the fit pipeline). Black-box responses stop at their Nyquist frequency.

@@ -423,7 +423,7 @@ void LqgPanel::refreshSources() {
   source_->blockSignals(true);
   source_->clear();
   source_->addItem(tr("Table 8.1 (seed)"));
-  for (const auto& m : workspace_->models()) source_->addItem(tr("model: %1").arg(m.name));
+  for (const auto& m : workspace_->models()) source_->addItem(tr("model: %1").arg(nameOf(m)));
   source_->setCurrentIndex(std::clamp(keep, 0, source_->count() - 1));
   source_->blockSignals(false);
 }
@@ -440,7 +440,7 @@ void LqgPanel::selectSource(int index) {
   const ModelEntry& entry = workspace_->models()[static_cast<std::size_t>(index - 1)];
   if (!entry.model) {
     reductionLabel_->setText(tr("Cannot use %1: a black-box estimate has no physical "
-                                "parameters to reduce. The parameters stay.").arg(entry.name));
+                                "parameters to reduce. The parameters stay.").arg(nameOf(entry)));
     return;
   }
   TwoMassReductionOptions o;
@@ -449,7 +449,7 @@ void LqgPanel::selectSource(int index) {
   const TwoMassReductionResult r = reduceToTwoMass(*entry.model, o);
   if (!r.ok()) {
     reductionLabel_->setText(tr("Cannot use %1: %2. The parameters stay.")
-                                 .arg(entry.name, QString::fromStdString(r.message)));
+                                 .arg(nameOf(entry), QString::fromStdString(r.message)));
     return;
   }
   reductionLabel_->setText(QString::fromStdString(r.message) + tr(" (f_a = 0)."));

@@ -167,7 +167,7 @@ ModelPanel::ModelPanel(Workspace* workspace, QWidget* parent)
 void ModelPanel::refreshList() {
   filling_ = true;
   list_->clear();
-  for (const auto& m : workspace_->models()) list_->addItem(m.name);
+  for (const auto& m : workspace_->models()) list_->addItem(nameOf(m));
   filling_ = false;
   const int n = static_cast<int>(workspace_->models().size());
   if (n == 0) {
@@ -192,8 +192,8 @@ int ModelPanel::newModel(const QString& structure) {
   e.model = std::shared_ptr<PhysicalModel>(makeModel(structure.toStdString()));
   int same = 1;
   for (const auto& m : workspace_->models())
-    if (m.name.startsWith(structure)) ++same;
-  e.name = same == 1 ? structure : QString("%1 (%2)").arg(structure).arg(same);
+    if (nameOf(m).startsWith(structure)) ++same;
+  e.name = (same == 1 ? structure : QString("%1 (%2)").arg(structure).arg(same)).toStdString();
   current_ = static_cast<int>(workspace_->models().size());
   const int index = workspace_->addModel(std::move(e));
   selectModel(index);
@@ -217,7 +217,7 @@ void ModelPanel::refreshModel() {
   if (!entry.model) {  // a black-box estimate: nothing physical to edit here
     simulate_->setEnabled(false);
     description_->setText(tr("%1 is a black-box estimate: the Bode, Compare and Residuals "
-                             "panels show it.").arg(entry.name));
+                             "panels show it.").arg(nameOf(entry)));
     frequencies_->clear();
     filling_ = false;
     return;
@@ -268,7 +268,7 @@ void ModelPanel::refreshModel() {
     const StateSpace sys = *analysedStateSpace(entry);
     const auto w = logGrid(1.0, 2000.0, 600);
     BodeCurve curve;
-    curve.name = entry.name;
+    curve.name = nameOf(entry);
     curve.color = QColor(31, 119, 180);
     curve.frequency = w;
     curve.response = frequencyResponse(sys, w);
@@ -276,7 +276,7 @@ void ModelPanel::refreshModel() {
     curve.extrema = curveExtrema(np, [&](double x) { return std::abs(frequencyResponse(sys, {x}).front()); });
     curve.extremaKnown = true;
     bode_->addCurve(curve);
-    poleZero_->addSet(entry.name, QColor(31, 119, 180), poles(sys), zeros(sys));
+    poleZero_->addSet(nameOf(entry), QColor(31, 119, 180), poles(sys), zeros(sys));
     frequencies_->setText(tr("Notches %1 rad/s; peaks %2 rad/s")
                               .arg(frequenciesText(np.notches))
                               .arg(frequenciesText(np.peaks)));

@@ -244,7 +244,7 @@ void RecursivePanel::refillModels() {
   model_->clear();
   const auto& models = workspace_->models();
   for (std::size_t i = 0; i < models.size(); ++i)
-    if (models[i].model) model_->addItem(models[i].name, static_cast<int>(i));
+    if (models[i].model) model_->addItem(nameOf(models[i]), static_cast<int>(i));
   for (const char* s : kStructures) model_->addItem(tr("%1 (nominal)").arg(s), QString(s));
   const int k = model_->findText(keep);
   model_->setCurrentIndex(k >= 0 ? k : model_->findData(QString("three-mass")));

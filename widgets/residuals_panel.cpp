@@ -7,6 +7,7 @@
 #include <QVBoxLayout>
 #include <qcustomplot.h>
 
+#include "core/compare/residual_study.h"
 #include "widgets/background_refresh.h"
 #include "widgets/ident_data.h"
 #include "widgets/plots/plot_tools.h"
@@ -109,7 +110,7 @@ void ResidualsPanel::refillList() {
   filling_ = true;
   const QString keep = model_->currentText();
   model_->clear();
-  for (const auto& m : workspace_->models()) model_->addItem(m.name);
+  for (const auto& m : workspace_->models()) model_->addItem(nameOf(m));
   const int k = model_->findText(keep);
   model_->setCurrentIndex(k >= 0 ? k : model_->count() - 1);  // default: the newest model
   filling_ = false;
@@ -127,58 +128,31 @@ bool ResidualsPanel::isBusy() const { return worker_->isBusy(); }
 
 namespace {
 
-// The correlation tests of one model on the snapshot's data: all the work that grows with
-// the log. Sets analysis (empty lags when there is none) and the sentence to show.
+// The correlation tests of one model on the snapshot's data by core's runResiduals (the
+// analysis `flexarm residuals`, the session part and the report make). Sets analysis (empty
+// lags when there is none) and the sentence to show.
 void analyse(const WorkspaceSnapshot& snapshot, const ModelEntry& entry, RangeKind kind, int maxLag,
              ResidualAnalysis& analysis, QString& text, double& sampleTime) {
-  QString why;
-  const int factor = snapshot.data ? decimationFor(entry, snapshot.data->sampleTime) : 1;
-  if (factor == 0) {
-    text = QObject::tr("%1: its sample time is no multiple of the data's.").arg(entry.name);
+  if (!snapshot.data || !snapshot.data->input() || !snapshot.data->output()) {
+    text = QObject::tr("Open a log with an input and an output channel first.");
     return;
   }
-  const auto data = workspaceData(snapshot, factor, wantsVelocity(entry), &why);
-  if (!data) {
-    text = why;
-    return;
-  }
-  const SampleRange r = kind == RangeKind::Validation ? data->validation : data->estimation;
-  if (r.empty()) {
-    text = QObject::tr("No validation range set: select one in the Log panel (V).");
-    return;
-  }
-  std::optional<Eigen::VectorXd> eps;
+  ResidualsRequest request;
+  request.data = evaluationDataOf(snapshot);
+  request.model = entry.evaluated();
+  request.range = kind == RangeKind::Validation ? DataRange::Validation : DataRange::Estimation;
+  request.options.maxLag = maxLag;
+  ResidualsResult r;
   try {
-    eps = residualsOf(entry, data->u, data->y, data->sampleTime, &why);
-  } catch (const std::exception& e) {
-    why = QString::fromStdString(e.what());
-  }
-  const auto b = static_cast<Eigen::Index>(r.begin);
-  const auto n = static_cast<Eigen::Index>(r.size());
-  ResidualOptions o;
-  o.maxLag = maxLag;
-  if (!eps || !eps->allFinite() || n < 2 * o.maxLag + 10) {
-    text = eps && eps->allFinite()
-               ? QObject::tr("The range holds %1 samples; %2 lags need at least %3.")
-                     .arg(n).arg(o.maxLag).arg(2 * o.maxLag + 10)
-               : QObject::tr("%1: no residuals (%2).")
-                     .arg(entry.name, why.isEmpty() ? QObject::tr("unstable") : why);
+    r = runResiduals(request);
+  } catch (const std::invalid_argument& e) {
+    text = QString::fromStdString(e.what());
     return;
   }
-  analysis = residualAnalysis(eps->segment(b, n), data->u.segment(b, n), o);
-  sampleTime = data->sampleTime;
-  text = QObject::tr("%1 on the %2 data, %3 samples. Whiteness: %4 (statistic %5, 99 % threshold %6). "
-                     "Independence from the input: %7 (statistic %8, threshold %9).\n%10")
-             .arg(entry.name, kind == RangeKind::Validation ? QObject::tr("validation")
-                                                            : QObject::tr("estimation"))
-             .arg(n)
-             .arg(analysis.white ? QObject::tr("passed") : QObject::tr("failed"))
-             .arg(analysis.whitenessStatistic, 0, 'g', 4)
-             .arg(analysis.whitenessThreshold, 0, 'g', 4)
-             .arg(analysis.independent ? QObject::tr("passed") : QObject::tr("failed"))
-             .arg(analysis.independenceStatistic, 0, 'g', 4)
-             .arg(analysis.independenceThreshold, 0, 'g', 4)
-             .arg(QString::fromStdString(analysis.verdict));
+  text = QString::fromStdString(r.summary());
+  if (!r.ok()) return;
+  analysis = r.analysis;
+  sampleTime = r.sampleTime;
 }
 
 }  // namespace

@@ -33,7 +33,7 @@ class ReplaceModelCommand : public QUndoCommand {
 class AddModelCommand : public QUndoCommand {
  public:
   AddModelCommand(Workspace* w, int index, ModelEntry entry)
-      : QUndoCommand(QObject::tr("add model %1").arg(entry.name)), w_(w), index_(index), entry_(std::move(entry)) {}
+      : QUndoCommand(QObject::tr("add model %1").arg(nameOf(entry))), w_(w), index_(index), entry_(std::move(entry)) {}
   void redo() override { w_->insertModelDirect(index_, entry_); }
   void undo() override { w_->removeModelDirect(index_); }
 

@@ -11,6 +11,7 @@
 #include "core/io/log_io.h"
 #include "core/models/effects.h"
 #include "core/models/physical_models.h"
+#include "core/session/model_entry.h"
 #include "core/session/provenance.h"
 #include "core/signal/id_data.h"
 #include "core/signal/preprocess.h"
@@ -20,30 +21,17 @@ class QUndoStack;
 
 namespace flexarm {
 
-struct FitRequest;  // core/session/fit_request.h
 
 enum class RangeKind { Estimation, Validation };
 
 // A range in seconds (core/signal/seconds_range.h).
 using TimeRange = SecondsRange;
 
-// A model in the shared model list: a physical model (its parameters, free/fixed flags and
-// output options) and the nonlinear effects switched on for it, or a black-box estimate.
-struct ModelEntry {
-  QString name;
-  std::shared_ptr<const PhysicalModel> model;  // null for a black-box estimate
-  std::vector<Effect> effects;
-  // A black-box estimate (4.8) with its covariance; set exactly when model is null.
-  std::shared_ptr<const PolynomialModel> polynomial;
-  // For a physical estimate: covariance of the free parameters (indices into
-  // model->parameters()) that gives its confidence bands. Empty for a hand-made model; an
-  // edit of the parameters clears it.
-  Eigen::MatrixXd covariance;
-  std::vector<int> covarianceIndices;
-  // For an estimate of the Fit panel: what was asked (structure, start values, free
-  // parameters, options, ranges), so a session can store and replay the fit.
-  std::shared_ptr<const FitRequest> fitRequest;
-};
+// The shared model list holds ModelEntry (core/session/model_entry.h): the one model entry
+// the command line, the sessions and every panel use.
+
+// An entry's name as the panels show it.
+inline QString nameOf(const ModelEntry& entry) { return QString::fromStdString(entry.name); }
 
 class Workspace : public QObject {
   Q_OBJECT

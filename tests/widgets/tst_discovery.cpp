@@ -86,7 +86,7 @@ class DiscoveryPanelTest : public QObject {
     QCOMPARE(added.count(), 1);
     QCOMPARE(workspace_->models().size(), before + 1);
     const ModelEntry& m = workspace_->models().back();
-    QVERIFY(m.name.contains(kEffect));
+    QVERIFY(nameOf(m).contains(kEffect));
     QCOMPARE(m.effects.size(), std::size_t{1});
     QCOMPARE(QString(toString(m.effects[0].kind)), QString(kEffect));
     // The gap shrinks: augmented curves shown, validation residual RMS lower.

@@ -58,6 +58,12 @@ class IdentificationTest : public QObject {
 
   // The Bode, Compare and Residuals panels compute in the background: waits for them.
   void settle() { QTRY_VERIFY_WITH_TIMEOUT(!window_->isBusy(), 60000); }
+  // The Compare panel in front, comparing on the validation range, its work done.
+  void compareOnValidation() {
+    showDock("compareDock");
+    window_->comparePanel()->setRangeKind(RangeKind::Validation);
+    settle();
+  }
 
   void showDock(const char* name) {
     auto* dock = window_->findChild<QDockWidget*>(name);
@@ -195,7 +201,7 @@ class IdentificationTest : public QObject {
     const auto report = nlohmann::json::parse(rout.str());
     const nlohmann::json* replay = nullptr;
     for (const auto& section : report["sections"])
-      if (section["title"] == "Fit " + panel.name.toStdString()) replay = &section["values"]["fit"];
+      if (section["title"] == "Fit " + panel.name) replay = &section["values"]["fit"];
     QVERIFY2(replay, rout.str().c_str());
 
     int free = 0;
@@ -218,6 +224,17 @@ class IdentificationTest : public QObject {
     QVERIFY((*replay)["notches_rad_s"] == line["notches_rad_s"]);
     const QString shown = QString::number(line["fit_percent_validation"].get<double>(), 'f', 1) + " %";
     QVERIFY2(fit->summaryText().contains(shown), qPrintable(shown + " not in " + fit->summaryText()));
+    // One model, one number: the Compare panel gives the estimate the validation fit % the Fit
+    // panel and the command line give (each computed by core, once).
+    {
+      compareOnValidation();
+      ComparePanel* cmp = window_->comparePanel();
+      const auto fits = cmp->fits();
+      QCOMPARE(static_cast<int>(fits.size()), static_cast<int>(window_->workspace()->models().size()));
+      QVERIFY2(std::abs(fits.back() - line["fit_percent_validation"].get<double>()) < 0.01,
+               qPrintable(QString("Compare %1, fit %2: ").arg(fits.back()).arg(line["fit_percent_validation"].get<double>()) +
+                          cmp->fitText()));
+    }
     // As a user sees it on a 1366 x 768 screen.
     window_->resize(1366, 768);
     QTest::qWait(300);
@@ -345,10 +362,8 @@ class IdentificationTest : public QObject {
   }
 
   void compareShowsFitOfEveryModel() {
+    compareOnValidation();
     ComparePanel* cmp = window_->comparePanel();
-    showDock("compareDock");
-    cmp->setRangeKind(RangeKind::Validation);
-    settle();
     const auto fits = cmp->fits();
     QCOMPARE(static_cast<int>(fits.size()), static_cast<int>(window_->workspace()->models().size()));
     // The physical estimate simulates the validation part of the sweep well.

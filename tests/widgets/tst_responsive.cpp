@@ -107,7 +107,7 @@ class StallWatch : public QObject {
 
 ModelEntry physicalEntry(const char* structure, const QString& name) {
   ModelEntry e;
-  e.name = name;
+  e.name = name.toStdString();
   e.model = makeModel(structure);
   return e;
 }

@@ -172,7 +172,7 @@ class SessionTest : public QObject {
     const QString physicalSummary = fit->summaryText();
     const ModelEntry physical = ws->models().back();
     QVERIFY(physical.fitRequest && physical.fitRequest->physical());
-    QCOMPARE(QString::fromStdString(physical.fitRequest->name), physical.name);
+    QCOMPARE(QString::fromStdString(physical.fitRequest->name), nameOf(physical));
     QVERIFY(fit->setModelChoice("oe"));
     PolyOrders o;
     o.nb = 4;
@@ -191,7 +191,7 @@ class SessionTest : public QObject {
     QVERIFY2(loaded.ok, loaded.message.c_str());
     const auto& requests = loaded.session.parts["fits"]["requests"];
     QCOMPARE(requests.size(), std::size_t{2});
-    QCOMPARE(QString::fromStdString(requests[0]["name"]), physical.name);
+    QCOMPARE(QString::fromStdString(requests[0]["name"].get<std::string>()), nameOf(physical));
     QCOMPARE(requests[1]["orders"]["nf"].get<int>(), 4);
 
     std::unique_ptr<MainWindow> other(newWindow());
@@ -202,7 +202,7 @@ class SessionTest : public QObject {
     QCOMPARE(models.size(), ws->models().size());
     QVERIFY(models[models.size() - 2].fitRequest != nullptr);
     QVERIFY(models.back().polynomial != nullptr);
-    QCOMPARE(models.back().name, blackBox.name);
+    QCOMPARE(nameOf(models.back()), nameOf(blackBox));
     QVERIFY(models.back().polynomial->parameterVector() == blackBox.polynomial->parameterVector());
     QCOMPARE(QString::fromStdString(stateOf(*other, path).dump(1)),
              QString::fromStdString(stateOf(*window_, path).dump(1)));
@@ -223,14 +223,14 @@ class SessionTest : public QObject {
     const auto shownFit = QRegularExpression("Fit ([0-9.]+) % \\(5\\.2\\)").match(blackBoxSummary);
     QVERIFY(shownFit.hasMatch());
     QVERIFY2(restored->summaryText().contains(shownFit.captured(0)), qPrintable(restored->summaryText()));
-    QVERIFY2(restored->summaryText().contains(blackBox.name), qPrintable(restored->summaryText()));
+    QVERIFY2(restored->summaryText().contains(nameOf(blackBox)), qPrintable(restored->summaryText()));
 
     const ReplayResult r = replaySession(loaded.session, path.toStdString());
     QVERIFY2(r.termination == Termination::Converged, r.message.c_str());
     int found = 0;
     for (const auto& s : r.report.sections) {
-      const bool isPhysical = s.title == "Fit " + physical.name.toStdString();
-      if (!isPhysical && s.title != "Fit " + blackBox.name.toStdString()) continue;
+      const bool isPhysical = s.title == "Fit " + physical.name;
+      if (!isPhysical && s.title != "Fit " + blackBox.name) continue;
       ++found;
       const QString summary = isPhysical ? physicalSummary : blackBoxSummary;
       for (const char* key : {"fit_percent", "fit_percent_validation"}) {

@@ -111,8 +111,8 @@ class WorkspaceProvenanceTest : public QObject {
     fit->setDecimation(1);
     QVERIFY2(clickEstimate(fit), qPrintable(fit->summaryText()));
     const ModelEntry e = ws->models().back();
-    chirpFit_ = e.name;
-    QCOMPARE(e.name, QString("three-mass estimate (three_mass_estimation_chirp.csv 0.5-12 s)"));
+    chirpFit_ = nameOf(e);
+    QCOMPARE(nameOf(e), QString("three-mass estimate (three_mass_estimation_chirp.csv 0.5-12 s)"));
     QVERIFY(e.fitRequest && e.fitRequest->provenance && e.fitRequest->stored);
     chirpRequest_ = *e.fitRequest;
     const Provenance& pr = *e.fitRequest->provenance;
@@ -122,9 +122,9 @@ class WorkspaceProvenanceTest : public QObject {
     QVERIFY(pr.validation && pr.validation->end == 17.5);
     // A second fit of the same structure on the same data is still told apart.
     QVERIFY2(clickEstimate(fit), qPrintable(fit->summaryText()));
-    QCOMPARE(ws->models().back().name, QString("three-mass estimate 2 (three_mass_estimation_chirp.csv 0.5-12 s)"));
+    QCOMPARE(nameOf(ws->models().back()), QString("three-mass estimate 2 (three_mass_estimation_chirp.csv 0.5-12 s)"));
     ws->undoStack()->undo();  // the second estimate goes again
-    QCOMPARE(ws->models().back().name, chirpFit_);
+    QCOMPARE(nameOf(ws->models().back()), chirpFit_);
   }
 
   // (b) Opening a log over unsaved work asks first; Cancel keeps everything.
@@ -192,7 +192,7 @@ class WorkspaceProvenanceTest : public QObject {
     other->sessionController()->open(path);
     QVERIFY(opened.wait(30000));
     const ModelEntry& e = other->workspace()->models().back();
-    QCOMPARE(e.name, chirpFit_);
+    QCOMPARE(nameOf(e), chirpFit_);
     QVERIFY(e.fitRequest && e.fitRequest->provenance && e.fitRequest->stored);
     QVERIFY(*e.fitRequest->provenance == *chirpRequest_.provenance);
     QCOMPARE(e.fitRequest->stored->parameters.size(), chirpRequest_.stored->parameters.size());
@@ -254,8 +254,8 @@ class WorkspaceProvenanceTest : public QObject {
     QVERIFY(estimated.wait(120000));
     QVERIFY2(estimated.first().first().toBool(), qPrintable(window_->fitPanel()->summaryText()));
     const ModelEntry& again = ws->models().back();
-    QVERIFY2(again.name.startsWith("three-mass estimate 2 (effect_backlash.csv"), qPrintable(again.name));
-    QVERIFY(again.name != chirpFit_);
+    QVERIFY2(nameOf(again).startsWith("three-mass estimate 2 (effect_backlash.csv"), qPrintable(nameOf(again)));
+    QVERIFY(nameOf(again) != chirpFit_);
     double kgB = 0.0;
     for (const auto& p : again.fitRequest->stored->parameters)
       if (p.name == "k_g") kgB = p.value;
