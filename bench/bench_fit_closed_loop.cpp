@@ -11,7 +11,7 @@
 //
 // Rows on stdout (bench/README.md: one per noise level and case, of kind "study": Auto's time,
 // bias and coverage beside the direct fit's, no peer and no speed ratio), the tables on stderr. The defaults (4 logs per level, 20 per coverage case) keep the suite
-// within minutes; the numbers README and the fit's sentences quote come from 6 and 40:
+// within minutes; the numbers docs/real-logs.md and the fit's sentences quote come from 6 and 40:
 //   cmake --build BUILD --target bench_fit_closed_loop && BUILD/bench/bench_fit_closed_loop [SEEDS [COVERAGE_LOGS [PARTS]]]
 #include <algorithm>
 #include <chrono>

@@ -91,14 +91,12 @@ TEST(CliModels, SimulateRefusesBadRequestsAndReportsAnUnstableLoop) {
   EXPECT_FALSE(std::filesystem::exists(out)) << "no log from a diverged simulation";
 }
 
-// README's "From MATLAB" table: every FlexArm verb it names exists and every option it gives
+// The "From MATLAB" table (docs/from-matlab.md): every FlexArm verb it names exists and every option it gives
 // that verb is one the verb's --help lists (--effect, --start and --bound of `fit` belong to
 // the nonlinear grey-box fit that lands beside this and are checked once it does).
-TEST(CliModels, ReadmeFromMatlabNamesRealVerbsAndOptions) {
-  const std::string readme = readAll(std::string(FLEXARM_SAMPLE_DIR) + "/../README.md");
-  const auto begin = readme.find("## From MATLAB");
-  ASSERT_NE(begin, std::string::npos);
-  const std::string section = readme.substr(begin, readme.find("\n## ", begin + 1) - begin);
+TEST(CliModels, FromMatlabPageNamesRealVerbsAndOptions) {
+  const std::string section = readAll(std::string(FLEXARM_SAMPLE_DIR) + "/../docs/from-matlab.md");
+  ASSERT_EQ(section.rfind("# From MATLAB", 0), 0u);
   for (const char* matlab : {"spa(", "etfe(", "tfest", "greyest", "idnlgrey", "compare(", "iddata"})
     EXPECT_NE(section.find(matlab), std::string::npos) << matlab;
   // `flexarm VERB ...` up to the closing backtick.
