@@ -1,11 +1,13 @@
-#include <cstdio>
+#include "app/cli/cli.h"
+
 #include <charconv>
+#include <cstdio>
 #include <cmath>
 #include <ostream>
 #include <sstream>
 #include <string>
 
-#include "app/cli/cli.h"
+#include "core/common/text.h"
 
 namespace flexarm::cli {
 
@@ -46,7 +48,7 @@ bool ArgParser::parse(const std::vector<std::string>& args) {
     const std::string& a = args[i];
     if (a.size() < 3 || a.compare(0, 2, "--") != 0) {
       if (a.size() >= 2 && a[0] == '-' && !(a[1] >= '0' && a[1] <= '9') && a[1] != '.') {
-        error_ = "unknown option '" + a + "'";
+        error_ = "unknown option " + inQuotes(a);
         return false;
       }
       positional_.push_back(a);
@@ -85,7 +87,7 @@ bool ArgParser::parse(const std::vector<std::string>& args) {
         const auto x = finiteNumber(value);
         const bool inside = x && (o->minOpen ? *x > o->min : *x >= o->min) && (o->maxOpen ? *x < o->max : *x <= o->max);
         if (!inside) {
-          error_ = "--" + name + " expects a number" + rangeText(*o) + ", got '" + value + "'";
+          error_ = "--" + name + " expects a number" + rangeText(*o) + ", got " + inQuotes(value);
           return false;
         }
         break;
@@ -93,7 +95,7 @@ bool ArgParser::parse(const std::vector<std::string>& args) {
       case OptionKind::Integer: {
         const auto x = wholeNumber(value);
         if (!x || static_cast<double>(*x) < o->min || static_cast<double>(*x) > o->max) {
-          error_ = "--" + name + " expects a whole number" + rangeText(*o) + ", got '" + value + "'";
+          error_ = "--" + name + " expects a whole number" + rangeText(*o) + ", got " + inQuotes(value);
           return false;
         }
         break;
@@ -105,7 +107,7 @@ bool ArgParser::parse(const std::vector<std::string>& args) {
           std::string list;
           for (std::size_t k = 0; k < o->choices.size(); ++k)
             list += (k == 0 ? "" : k + 1 == o->choices.size() ? " or " : ", ") + o->choices[k];
-          error_ = "--" + name + " expects " + list + ", not '" + value + "'";
+          error_ = "--" + name + " expects " + list + ", not " + inQuotes(value);
           return false;
         }
         break;
@@ -152,11 +154,6 @@ long ArgParser::integer(const std::string& name) const {
 
 namespace {
 
-// A value as a message quotes it: at most 100 characters.
-std::string quotedValue(const std::string& v) {
-  return "'" + (v.size() > 100 ? v.substr(0, 100) + "...' (" + std::to_string(v.size()) + " characters)" : v + "'");
-}
-
 std::string shortNumber(double v) {
   char buf[32];
   std::snprintf(buf, sizeof buf, "%g", v);
@@ -171,7 +168,7 @@ bool ArgParser::number(const std::string& name, double& out, double min, double 
   const auto x = finiteNumber(*v);
   if (!x || *x < min || *x > max) {
     error_ = "--" + name + " expects a number from " + shortNumber(min) + " to " + shortNumber(max) + ", got " +
-             quotedValue(*v);
+             inQuotes(*v);
     return false;
   }
   out = *x;
@@ -183,7 +180,7 @@ bool ArgParser::number(const std::string& name, double& out) {
   if (!v) return true;
   const auto x = finiteNumber(*v);
   if (!x) {
-    error_ = "--" + name + " expects a number, got " + quotedValue(*v);
+    error_ = "--" + name + " expects a number, got " + inQuotes(*v);
     return false;
   }
   out = *x;
@@ -196,7 +193,7 @@ bool ArgParser::integer(const std::string& name, long& out) {
   long x = 0;
   auto res = std::from_chars(v->data(), v->data() + v->size(), x);
   if (res.ec != std::errc() || res.ptr != v->data() + v->size()) {
-    error_ = "--" + name + " expects an integer, got " + quotedValue(*v);
+    error_ = "--" + name + " expects an integer, got " + inQuotes(*v);
     return false;
   }
   out = x;
@@ -209,7 +206,7 @@ bool ArgParser::integer(const std::string& name, int& out, int min, int max) {
   const auto x = wholeNumber(*v);
   if (!x || *x < min || *x > max) {
     error_ = "--" + name + " expects a whole number from " + std::to_string(min) + " to " +
-             std::to_string(max) + ", got " + quotedValue(*v);
+             std::to_string(max) + ", got " + inQuotes(*v);
     return false;
   }
   out = static_cast<int>(*x);

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <ostream>
 
+#include "core/common/text.h"
 #include "core/io/ranges.h"
 
 namespace flexarm::cli {
@@ -133,7 +134,7 @@ bool parseTimeRange(const std::string& text, const IdData& data, SampleRange& ra
                     std::string* why) {
   double t0 = 0, t1 = 0;
   if (!parseSecondsRange(text, t0, t1)) {
-    if (why) *why = "a range is written A:B in seconds, e.g. 2.5:10, not '" + text + "'";
+    if (why) *why = "a range is written A:B in seconds, e.g. 2.5:10, not " + inQuotes(text);
     return false;
   }
   range = data.rangeForTimes(t0, t1);

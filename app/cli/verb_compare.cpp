@@ -4,6 +4,7 @@
 #include <nlohmann/json.hpp>
 #include <ostream>
 
+#include "core/common/text.h"
 #include "app/cli/cli.h"
 #include "app/cli/evaluation_args.h"
 #include "app/cli/progress_line.h"
@@ -71,7 +72,7 @@ int runCompare(const std::vector<std::string>& argv, std::ostream& out, std::ost
   CompareRequest request;
   if (const auto on = args.value("on")) {
     const auto r = dataRangeFromString(*on);
-    if (!r) return usage("--on must be validation or estimation, not '" + *on + "'");
+    if (!r) return usage("--on must be validation or estimation, not " + inQuotes(*on));
     request.range = *r;
   }
   if (args.value("horizon") && !args.integer("horizon", request.horizon, 0, kMaxCompareHorizon))

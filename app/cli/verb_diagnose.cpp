@@ -6,6 +6,7 @@
 #include <ostream>
 #include <sstream>
 
+#include "core/common/text.h"
 #include "app/cli/cli.h"
 #include "app/cli/log_args.h"
 #include "app/cli/model_args.h"
@@ -228,7 +229,7 @@ int runDiagnose(const std::vector<std::string>& argv, std::ostream& out, std::os
   }
   if (auto p = args.value("predictor")) {
     auto parsed = diagnosisPredictorFromString(*p);
-    if (!parsed) return usage("--predictor must be auto, loop or direct, not '" + *p + "'");
+    if (!parsed) return usage("--predictor must be auto, loop or direct, not " + inQuotes(*p));
     options.predictor = *parsed;
   }
   if (auto w = args.value("window")) {
@@ -237,7 +238,7 @@ int runDiagnose(const std::vector<std::string>& argv, std::ostream& out, std::os
     } else {
       options.window = HypothesisWindow::Sliding;
       if (!args.number("window", options.windowS))
-        return usage("--window expects seconds or 'cumulative', not '" + *w + "'");
+        return usage("--window expects seconds or 'cumulative', not " + inQuotes(*w));
     }
   }
   double lambda = options.estimator.lambda, k = 0.0;
@@ -291,7 +292,7 @@ int runDiagnose(const std::vector<std::string>& argv, std::ostream& out, std::os
     const auto eq = f->find('=');
     double factor = 0.0;
     if (eq == std::string::npos || !(std::istringstream(f->substr(eq + 1)) >> factor) || !(factor > 0.0))
-      return usage("--seed-fault expects NAME=FACTOR (e.g. k_T=1.2), not '" + *f + "'");
+      return usage("--seed-fault expects NAME=FACTOR (e.g. k_T=1.2), not " + inQuotes(*f));
     request.seedFault = std::make_pair(f->substr(0, eq), factor);
   }
 

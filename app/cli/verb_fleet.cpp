@@ -2,6 +2,7 @@
 //               [--report fleet.pdf|html] [--json]
 // flexarm fleet --task CHUNK.json --out RESULT.json      (one Slurm array task)
 // flexarm simulate --fleet DIR --robots N --days D ...    (the simulated plant)
+#include "core/common/text.h"
 #include "app/cli/verb_fleet.h"
 
 #include <algorithm>
@@ -112,14 +113,14 @@ int runFleet(const std::vector<std::string>& argv, std::ostream& out, std::ostre
   if (!db) return usage("--db FLEET.sqlite is required");
   const auto reportPath = args.value("report");
   if (reportPath && !endsWith(*reportPath, ".pdf") && !endsWith(*reportPath, ".html"))
-    return usage("--report must name a .pdf or .html file, not '" + *reportPath + "'");
+    return usage("--report must name a .pdf or .html file, not " + inQuotes(*reportPath));
   if (reportPath && !reportRenderer())
     return usage("this build has no report rendering (it was built without the GUI); use --json");
 
   FleetOptions o;
   if (auto e = args.value("engine")) {
     auto engine = fleetEngineFromString(*e);
-    if (!engine) return usage("--engine must be local or slurm, not '" + *e + "'");
+    if (!engine) return usage("--engine must be local or slurm, not " + inQuotes(*e));
     o.engine = *engine;
   }
   int logsPerTask = o.slurm.logsPerTask, maxTasks = 0;

@@ -5,6 +5,7 @@
 #include <nlohmann/json.hpp>
 #include <ostream>
 
+#include "core/common/text.h"
 #include "app/cli/cli.h"
 #include "core/control/lqg_analysis.h"
 
@@ -57,7 +58,7 @@ bool parseList(const std::string& text, Eigen::VectorXd& out, std::string& why) 
     double x = 0.0;
     auto res = std::from_chars(b, e, x);
     if (b == e || res.ec != std::errc() || res.ptr != e || !std::isfinite(x)) {
-      why = "expects comma-separated numbers, got '" + text + "'";
+      why = "expects comma-separated numbers, got " + inQuotes(text);
       return false;
     }
     v.push_back(x);
@@ -113,7 +114,7 @@ int runLqg(const std::vector<std::string>& argv, std::ostream& out, std::ostream
   if (!args.positional().empty())
     return usage("unexpected argument '" + args.positional()[0] + "'");
   if (auto m = args.value("model"); m && *m != "two-mass")
-    return usage("--model must be two-mass, not '" + *m + "'");
+    return usage("--model must be two-mass, not " + inQuotes(*m));
 
   LqgOptions o;
   if (args.flag("accel")) o = LqgOptions::seedAccelerationFeedback();
@@ -124,12 +125,12 @@ int runLqg(const std::vector<std::string>& argv, std::ostream& out, std::ostream
   }
   for (const std::string& p : args.values("param")) {
     const auto eq = p.find('=');
-    if (eq == std::string::npos) return usage("--param expects NAME=VALUE, got '" + p + "'");
+    if (eq == std::string::npos) return usage("--param expects NAME=VALUE, got " + inQuotes(p));
     const std::string name = p.substr(0, eq), text = p.substr(eq + 1);
     double value = 0.0;
     const auto res = std::from_chars(text.data(), text.data() + text.size(), value);
     if (text.empty() || res.ec != std::errc() || res.ptr != text.data() + text.size())
-      return usage("--param " + name + " expects a number, got '" + text + "'");
+      return usage("--param " + name + " expects a number, got " + inQuotes(text));
     try {
       o.parameters.set(name, value);
     } catch (const std::invalid_argument& e) {

@@ -9,6 +9,7 @@
 #include <nlohmann/json.hpp>
 #include <ostream>
 
+#include "core/common/text.h"
 #include "app/cli/cli.h"
 #include "app/cli/log_args.h"
 #include "app/cli/model_args.h"
@@ -99,7 +100,7 @@ bool parseNumbers(const std::string& option, const std::string& text, std::vecto
     double v = 0.0;
     const auto r = std::from_chars(item.data(), item.data() + item.size(), v);
     if (r.ec != std::errc() || r.ptr != item.data() + item.size() || !std::isfinite(v)) {
-      *why = "--" + option + " expects numbers separated by commas, not '" + text + "'";
+      *why = "--" + option + " expects numbers separated by commas, not " + inQuotes(text);
       return false;
     }
     out.push_back(v);

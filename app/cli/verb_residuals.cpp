@@ -3,6 +3,7 @@
 #include <nlohmann/json.hpp>
 #include <ostream>
 
+#include "core/common/text.h"
 #include "app/cli/cli.h"
 #include "app/cli/evaluation_args.h"
 #include "core/compare/compare_json.h"
@@ -55,7 +56,7 @@ int runResiduals(const std::vector<std::string>& argv, std::ostream& out, std::o
   ResidualsRequest request;
   if (const auto on = args.value("on")) {
     const auto r = dataRangeFromString(*on);
-    if (!r) return usage("--on must be estimation or validation, not '" + *on + "'");
+    if (!r) return usage("--on must be estimation or validation, not " + inQuotes(*on));
     request.range = *r;
   }
   if (args.value("lags") && !args.integer("lags", request.options.maxLag, 1, 100000)) return usage(args.error());

@@ -7,6 +7,7 @@
 #include <nlohmann/json.hpp>
 #include <ostream>
 
+#include "core/common/text.h"
 #include "app/cli/cli.h"
 #include "app/cli/model_args.h"
 #include "app/cli/verb_fleet.h"
@@ -167,7 +168,7 @@ int runSimulate(const std::vector<std::string>& argv, std::ostream& out, std::os
   SimulationOptions o;
   if (auto e = args.value("excitation")) {
     auto kind = excitationKindFromString(*e);
-    if (!kind) return usage("--excitation must be chirp, multisine, prbs or none, not '" + *e + "'");
+    if (!kind) return usage("--excitation must be chirp, multisine, prbs or none, not " + inQuotes(*e));
     o.excitation.kind = *kind;
   }
   long seed = 1;
@@ -195,11 +196,11 @@ int runSimulate(const std::vector<std::string>& argv, std::ostream& out, std::os
   if (!args.number("rate", o.logRateHz)) return usage(args.error());
   if (auto c = args.value("chirp");
       c && !parsePair(*c, o.excitation.chirpStartHz, o.excitation.chirpEndHz))
-    return usage("--chirp expects HZ0:HZ1, got '" + *c + "'");
+    return usage("--chirp expects HZ0:HZ1, got " + inQuotes(*c));
   if (auto l = args.value("multisine-lines")) {
     double a = 0, b = 0;
     if (!parsePair(*l, a, b) || a != std::floor(a) || b != std::floor(b))
-      return usage("--multisine-lines expects K0:K1 (integers), got '" + *l + "'");
+      return usage("--multisine-lines expects K0:K1 (integers), got " + inQuotes(*l));
     o.excitation.multisineFirstLine = static_cast<int>(a);
     o.excitation.multisineLastLine = static_cast<int>(b);
   }
@@ -228,7 +229,7 @@ int runSimulate(const std::vector<std::string>& argv, std::ostream& out, std::os
   if (!model) return kExitUsage;
   for (const auto& s : o.parameterSteps) {
     const int i = model->indexOf(s.name);
-    if (i < 0) return usage("--step: the " + model->structureName() + " model has no parameter '" + s.name + "'");
+    if (i < 0) return usage("--step: the " + model->structureName() + " model has no parameter " + inQuotes(s.name));
     const auto& p = model->parameters()[static_cast<std::size_t>(i)];
     if (s.value < p.lower || s.value > p.upper)
       return usage("--step " + toString(s) + ": the value is outside " + s.name + "'s bounds");

@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <stdexcept>
 
+#include "core/common/text.h"
 #include "core/diagnosis/diagnosis_temperature.h"
 #include "core/diagnosis/simulate_like.h"
 #include "core/ident/closed_loop_pem.h"
@@ -216,7 +217,7 @@ DiagnosisReference referenceFromSignals(const PhysicalModel& start, const Diagno
 DiagnosisReference withSeedFault(const DiagnosisReference& reference, const DiagnosisOptions& options,
                                  const std::string& name, double factor) {
   if (std::find(options.parameters.begin(), options.parameters.end(), name) == options.parameters.end())
-    throw std::invalid_argument("a seed fault needs a monitored parameter, not '" + name + "'");
+    throw std::invalid_argument("a seed fault needs a monitored parameter, not " + inQuotes(name));
   if (!reference.nominal) throw std::invalid_argument("the reference has no theta_0");
   if (!(factor > 0.0) || !std::isfinite(factor))
     throw std::invalid_argument("a seed fault's factor must be a positive number");

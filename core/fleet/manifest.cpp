@@ -10,6 +10,8 @@
 #include <sstream>
 #include <tuple>
 
+#include "core/common/text.h"
+
 namespace flexarm {
 
 namespace {
@@ -55,13 +57,6 @@ bool readInt(std::string_view s, std::size_t digits, long& out) {
     out = out * 10 + (c - '0');
   }
   return true;
-}
-
-// A field as a message quotes it: at most 100 characters, control characters as '?'.
-std::string quote(std::string_view s) {
-  std::string out;
-  for (char c : s.substr(0, 100)) out += static_cast<unsigned char>(c) < 0x20 || c == 0x7f ? '?' : c;
-  return "'" + out + (s.size() > 100 ? "...' (" + std::to_string(s.size()) + " characters)" : "'");
 }
 
 bool hasControl(std::string_view s) {
@@ -198,7 +193,7 @@ std::optional<FleetManifest> parseFleetManifest(std::string_view text, const std
       if (body.rfind("flexarm-fleet:", 0) == 0) {
         const std::string_view v = trim(body.substr(14));
         if (v != "1")
-          return fail(lineNo, "", "manifest version " + quote(v) + " is not one this FlexArm reads (version 1)");
+          return fail(lineNo, "", "manifest version " + inQuotes(v) + " is not one this FlexArm reads (version 1)");
         versioned = true;
       }
       continue;
@@ -213,7 +208,7 @@ std::optional<FleetManifest> parseFleetManifest(std::string_view text, const std
                   : name == "log" ? &iLog : name == "temperature_c" ? &iTemp : name == "role" ? &iRole
                   : nullptr;
         if (!slot)
-          return fail(lineNo, name.size() <= 100 && !hasControl(name) ? name : quote(name), "unknown column (robot, axis, time, log, temperature_c, role)");
+          return fail(lineNo, name.size() <= 100 && !hasControl(name) ? name : inQuotes(name), "unknown column (robot, axis, time, log, temperature_c, role)");
         if (*slot >= 0) return fail(lineNo, name, "the column appears twice");
         *slot = static_cast<int>(i);
         header.push_back(name);
@@ -234,25 +229,25 @@ std::optional<FleetManifest> parseFleetManifest(std::string_view text, const std
     e.robot = std::string(fields[static_cast<std::size_t>(iRobot)]);
     if (e.robot.empty() || e.robot.size() > 64 || e.robot.find_first_of("/\\\"") != std::string::npos ||
         hasControl(e.robot))
-      return fail(lineNo, "robot", quote(e.robot) + ": a robot needs a name of 1 to 64 characters without / \\ \" or control characters");
+      return fail(lineNo, "robot", inQuotes(e.robot) + ": a robot needs a name of 1 to 64 characters without / \\ \" or control characters");
     {
       const std::string a(fields[static_cast<std::size_t>(iAxis)]);
       if (a.empty() || a.size() > 2 || a.find_first_not_of("0123456789") != std::string::npos ||
           (e.axis = std::stoi(a)) < 1 || e.axis > 64)
-        return fail(lineNo, "axis", quote(a) + " is not an axis number from 1 to 64");
+        return fail(lineNo, "axis", inQuotes(a) + " is not an axis number from 1 to 64");
     }
     e.time = std::string(fields[static_cast<std::size_t>(iTime)]);
     const auto day = parseIsoDay(e.time);
-    if (!day) return fail(lineNo, "time", quote(e.time) + " is not an ISO 8601 UTC time (2026-03-01T06:00:00Z)");
+    if (!day) return fail(lineNo, "time", inQuotes(e.time) + " is not an ISO 8601 UTC time (2026-03-01T06:00:00Z)");
     e.day = *day;
     e.log = std::string(fields[static_cast<std::size_t>(iLog)]);
     if (e.log.empty()) return fail(lineNo, "log", "the log's path is empty");
-    if (hasControl(e.log)) return fail(lineNo, "log", quote(e.log) + ": a path with control characters");
+    if (hasControl(e.log)) return fail(lineNo, "log", inQuotes(e.log) + ": a path with control characters");
     const std::filesystem::path lp(e.log);
     e.path = lp.is_absolute() || folder.empty() ? e.log : (folder / lp).string();
     if (!options.allowLogsOutside && !insideFolder(e.path, folder))
-      return fail(lineNo, "log", quote(e.log) + " lies outside the manifest's folder " +
-                                     quote(folder.empty() ? "." : folder.string()) +
+      return fail(lineNo, "log", inQuotes(e.log) + " lies outside the manifest's folder " +
+                                     inQuotes(folder.empty() ? "." : folder.string()) +
                                      " (links resolved); FlexArm reads only the logs beside their manifest unless "
                                      "told otherwise (--allow-logs-outside)");
     if (iTemp >= 0) {
@@ -260,14 +255,14 @@ std::optional<FleetManifest> parseFleetManifest(std::string_view text, const std
       if (!t.empty()) {
         const auto v = decimal(t);
         if (!v || *v < -100.0 || *v > 300.0)
-          return fail(lineNo, "temperature_c", quote(t) + " is not a temperature in degC (-100 to 300)");
+          return fail(lineNo, "temperature_c", inQuotes(t) + " is not a temperature in degC (-100 to 300)");
         e.temperatureC = *v;
       }
     }
     if (iRole >= 0) {
       const std::string_view r = fields[static_cast<std::size_t>(iRole)];
       if (r == "reference") e.reference = true;
-      else if (!r.empty()) return fail(lineNo, "role", quote(r) + " is not a role (reference, or empty)");
+      else if (!r.empty()) return fail(lineNo, "role", inQuotes(r) + " is not a role (reference, or empty)");
     }
     if (!seen.insert({e.robot, e.axis, e.time}).second)
       return fail(lineNo, "time", "robot " + e.robot + " axis " + std::to_string(e.axis) +

@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <stdexcept>
 
+#include "core/common/text.h"
 #include "core/signal/excitation.h"
 
 namespace flexarm {
@@ -84,7 +85,7 @@ PreparedData prepareFitData(const IdData& data, const FitDataOptions& options) {
   }
   if (!options.reference.empty() && !ref)
     return fail("the log has no channel '" + options.reference + "' for the reference");
-  if (in == outCh) return fail("the input and the output are the same channel '" + in->name + "'");
+  if (in == outCh) return fail("the input and the output are the same channel " + inQuotes(in->name));
   // Dead data (a stuck encoder, a zero torque, values too large to square) are refused here,
   // before any estimator or diagnosis runs on them.
   if (std::string dead = deadDataProblem(data, {in->name, outCh->name, columns::kArmAngle}); !dead.empty()) return fail(dead);

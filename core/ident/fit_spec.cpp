@@ -1,4 +1,5 @@
 #include "core/ident/fit_spec.h"
+#include "core/common/text.h"
 
 #include <algorithm>
 #include <cctype>
@@ -67,7 +68,7 @@ std::optional<FitModelSpec> fitModelSpecFromText(const std::string& text, bool a
     if (text.size() > head.size() &&
         (text[head.size()] != ':' || !wholeNumbers(text.substr(head.size() + 1), ',', v) || v.size() != 1 ||
          v[0] < 0))
-      return fail(head + ":W takes one non-negative window width, not '" + text + "'");
+      return fail(head + ":W takes one non-negative window width, not " + inQuotes(text));
     spec.windowWidth = v.empty() ? 0 : v[0];
     return spec;
   }
@@ -81,14 +82,14 @@ std::optional<FitModelSpec> fitModelSpecFromText(const std::string& text, bool a
   const bool named = s && text.size() > head.size() + 1 && text[head.size()] == '[' && text.back() == ']';
   const bool typed = s && text.size() > head.size() && text[head.size()] == ':';
   if (!named && !typed)
-    return fail("a model is " + fitModelSpecGrammar(allowNonparametric) + ", not '" + text + "'");
+    return fail("a model is " + fitModelSpecGrammar(allowNonparametric) + ", not " + inQuotes(text));
   const std::string numbers =
       named ? text.substr(head.size() + 1, text.size() - head.size() - 2) : text.substr(head.size() + 1);
   std::vector<int> v;
   const auto& orders = polyOrdersOf(*s);
   if (!wholeNumbers(numbers, named ? ' ' : ',', v) || v.size() != orders.size())
     return fail(head + " needs " + std::to_string(orders.size()) + (named ? " " : " comma-separated ") +
-                "integers (" + orderList(*s, false) + "), not '" + numbers + "'");
+                "integers (" + orderList(*s, false) + "), not " + inQuotes(numbers));
   spec.kind = FitModelKind::BlackBox;
   spec.structure = *s;
   spec.orders = PolyOrders{0, 0, 0, 0, 0, 0};
@@ -232,7 +233,7 @@ bool applyParameterOption(FitOptions& options, ParameterOption kind, const std::
   }
   if (kind == ParameterOption::Bound) {
     const auto b = parameterBoundFromText(text);
-    if (!b) return fail("expects NAME=LO:HI with LO <= HI (numbers, or -inf/inf), not '" + text + "'");
+    if (!b) return fail("expects NAME=LO:HI with LO <= HI (numbers, or -inf/inf), not " + inQuotes(text));
     if (spec.start->indexOf(b->name) < 0) return fail(unknownFitParameter(spec, b->name));
     options.bounds.push_back(*b);
     return true;
@@ -240,7 +241,7 @@ bool applyParameterOption(FitOptions& options, ParameterOption kind, const std::
   const bool valued = text.find('=') != std::string::npos;
   const auto v = parameterValueFromText(text);
   if ((valued || kind == ParameterOption::Start) && !v)
-    return fail("expects NAME=VALUE (a finite number), not '" + text + "'");
+    return fail("expects NAME=VALUE (a finite number), not " + inQuotes(text));
   const std::string name = v ? v->name : text;
   const FitParameterRef ref = findFitParameter(spec, name);
   if (!ref.found()) return fail(unknownFitParameter(spec, name));

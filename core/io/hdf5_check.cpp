@@ -5,6 +5,7 @@
 // Everything else a file could use (dense storage in fractal heaps, chunk indexes other than
 // the version-1 B-tree, a single chunk or an implicit index) is refused by name: MATLAB does not
 // write it.
+#include "core/common/text.h"
 #include "core/io/hdf5_check.h"
 
 #include <zlib.h>
@@ -559,7 +560,7 @@ class Walker {
 
   void addLink(Object& o, std::string linkName, std::uint64_t target, const std::string& path) {
     if (linkName.empty() || linkName.find('/') != std::string::npos || linkName == "." )
-      refuse(path + " holds a link with an impossible name '" + linkName + "'");
+      refuse(path + " holds a link with an impossible name " + inQuotes(linkName));
     o.group = true;
     o.links.push_back({std::move(linkName), target});
     if (o.links.size() > static_cast<std::size_t>(limits_.maxObjects))

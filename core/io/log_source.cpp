@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <filesystem>
 
+#include "core/common/text.h"
 #include "core/io/input_file.h"
 #include "core/io/reader_support.h"
 
@@ -104,7 +105,7 @@ SeriesRead readSourceSeries(const std::string& path, const SourceListing& listin
       out.values = listing.columns[i];
       return out;
     }
-  out.error = ReadError{path, 0, 0, name, "the file has no column '" + name + "'"};
+  out.error = ReadError{path, 0, 0, name, "the file has no column " + inQuotes(name)};
   return out;
 }
 

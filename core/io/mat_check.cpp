@@ -8,6 +8,7 @@
 #include <memory>
 #include <vector>
 
+#include "core/common/text.h"
 #include "core/io/hdf5_check.h"
 
 namespace flexarm {
@@ -134,7 +135,7 @@ class Level5 {
     p += dims.total;
     std::string text;
     if (!nameTag(p, end, where0, name, text)) return false;
-    const std::string where = name.nbytes ? "variable '" + text + "'" : where0;
+    const std::string where = name.nbytes ? "variable " + inQuotes(text) : where0;
     p += name.total;
     if (out) {
       if (name.nbytes) out->name = text;  // a field keeps the name its struct gives it
@@ -212,7 +213,7 @@ class Level5 {
     std::string text, systemText, classText;
     if (!nameTag(p, end, where0, name, text)) return false;
     p += name.total;
-    const std::string where = name.nbytes ? "variable '" + text + "'" : where0;
+    const std::string where = name.nbytes ? "variable " + inQuotes(text) : where0;
     if (!nameTag(p, end, where, system, systemText)) return false;
     p += system.total;
     if (!nameTag(p, end, where, className, classText)) return false;

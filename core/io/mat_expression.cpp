@@ -1,4 +1,5 @@
 #include "core/io/mat_expression.h"
+#include "core/common/text.h"
 
 #include <algorithm>
 #include <cctype>
@@ -314,7 +315,7 @@ bool selectMatVector(const std::vector<MatVariable>& variables, const MatExpress
         if (brace && node->arrayClass != 1) return fail("'" + where + "' is " + describe(*node) + ", not a cell array");
         if (node->arrayClass == 1 || node->arrayClass == 2) {
           std::uint64_t index = 0;
-          if (!oneElement(step.subscripts, node->dims, "'" + where + "'", index, why)) return false;
+          if (!oneElement(step.subscripts, node->dims, "" + inQuotes(where), index, why)) return false;
           const std::uint64_t perElement = node->arrayClass == 2 ? std::max<std::size_t>(node->fields.size(), 1) : 1;
           const std::uint64_t child = node->arrayClass == 1 ? index : index * perElement;
           if (node->arrayClass == 2 && node->fields.empty())

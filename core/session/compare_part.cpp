@@ -1,5 +1,6 @@
 // The session parts "compare", "residuals" and "sensitivity" (compare_part.h): their requests
 // as JSON and their replay. The report sections are in compare_report.cpp.
+#include "core/common/text.h"
 #include "core/session/compare_part.h"
 
 #include <filesystem>
@@ -57,7 +58,7 @@ const EvaluatedModel* findModel(const std::vector<EvaluatedModel>& models, const
     if ((name.empty() || m.name == name) && (!physicalOnly || m.physical)) found = &m;
   if (!found && why)
     *why = name.empty() ? std::string(physicalOnly ? "the model list holds no physical model" : "the model list is empty")
-                        : "the model list holds no model '" + name + "'";
+                        : "the model list holds no model " + inQuotes(name);
   return found;
 }
 

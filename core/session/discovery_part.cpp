@@ -1,5 +1,6 @@
 #include "core/session/discovery_part.h"
 
+#include "core/common/text.h"
 #include "core/discovery/discovery_json.h"
 
 #include <cmath>
@@ -183,7 +184,7 @@ std::optional<IdData> pickData(const DiscoveryDataRef& ref, bool raw, const Repl
   const SampleRange r = d->rangeForTimes(ref.range->start, ref.range->end);
   if (r.size() < 10) {
     *why = "the range " + formatSignificant(ref.range->start) + "-" + formatSignificant(ref.range->end) +
-           " s holds " + std::to_string(r.size()) + " samples of log '" + ref.log + "'";
+           " s holds " + std::to_string(r.size()) + " samples of log " + inQuotes(ref.log);
     return std::nullopt;
   }
   return d->select(r);
@@ -422,7 +423,7 @@ bool DiscoveryRequest::isValid(std::string* why) const {
     bool known = false;
     for (const char* s : kStructures) known = known || baseStructure == s;
     if (!known) {
-      if (why) *why = "the base structure must be two-mass, three-mass or four-mass, not '" + baseStructure + "'";
+      if (why) *why = "the base structure must be two-mass, three-mass or four-mass, not " + inQuotes(baseStructure);
       return false;
     }
   }
@@ -474,7 +475,7 @@ std::optional<DiscoveryRequest> discoveryRequestFromJson(const json& j, std::str
   std::string data = "preprocessed";
   if (!readText(j, "data", data, false, why, where)) return std::nullopt;
   if (data != "preprocessed" && data != "as-read") {
-    if (why) *why = where + "data must be \"preprocessed\" or \"as-read\", not '" + data + "'";
+    if (why) *why = where + "data must be \"preprocessed\" or \"as-read\", not " + inQuotes(data);
     return std::nullopt;
   }
   q.rawData = data == "as-read";
@@ -539,7 +540,7 @@ bool candidatesFromJson(const json& j, std::vector<CandidateFit>& out, std::stri
     }
     auto k = effectKindFromString(name);
     if (!k) {
-      if (why) *why = cw + "unknown effect '" + name + "'";
+      if (why) *why = cw + "unknown effect " + inQuotes(name);
       return false;
     }
     f.kind = *k;
@@ -584,7 +585,7 @@ std::optional<DiscoveryResult> discoveryResultFromJson(const json& j, std::strin
   if (effect != "none") {
     r.effect = effectKindFromString(effect);
     if (!r.effect) {
-      if (why) *why = where + "unknown effect '" + effect + "'";
+      if (why) *why = where + "unknown effect " + inQuotes(effect);
       return std::nullopt;
     }
   }
@@ -654,7 +655,7 @@ std::optional<DiscoveryResult> discoveryResultFromJson(const json& j, std::strin
         return std::nullopt;
       const auto k = effectKindFromString(name);
       if (!k) {
-        if (why) *why = tw + "unknown effect '" + name + "'";
+        if (why) *why = tw + "unknown effect " + inQuotes(name);
         return std::nullopt;
       }
       x.kind = *k;
@@ -677,7 +678,7 @@ std::optional<DiscoveryResult> discoveryResultFromJson(const json& j, std::strin
   if (!termination.empty()) {
     const auto t = terminationFromString(termination);
     if (!t) {
-      if (why) *why = where + "unknown termination '" + termination + "'";
+      if (why) *why = where + "unknown termination " + inQuotes(termination);
       return std::nullopt;
     }
     r.termination = *t;

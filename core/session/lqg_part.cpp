@@ -2,6 +2,7 @@
 
 #include <cmath>
 
+#include "core/common/text.h"
 #include "core/session/report.h"
 
 namespace flexarm {
@@ -232,7 +233,7 @@ std::optional<LqgRequest> lqgRequestFromJson(const json& j, std::string* why) {
     for (const auto& [name, value] : j["parameters"].items()) {
       bool known = false;
       for (const auto& n : TwoMassLqgParameters::names()) known = known || n == name;
-      if (!known) return fail("unknown parameter '" + name + "'");
+      if (!known) return fail("unknown parameter " + inQuotes(name));
       if (!value.is_number()) return fail("parameter " + name + " must be a number");
       r.design.parameters.set(name, value.get<double>());
     }

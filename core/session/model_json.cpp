@@ -1,4 +1,5 @@
 #include "core/session/model_json.h"
+#include "core/common/text.h"
 
 #include <cmath>
 #include <set>
@@ -102,7 +103,7 @@ std::optional<ModelSpec> findListModel(const nlohmann::json& models, const std::
       auto spec = modelFromJson(m, why);
       if (spec && spec->name == name) return spec;
     }
-  if (why) *why = "the model list has no model named '" + name + "'";
+  if (why) *why = "the model list has no model named " + inQuotes(name);
   return std::nullopt;
 }
 

@@ -2,6 +2,7 @@
 
 #include <cmath>
 
+#include "core/common/text.h"
 #include "core/session/fit_request.h"
 #include "core/session/model_json.h"
 #include "core/session/report.h"
@@ -165,7 +166,7 @@ class RecursivePart : public SessionPart {
     if (context.rawLogs)
       for (const auto& [name, data] : *context.rawLogs)
         if (q.log.empty() ? log == nullptr : name == q.log) log = data;
-    if (!log) return fail(context.rawLogs ? "the session has no log named '" + q.log + "'"
+    if (!log) return fail(context.rawLogs ? "the session has no log named " + inQuotes(q.log)
                                           : "the logs as read are not available");
     RecursiveLogResult run;
     try {
@@ -322,16 +323,16 @@ std::optional<RecursiveRequest> recursiveRequestFromJson(const json& j, std::str
     return fail("decimation must be 0 (to the highest rate) or a positive whole number");
   q.data.decimation = static_cast<int>(decimation);
   const auto a = recursiveAlgorithmFromString(algorithm);
-  if (!a) return fail("algorithm must be forgetting or kalman, not '" + algorithm + "'");
+  if (!a) return fail("algorithm must be forgetting or kalman, not " + inQuotes(algorithm));
   o.algorithm = *a;
   const auto t = recursiveTrackingFromString(tracking);
-  if (!t) return fail("tracking must be fixed, variable or bank, not '" + tracking + "'");
+  if (!t) return fail("tracking must be fixed, variable or bank, not " + inQuotes(tracking));
   o.tracking = *t;
   if (bankSize != std::floor(bankSize) || bankSize < 1.0 || bankSize > 64.0)
     return fail("bank_size must be a whole number from 1 to 64");
   o.bankSize = static_cast<int>(bankSize);
   const auto g = recursiveGradientFromString(gradient);
-  if (!g) return fail("gradient must be sensitivity or difference, not '" + gradient + "'");
+  if (!g) return fail("gradient must be sensitivity or difference, not " + inQuotes(gradient));
   o.gradient = *g;
   if (!q.isValid(&reason)) return fail(reason);
   return q;
@@ -367,7 +368,7 @@ std::unique_ptr<PhysicalModel> recursiveNominalModel(const RecursiveRequest& q, 
       auto c = spec->model->clone();
       return std::unique_ptr<PhysicalModel>(static_cast<PhysicalModel*>(c.release()));
     }
-  *why = "the model list has no model named '" + q.model + "'";
+  *why = "the model list has no model named " + inQuotes(q.model);
   return nullptr;
 }
 

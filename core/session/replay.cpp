@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <stdexcept>
 
+#include "core/common/text.h"
 #include "core/session/session_part.h"
 #include "core/session/sha256.h"
 #include "core/signal/preprocess.h"
@@ -27,7 +28,7 @@ PreparedSession prepareSession(const Session& session, const std::string& sessio
     bool known = false;
     for (const auto& l : session.logs) known = known || l.name == name;
     if (!known) {
-      out.message = "the session has no log named '" + name + "'";
+      out.message = "the session has no log named " + inQuotes(name);
       return out;
     }
   }

@@ -6,6 +6,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "core/common/text.h"
 #include "core/io/input_file.h"
 #include "core/session/session_part.h"
 
@@ -123,7 +124,7 @@ bool readOptionsFromJson(const json& j, const std::string& where, LogReadOptions
       o.format = k;
       known = true;
     }
-  if (!known) return f.fail(where + ".format", "unknown log format '" + format + "'");
+  if (!known) return f.fail(where + ".format", "unknown log format " + inQuotes(format));
   f.integer(j, "input_column", where, o.inputColumn, false);
   f.integer(j, "output_column", where, o.outputColumn, false);
   f.integer(j, "time_column", where, o.timeColumn, false);
@@ -142,12 +143,12 @@ bool readOptionsFromJson(const json& j, const std::string& where, LogReadOptions
     f.string(j, key, where, text, false);
     if (text.empty()) continue;
     *unit = signalUnitFromString(text);
-    if (!*unit) return f.fail(where + "." + key, "unknown unit '" + text + "'");
+    if (!*unit) return f.fail(where + "." + key, "unknown unit " + inQuotes(text));
   }
   std::string side;
   f.string(j, "output_side", where, side, false);
   if (!side.empty() && !(m.outputSide = encoderSideFromString(side)))
-    return f.fail(where + ".output_side", "must be motor or arm, not '" + side + "'");
+    return f.fail(where + ".output_side", "must be motor or arm, not " + inQuotes(side));
   f.string(j, "gear_ratio", where, m.gearRatio, false);
   f.number(j, "input_scale", where, m.inputScale, false);
   f.number(j, "max_sample_jitter", where, o.maxSampleJitter, false);
@@ -170,7 +171,7 @@ bool resampleFromJson(const json& j, const std::string& where, UniformGridOption
   std::string method;
   if (f.string(j, "method", where, method)) {
     auto m = interpolationMethodFromString(method);
-    if (!m) return f.fail(where + ".method", "unknown method '" + method + "'");
+    if (!m) return f.fail(where + ".method", "unknown method " + inQuotes(method));
     r.method = *m;
   }
   f.number(j, "max_gap_s", where, r.maxGapSeconds, false);
@@ -214,7 +215,7 @@ bool preprocessFromJson(const json& j, Session& s, FieldReader& f) {
     std::string filter;
     if (f.string(*d, "filter", where + ".decimation", filter)) {
       auto k = antiAliasFilterFromString(filter);
-      if (!k) return f.fail(where + ".decimation.filter", "unknown filter '" + filter + "'");
+      if (!k) return f.fail(where + ".decimation.filter", "unknown filter " + inQuotes(filter));
       p.decimation.filter = *k;
     }
     f.number(*d, "stopband_db", where + ".decimation", p.decimation.stopbandDb);
@@ -222,7 +223,7 @@ bool preprocessFromJson(const json& j, Session& s, FieldReader& f) {
   std::string detrend;
   if (f.string(j, "detrend", where, detrend)) {
     auto k = detrendFromString(detrend);
-    if (!k) return f.fail(where + ".detrend", "unknown detrend '" + detrend + "'");
+    if (!k) return f.fail(where + ".detrend", "unknown detrend " + inQuotes(detrend));
     p.detrend = *k;
   }
   if (f.failed()) return false;

@@ -7,6 +7,7 @@
 #include <cctype>
 #include <set>
 
+#include "core/common/text.h"
 #include "core/models/analysis.h"
 #include "core/models/nonlinear_plant.h"
 #include "core/session/compare_part.h"
@@ -251,7 +252,7 @@ const IdData* findLog(const ReplayContext& context, const std::string& name, boo
   const IdData* d = nullptr;
   for (const auto& [logName, data] : *logs)
     if (name.empty() ? d == nullptr : logName == name) d = data;
-  if (!d && why) *why = "the session has no log named '" + name + "'";
+  if (!d && why) *why = "the session has no log named " + inQuotes(name);
   return d;
 }
 

@@ -6,6 +6,7 @@
 #include <complex>
 #include <stdexcept>
 
+#include "core/common/text.h"
 #include "core/common/fft.h"
 
 namespace flexarm {
@@ -43,7 +44,7 @@ std::vector<double> differentiate(const std::vector<double>& x, double sampleTim
 IdData addDerivative(const IdData& data, const std::string& from, const std::string& to,
                      bool makeOutput) {
   const Channel* src = data.channel(from);
-  if (!src) throw std::invalid_argument("addDerivative: the data have no channel '" + from + "'");
+  if (!src) throw std::invalid_argument("addDerivative: the data have no channel " + inQuotes(from));
   IdData out = data;
   Channel c;
   c.name = to;

@@ -1,4 +1,5 @@
 #include "core/signal/seconds_range.h"
+#include "core/common/text.h"
 
 #include <charconv>
 #include <cmath>
@@ -24,7 +25,7 @@ bool parseSecondsRange(const std::string& text, double& t0, double& t1) {
 std::optional<SecondsRange> secondsRangeFromText(const std::string& text, std::string* why) {
   SecondsRange r;
   if (parseSecondsRange(text, r.start, r.end)) return r;
-  if (why) *why = "a range is written A:B in seconds with A < B, e.g. 2.5:10, not '" + text + "'";
+  if (why) *why = "a range is written A:B in seconds with A < B, e.g. 2.5:10, not " + inQuotes(text);
   return std::nullopt;
 }
 

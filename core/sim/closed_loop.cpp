@@ -9,6 +9,7 @@
 #include <stdexcept>
 #include <utility>
 
+#include "core/common/text.h"
 #include "core/models/nonlinear_plant.h"
 #include "core/sim/random.h"
 
@@ -98,7 +99,7 @@ PlantSchedule schedulePlants(const PhysicalModel& model, const std::vector<Effec
   for (const auto& step : steps) {
     if (model.indexOf(step.name) < 0)
       throw std::invalid_argument("parameter step: the " + model.structureName() +
-                                  " model has no parameter '" + step.name + "'");
+                                  " model has no parameter " + inQuotes(step.name));
     changed->setParameter(step.name, step.value);  // throws outside the bounds
     s.plants.push_back(
         std::make_unique<NonlinearPlant>(dynamic_cast<const PhysicalModel&>(*changed), effects));
@@ -296,7 +297,7 @@ std::optional<ParameterStep> parseParameterStep(const std::string& text, std::st
   if (eq == std::string::npos || eq == 0 || at == std::string::npos ||
       !number(text.substr(eq + 1, at - eq - 1), s.value) || !number(text.substr(at + 1), s.timeS) ||
       s.timeS < 0.0) {
-    if (why) *why = "a parameter step is NAME=VALUE@SECONDS (e.g. k_T=1.2@20), not '" + text + "'";
+    if (why) *why = "a parameter step is NAME=VALUE@SECONDS (e.g. k_T=1.2@20), not " + inQuotes(text);
     return std::nullopt;
   }
   s.name = text.substr(0, eq);

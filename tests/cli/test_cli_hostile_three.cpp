@@ -133,3 +133,16 @@ TEST(HostileThree, ThresholdsSetByHandAreSaidToBeUncalibrated) {
             std::string::npos)
       << settle.err;
 }
+
+TEST(HostileThree, AFileThatIsNotALogIsNamedWithoutItsFirstLine) {
+  // The user named /etc/passwd as a log: it is read (they asked), and refused without its text.
+  const auto temperature =
+      runFlexarm({"diagnose", kHealthy, "--reference-log", kHealthy, "--temperature-logs", "/etc/passwd"});
+  EXPECT_NE(temperature.code, 0);
+  EXPECT_NE(temperature.err.find("/etc/passwd:1"), std::string::npos) << temperature.err;
+  EXPECT_NE(temperature.err.find("not a CSV log's header"), std::string::npos) << temperature.err;
+  EXPECT_EQ(temperature.err.find("root:"), std::string::npos) << temperature.err;
+  const auto info = runFlexarm({"info", "/etc/passwd"});
+  EXPECT_EQ(info.code, 3);
+  EXPECT_EQ(info.err.find("root:"), std::string::npos) << info.err;
+}

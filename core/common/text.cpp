@@ -1,0 +1,12 @@
+#include "core/common/text.h"
+
+namespace flexarm {
+
+std::string inQuotes(std::string_view value, std::size_t most) {
+  std::string out = "'";
+  for (char c : value.substr(0, most)) out += static_cast<unsigned char>(c) < 0x20 || c == 0x7f ? '?' : c;
+  if (value.size() <= most) return out + "'";
+  return out + "...' (" + std::to_string(value.size()) + " characters)";
+}
+
+}  // namespace flexarm

@@ -1,0 +1,14 @@
+#pragma once
+// Text for messages. A message quotes what the user gave so that they see what was read, but
+// never a whole file or a megabyte of command line: at most `most` characters, control
+// characters (a line break that would forge a second line) shown as '?'.
+#include <cstddef>
+#include <string>
+#include <string_view>
+
+namespace flexarm {
+
+// 'value', or 'first 100 characters...' (123456 characters).
+std::string inQuotes(std::string_view value, std::size_t most = 100);
+
+}  // namespace flexarm
