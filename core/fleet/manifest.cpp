@@ -75,14 +75,20 @@ std::optional<double> decimal(std::string_view s) {
   return v;
 }
 
-// Whether `inner`, links resolved, lies inside `folder`.
-bool insideFolder(const std::filesystem::path& inner, const std::filesystem::path& folder) {
+// The folder, links resolved, that a manifest's logs must lie in.
+std::filesystem::path resolvedFolder(const std::filesystem::path& folder) {
   std::error_code ec;
-  const auto f = std::filesystem::weakly_canonical(std::filesystem::absolute(folder.empty() ? "." : folder, ec), ec);
-  if (ec) return false;
+  auto f = std::filesystem::weakly_canonical(std::filesystem::absolute(folder.empty() ? "." : folder, ec), ec);
+  return ec ? std::filesystem::path() : f;
+}
+
+// Whether `inner`, links resolved, lies inside `folder` (resolvedFolder's).
+bool insideFolder(const std::filesystem::path& inner, const std::filesystem::path& folder) {
+  if (folder.empty()) return false;
+  std::error_code ec;
   const auto p = std::filesystem::weakly_canonical(std::filesystem::absolute(inner, ec), ec);
   if (ec) return false;
-  const auto rel = p.lexically_relative(f);
+  const auto rel = p.lexically_relative(folder);
   return !rel.empty() && *rel.begin() != ".." && rel != ".";
 }
 
@@ -176,6 +182,7 @@ std::optional<FleetManifest> parseFleetManifest(std::string_view text, const std
   FleetManifest m;
   m.path = path;
   const std::filesystem::path folder = std::filesystem::path(path).parent_path();
+  const std::filesystem::path inside = options.allowLogsOutside ? std::filesystem::path() : resolvedFolder(folder);
   bool versioned = false;
   std::vector<std::string> header;
   int iRobot = -1, iAxis = -1, iTime = -1, iLog = -1, iTemp = -1, iRole = -1;
@@ -245,7 +252,7 @@ std::optional<FleetManifest> parseFleetManifest(std::string_view text, const std
     if (hasControl(e.log)) return fail(lineNo, "log", inQuotes(e.log) + ": a path with control characters");
     const std::filesystem::path lp(e.log);
     e.path = lp.is_absolute() || folder.empty() ? e.log : (folder / lp).string();
-    if (!options.allowLogsOutside && !insideFolder(e.path, folder))
+    if (!options.allowLogsOutside && !insideFolder(e.path, inside))
       return fail(lineNo, "log", inQuotes(e.log) + " lies outside the manifest's folder " +
                                      inQuotes(folder.empty() ? "." : folder.string()) +
                                      " (links resolved); FlexArm reads only the logs beside their manifest unless "
