@@ -675,15 +675,21 @@ void FitPanel::fillTable(const std::vector<FitParameter>& parameters) {
   table_->setRowCount(static_cast<int>(parameters.size()));
   for (int i = 0; i < static_cast<int>(parameters.size()); ++i) {
     const FitParameter& row = parameters[static_cast<std::size_t>(i)];
+    // An undetermined parameter shows why instead of a std of 0 or nan and an interval.
+    const bool shown = row.free && row.determined;
     const QStringList cells = {QString::fromStdString(fitParameterLabel(row)),
                                number(row.value),
-                               row.free ? number(row.std) : tr("fixed"),
-                               row.free ? number(row.lower) : QString(),
-                               row.free ? number(row.upper) : QString(),
+                               !row.free ? tr("fixed") : shown ? number(row.std) : tr("undetermined"),
+                               shown ? number(row.lower) : QString(),
+                               shown ? number(row.upper) : QString(),
                                QString::fromStdString(row.unit)};
     for (int c = 0; c < cells.size(); ++c) {
       auto* item = new QTableWidgetItem(cells[c]);
       if (!row.free) item->setForeground(QColor(130, 130, 130));
+      if (row.free && !row.determined) {
+        item->setForeground(QColor(180, 60, 0));
+        item->setToolTip(tr("Undetermined: %1.").arg(QString::fromStdString(row.undetermined)));
+      }
       table_->setItem(i, c, item);
     }
   }

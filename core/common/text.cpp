@@ -1,5 +1,7 @@
 #include "core/common/text.h"
 
+#include <cstdio>
+
 namespace flexarm {
 
 std::string inQuotes(std::string_view value, std::size_t most) {
@@ -7,6 +9,12 @@ std::string inQuotes(std::string_view value, std::size_t most) {
   for (char c : value.substr(0, most)) out += static_cast<unsigned char>(c) < 0x20 || c == 0x7f ? '?' : c;
   if (value.size() <= most) return out + "'";
   return out + "...' (" + std::to_string(value.size()) + " characters)";
+}
+
+std::string shortNumber(double value, int digits) {
+  char buf[48];
+  std::snprintf(buf, sizeof buf, "%.*g", digits, value);
+  return buf;
 }
 
 }  // namespace flexarm

@@ -11,4 +11,7 @@ namespace flexarm {
 // 'value', or 'first 100 characters...' (123456 characters).
 std::string inQuotes(std::string_view value, std::size_t most = 100);
 
+// A number in a sentence: %g with `digits` significant digits ("0.0355", "1.5e+05", "nan").
+std::string shortNumber(double value, int digits = 3);
+
 }  // namespace flexarm

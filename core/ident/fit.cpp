@@ -418,7 +418,7 @@ bool fitBlackBox(const FitOptions& o, FitResult& r, const ProgressCallback& prog
   for (std::size_t i = 0; i < names.size(); ++i) {
     const auto k = static_cast<Eigen::Index>(i);
     const double s = sd.size() > k ? sd[k] : 0.0;
-    r.parameters.push_back({names[i], "", th[k], s, th[k] - z * s, th[k] + z * s, true, ""});
+    r.parameters.push_back({names[i], "", th[k], s, th[k] - z * s, th[k] + z * s, true, "", true, {}});
   }
   r.polynomial = std::make_shared<PolynomialModel>(std::move(e.model));
   return true;
@@ -579,6 +579,7 @@ FitResult fitModel(const FitOptions& options, const ProgressCallback& progress) 
       if (!fit_detail::fitIdim(options, r)) return finish(r.termination, r.message);
       r.response = fitResponse(r, fitFrequencyGrid(r.data, options.responsePoints), options.level);
       fit_detail::plausibilityChecks(options, r);
+      fit_detail::assessDeterminacy(options, r);
     } catch (const std::exception& e) {
       return finish(Termination::Failed, std::string("inverse dynamics failed: ") + e.what());
     }
@@ -625,6 +626,7 @@ FitResult fitModel(const FitOptions& options, const ProgressCallback& progress) 
   try {
     fit_detail::evaluate(options, r);
     fit_detail::plausibilityChecks(options, r);
+    fit_detail::assessDeterminacy(options, r);
   } catch (const std::exception& e) {
     return finish(Termination::Failed, std::string("the estimate could not be evaluated: ") + e.what());
   }

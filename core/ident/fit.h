@@ -231,6 +231,12 @@ struct FitParameter {
   double value = 0.0, std = 0.0, lower = 0.0, upper = 0.0;  // interval at FitOptions::level
   bool free = false;
   std::string effect;  // the effect it belongs to ("coulomb_friction"); empty: the model's
+  // A free parameter the data do not determine (fit_detail::assessDeterminacy): its std is 0
+  // or not finite (the loss is flat or singular along it), it sits on a bound (the curvature's
+  // interval does not hold there), or its interval is wider than its value. `undetermined`
+  // says which, as a clause; std and the interval are then not to be quoted.
+  bool determined = true;
+  std::string undetermined;
 };
 
 // The evaluation on one experiment. Validation: data with the estimation data's means, fit %
@@ -389,6 +395,10 @@ struct FitResult {
   // range of robot axes, a resonance the data cannot see, a gear ratio the log never stated.
   // Empty: nothing absurd found.
   std::vector<std::string> plausibility;
+  // When parameters are undetermined and the covariance says along what: the combination of
+  // the free physical parameters the data fix least (the largest eigenvector of their
+  // covariance relative to their values), "J_a +0.92, k_a -0.39"; empty otherwise.
+  std::string undeterminedDirection;
   // A physical fit on a log with an arm-side encoder: the deflection it predicts.
   std::optional<DeflectionCheck> deflection;
 

@@ -92,7 +92,7 @@ bool fitIdim(const FitOptions& o, FitResult& r) {
   r.summary.message = e.message;
   r.summary.iterations = 0;
   r.summary.loss = (e.torque - e.predicted).squaredNorm() / std::max<Eigen::Index>(1, e.torque.size());
-  for (const auto& p : e.parameters) r.parameters.push_back({p.name, p.unit, p.value, p.std, p.lower, p.upper, true, ""});
+  for (const auto& p : e.parameters) r.parameters.push_back({p.name, p.unit, p.value, p.std, p.lower, p.upper, true, "", true, {}});
   // The rigid model (3.10) of the estimate, for its response: J_m the whole inertia, J_a at
   // its least, f_m the viscous friction (torque reference per unit of speed).
   auto rigid = makeModel("rigid", ModelOptions{ModelOutput::MotorVelocity, false});

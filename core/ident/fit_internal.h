@@ -55,8 +55,15 @@ void idimStart(FitOptions& options, FitResult& result);
 // against the measured one (FitResult::deflection).
 void deflectionCheck(const FitOptions& options, FitResult& result);
 
+// Whether a bound warning says the named parameter ended on its bound.
+bool sitsOnBound(const FitResult& result, const std::string& name);
+
 // Step 5 for physical fits: FitResult::plausibility.
 void plausibilityChecks(const FitOptions& options, FitResult& result);
+
+// Step 5, after the plausibility checks: FitParameter::determined and undetermined, and
+// FitResult::undeterminedDirection.
+void assessDeterminacy(const FitOptions& options, FitResult& result);
 
 // Step 5: fit % on every experiment, residual tests, response, notches and peaks, warnings.
 void evaluate(const FitOptions& options, FitResult& result);

@@ -115,7 +115,9 @@ void addFitParameters(json& j, const std::vector<FitParameter>& rows) {
               {"std", finiteOrNull(p.std)},
               {"lower", finiteOrNull(p.lower)},
               {"upper", finiteOrNull(p.upper)},
-              {"free", p.free}};
+              {"free", p.free},
+              {"determined", p.determined},
+              {"undetermined", p.determined ? json(nullptr) : json(p.undetermined)}};
     if (!p.effect.empty()) q["effect"] = p.effect;
     table.push_back(q);
   }
@@ -170,6 +172,7 @@ json fitResultJson(const FitResult& fit, const FitLogNames& logs) {
             {"covariance", toString(fit.covarianceKind)},
             {"residuals", residualsJson(fit)}});
   addFitParameters(j, fit.parameters);
+  j["undetermined_direction"] = fit.undeterminedDirection.empty() ? json(nullptr) : json(fit.undeterminedDirection);
   return j;
 }
 

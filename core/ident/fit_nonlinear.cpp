@@ -182,12 +182,12 @@ void keepNonlinear(NonlinearPemResult&& e, const FitOptions& o, const PhysicalMo
   std::size_t row = 0;
   for (; row < e.model->parameters().size(); ++row) {
     const auto& p = e.parameters[row];
-    r.parameters.push_back({p.name, p.unit, p.value, p.std, p.lower, p.upper, p.free, ""});
+    r.parameters.push_back({p.name, p.unit, p.value, p.std, p.lower, p.upper, p.free, "", true, {}});
   }
   for (const auto& fx : e.effects)
     for (std::size_t k = 0; k < fx.values.size(); ++k, ++row) {
       const auto& p = e.parameters[row];
-      r.parameters.push_back({p.name, p.unit, p.value, p.std, p.lower, p.upper, p.free, toString(fx.kind)});
+      r.parameters.push_back({p.name, p.unit, p.value, p.std, p.lower, p.upper, p.free, toString(fx.kind), true, {}});
     }
   const auto pf = static_cast<Eigen::Index>(e.freeIndices.size());
   if (pf > 0 && e.covariance.rows() >= pf) {

@@ -157,7 +157,7 @@ void keepEstimate(PemResult&& e, const FitOptions& o, FitResult& r) {
     r.warn(FitWarning::SkippedStarts, std::to_string(e.skippedStarts) + " of " + std::to_string(e.starts) +
                          " starts were skipped for numerical trouble (" + e.skipReason + ")");
   for (const auto& p : e.parameters)
-    r.parameters.push_back({p.name, p.unit, p.value, p.std, p.lower, p.upper, p.free, ""});
+    r.parameters.push_back({p.name, p.unit, p.value, p.std, p.lower, p.upper, p.free, "", true, {}});
   r.physical = std::shared_ptr<const PhysicalModel>(static_cast<PhysicalModel*>(e.model.release()));
   r.K = e.K;
   r.covarianceKind = e.covarianceKind;

@@ -3,17 +3,14 @@
 #include <cmath>
 #include <cstdio>
 
+#include "core/common/text.h"
 #include "core/ident/evaluation.h"
 #include "core/ident/fit_internal.h"
 
 namespace flexarm::fit_detail {
 namespace {
 
-std::string g(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.3g", v);
-  return buf;
-}
+std::string g(double v) { return shortNumber(v); }
 
 bool startsWith(const std::string& s, const char* prefix) { return s.rfind(prefix, 0) == 0; }
 
@@ -32,14 +29,16 @@ constexpr double kMargin = 100.0;
 
 }  // namespace
 
+bool sitsOnBound(const FitResult& r, const std::string& name) {  // said by the bound's own warning
+  for (const auto& w : r.warnings)
+    if (w.rfind(name + " sits on its", 0) == 0) return true;
+  return false;
+}
+
 void plausibilityChecks(const FitOptions& o, FitResult& r) {
   if (o.model.kind != FitModelKind::Physical || r.parameters.empty()) return;
   const double z = twoSidedNormalQuantile(o.level);
-  auto onBound = [&r](const std::string& name) {  // said by the bound's own warning
-    for (const auto& w : r.warnings)
-      if (w.rfind(name + " sits on its", 0) == 0) return true;
-    return false;
-  };
+  auto onBound = [&r](const std::string& name) { return sitsOnBound(r, name); };
   for (const auto& p : r.parameters) {
     if (!p.free || !std::isfinite(p.value) || onBound(p.name)) continue;
     if (std::isfinite(p.std) && z * p.std > std::abs(p.value))

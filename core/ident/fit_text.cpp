@@ -1,5 +1,6 @@
 #include "core/ident/fit_text.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -42,9 +43,15 @@ std::string fitResultText(const FitResult& fit, const FitLogNames& logs) {
   if (fit.idim && fit.idimNote.empty())
     out << "inverse dynamics: " << fit.idim->message << ", the torque explained " << fit.idim->torqueFitPercent
         << " % (5.2), condition number " << fit.idim->conditionNumber << "\n";
-  for (const auto& p : fit.parameters)
-    out << "  " << p.name << " = " << p.value << " +- " << p.std << (p.free ? "" : " (fixed)")
-        << (p.effect.empty() ? "" : " " + p.unit + " (" + p.effect + ")") << "\n";
+  for (const auto& p : fit.parameters) {
+    out << "  " << p.name << " = " << p.value;
+    // An undetermined parameter's std is not quoted (0 or nan would claim what the data do not say).
+    if (!p.determined && (!std::isfinite(p.std) || p.std <= 0.0)) out << " (undetermined: " << p.undetermined << ")";
+    else out << " +- " << p.std << (p.determined ? "" : " (undetermined: " + p.undetermined + ")");
+    out << (p.free ? "" : " (fixed)") << (p.effect.empty() ? "" : " " + p.unit + " (" + p.effect + ")") << "\n";
+  }
+  if (!fit.undeterminedDirection.empty())
+    out << "the direction the data fix least (relative to the values): " << fit.undeterminedDirection << "\n";
   out << "loss " << s.loss << ", FPE " << s.fpe << "\n";
   // Both fit percentages, named (evaluation.h): the seed's (5.2) and MATLAB compare's NRMSE.
   auto both = [&](const std::optional<double>& seed52, const std::optional<double>& nrmse) {
@@ -153,6 +160,22 @@ std::vector<std::string> fitSummaryLines(const FitResult& r, const std::string& 
                     format("%.1f", r.deflection->fitPercentNrmse.value_or(NAN)) + " % NRMSE; encoder skew " +
                     format("%.3g", 1e3 * r.deflection->skewSeconds) + " ms.");
   for (const auto& w : r.plausibility) lines.push_back("Implausible: " + w + ".");
+  // Grouped by reason: "J_m, J_a (its std is 0: ...); d_a (it sits on a bound, ...)".
+  std::vector<std::pair<std::string, std::string>> reasons;  // reason, names
+  for (const auto& p : r.parameters) {
+    if (p.determined) continue;
+    auto it = std::find_if(reasons.begin(), reasons.end(), [&](const auto& x) { return x.first == p.undetermined; });
+    if (it == reasons.end()) reasons.push_back({p.undetermined, p.name});
+    else it->second += ", " + p.name;
+  }
+  std::string undetermined;
+  for (const auto& [why, names] : reasons) undetermined += (undetermined.empty() ? "" : "; ") + names + " (" + why + ")";
+  if (!undetermined.empty())
+    lines.push_back("Undetermined by these data: " + undetermined +
+                    (r.undeterminedDirection.empty() ? std::string(".")
+                                                     : ". The data fix least the combination " + r.undeterminedDirection +
+                                                           " (relative to the values): fix one of them, or log an "
+                                                           "experiment that excites it."));
   if (!r.idimNote.empty()) lines.push_back("Start: " + r.idimNote + ".");
   for (const auto& w : r.warnings) lines.push_back("Note: " + w + ".");
   return lines;

@@ -50,7 +50,10 @@ std::vector<ReportPlot> bodeWithBand(const FrequencyResponse& r, const std::stri
 ReportTable parameterTable(const std::string& caption, const std::vector<FitParameter>& parameters) {
   ReportTable t{caption, {"Parameter", "Value", "+- std", "99 % lower", "99 % upper", "Unit"}, {}};
   for (const auto& p : parameters) {
-    if (p.free)
+    if (p.free && !p.determined)  // no std or interval to quote: what the data do not say
+      t.rows.push_back({fitParameterLabel(p), formatSignificant(p.value, 6), "undetermined: " + p.undetermined, "",
+                        "", p.unit});
+    else if (p.free)
       t.rows.push_back({fitParameterLabel(p), formatSignificant(p.value, 6), formatSignificant(p.std, 3),
                         formatSignificant(p.lower, 6), formatSignificant(p.upper, 6), p.unit});
     else

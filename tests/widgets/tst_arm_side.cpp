@@ -8,6 +8,7 @@
 #include <QLineEdit>
 #include <QPushButton>
 #include <QSignalSpy>
+#include <QTableWidget>
 #include <QTemporaryDir>
 #include <QtTest>
 #include <qcustomplot.h>
@@ -30,6 +31,15 @@ class ArmSideTest : public QObject {
   QTemporaryDir dir_;
 
   void settle() { QTRY_VERIFY_WITH_TIMEOUT(!window_->isBusy(), 60000); }
+  // A window of its own on the KUKA KR300's axis one with its arm encoder (tests/data/kuka).
+  void openKukaAxisOne(MainWindow& w) {
+    w.resize(1366, 768);
+    w.show();
+    QVERIFY(QTest::qWaitForWindowExposed(&w));
+    QSignalSpy opened(&w, &MainWindow::logOpened);
+    w.openFile(QString(FLEXARM_TEST_DATA_DIR) + "/kuka/axis1.csv");
+    QVERIFY(opened.wait(30000));
+  }
   void showDock(const char* name) {
     auto* dock = window_->findChild<QDockWidget*>(name);
     QVERIFY(dock);
@@ -108,12 +118,7 @@ class ArmSideTest : public QObject {
   // encoder together with the encoders' skew, and Compare shows the deflection it predicts.
   void kukaAxisOneWithTheArmEncoder() {
     MainWindow w;
-    w.resize(1366, 768);
-    w.show();
-    QVERIFY(QTest::qWaitForWindowExposed(&w));
-    QSignalSpy opened(&w, &MainWindow::logOpened);
-    w.openFile(QString(FLEXARM_TEST_DATA_DIR) + "/kuka/axis1.csv");
-    QVERIFY(opened.wait(30000));
+    openKukaAxisOne(w);
     FitPanel* fit = w.fitPanel();
     w.findChild<QDockWidget*>("fitDock")->show();
     QVERIFY(fit->setModelChoice("two-mass"));
@@ -142,6 +147,37 @@ class ArmSideTest : public QObject {
     QVERIFY2(text.mid(at + 13).section(' ', 0, 0).toDouble() > 85.0, qPrintable(text));
     test::saveShot(w.comparePanel()->grab().toImage(), "kuka_compare");
     test::saveShot(w.grab().toImage(), "kuka_window");
+  }
+
+  // The KUKA axis at the Fit panel's defaults (two-mass, 0.5-7 s): the data do not determine
+  // its arm-side parameters. The table says "undetermined" with why (a tooltip) and leaves the
+  // interval empty, instead of a std of 0 and an interval of zero width.
+  void kukaUndeterminedParametersAreShownSo() {
+    MainWindow w;
+    openKukaAxisOne(w);
+    w.workspace()->setRange(RangeKind::Estimation, {0.5, 7.0});
+    FitPanel* fit = w.fitPanel();
+    w.findChild<QDockWidget*>("fitDock")->show();
+    QVERIFY(fit->setModelChoice("two-mass"));
+    QSignalSpy done(fit, &FitPanel::estimated);
+    QTest::mouseClick(fit->findChild<QPushButton*>("estimateButton"), Qt::LeftButton);
+    QVERIFY(done.wait(120000));
+    QVERIFY2(done.takeFirst().at(0).toBool(), qPrintable(fit->summaryText()));
+    auto* table = fit->findChild<QTableWidget*>("fitResultsTable");
+    QVERIFY(table);
+    int undetermined = 0;
+    for (int row = 0; row < table->rowCount(); ++row) {
+      const QString sd = table->item(row, 2)->text();
+      QVERIFY2(sd != "0" && !sd.contains("nan"), qPrintable(table->item(row, 0)->text() + ": " + sd));
+      if (sd != "undetermined") continue;
+      ++undetermined;
+      QVERIFY(table->item(row, 3)->text().isEmpty() && table->item(row, 4)->text().isEmpty());
+      QVERIFY(table->item(row, 2)->toolTip().startsWith("Undetermined: "));
+    }
+    QVERIFY2(undetermined > 0, qPrintable(fit->summaryText()));
+    QVERIFY2(fit->summaryText().contains("Undetermined by these data: "), qPrintable(fit->summaryText()));
+    QTest::qWait(100);
+    test::saveShot(fit->grab().toImage(), "kuka_fit_undetermined");
   }
 
   void cleanupTestCase() { delete window_; }

@@ -402,8 +402,8 @@ TEST(FitRequest, EffectsRoundTripAndReplayAsTheFit) {
 // fit_validation_percent) still opens with the same numbers.
 TEST(FitsPart, StoredFitsOfEitherSchemaVersionRead) {
   StoredFit f;
-  f.parameters = {{"J_m", "kg m^2", 5e-4, 1e-5, 4.7e-4, 5.3e-4, true, ""},
-                  {"beta", "1/rad^2", 2e6, 0.0, 0.0, 0.0, false, "nonlinear_spring"}};
+  f.parameters = {{"J_m", "kg m^2", 5e-4, 1e-5, 4.7e-4, 5.3e-4, true, "", true, {}},
+                  {"beta", "1/rad^2", 2e6, 0.0, 0.0, 0.0, false, "nonlinear_spring", true, {}}};
   f.loss = 0.5;
   f.fitEstimation = 91.5;
   f.notches = {100.0};

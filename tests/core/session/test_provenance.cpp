@@ -47,9 +47,9 @@ Session sessionWithStoredFit() {
   request->name = "three-mass estimate (three_mass_estimation_chirp.csv 0.5-12 s)";
   request->provenance = chirpProvenance(s);
   StoredFit f;
-  f.parameters = {{"J_m", "kg m^2", 0.000512, 1e-5, 0.000486, 0.000538, true, ""},
-                  {"J_g", "kg m^2", 11.1, 0.4, 10.07, 12.13, true, ""},
-                  {"f_m", "N m s/rad", 0.0355, 0.0, 0.0, 0.0, false, ""}};
+  f.parameters = {{"J_m", "kg m^2", 0.000512, 1e-5, 0.000486, 0.000538, true, "", true, {}},
+                  {"J_g", "kg m^2", 11.1, 0.4, 10.07, 12.13, true, "", true, {}},
+                  {"f_m", "N m s/rad", 0.0355, 0.0, 0.0, 0.0, false, "", true, {}}};
   f.loss = 0.0123;
   f.fitEstimation = -121.65;
   f.notches = {101.5};
