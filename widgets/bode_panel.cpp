@@ -112,13 +112,14 @@ BodePanel::BodePanel(Workspace* workspace, QWidget* parent)
   for (QCheckBox* c : {spa_, etfe_}) connect(c, &QCheckBox::toggled, this, &BodePanel::refresh);
   connect(export_, &QPushButton::clicked, this, &BodePanel::exportDialog);
   connect(workspace_, &Workspace::modelsChanged, this, [this](int) { refillList(); });
-  for (auto sig : {&Workspace::currentChanged, &Workspace::rangesChanged})
-    connect(workspace_, sig, this, &BodePanel::refresh);
+  // Another log (or its preprocessing) changes which models are of the open data.
+  connect(workspace_, &Workspace::currentChanged, this, &BodePanel::refillList);
+  connect(workspace_, &Workspace::rangesChanged, this, &BodePanel::refresh);
   refillList();
 }
 
 void BodePanel::refillList() {
-  fillModelChecklist(models_, workspace_->models());
+  fillModelChecklist(models_, workspace_->models(), *workspace_);
   refresh();
 }
 

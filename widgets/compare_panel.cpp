@@ -83,13 +83,14 @@ ComparePanel::ComparePanel(Workspace* workspace, QWidget* parent)
   connect(models_, &QListWidget::itemChanged, this, &ComparePanel::refresh);
   connect(range_, QOverload<int>::of(&QComboBox::currentIndexChanged), this, &ComparePanel::refresh);
   connect(workspace_, &Workspace::modelsChanged, this, [this](int) { refillList(); });
-  for (auto sig : {&Workspace::currentChanged, &Workspace::rangesChanged})
-    connect(workspace_, sig, this, &ComparePanel::refresh);
+  // Another log (or its preprocessing) changes which models are of the open data.
+  connect(workspace_, &Workspace::currentChanged, this, &ComparePanel::refillList);
+  connect(workspace_, &Workspace::rangesChanged, this, &ComparePanel::refresh);
   refillList();
 }
 
 void ComparePanel::refillList() {
-  fillModelChecklist(models_, workspace_->models());
+  fillModelChecklist(models_, workspace_->models(), *workspace_);
   refresh();
 }
 

@@ -1,6 +1,7 @@
 #include "widgets/ident_data.h"
 
 #include <QFileInfo>
+#include <QHash>
 #include <QListWidget>
 #include <cmath>
 
@@ -15,16 +16,37 @@ std::shared_ptr<PhysicalModel> clonePhysical(const ParametricModel& model) {
   return std::shared_ptr<PhysicalModel>(static_cast<PhysicalModel*>(c.release()));
 }
 
-void fillModelChecklist(QListWidget* list, const std::vector<ModelEntry>& models) {
-  QStringList unchecked;
+bool ofOpenData(const ModelEntry& entry, const Workspace& workspace) {
+  const auto data = entry.dataProvenance();
+  return !data || (workspace.hasLog() && sameData(*data, workspace.dataProvenance()));
+}
+
+void fillModelChecklist(QListWidget* list, const std::vector<ModelEntry>& models, const Workspace& workspace) {
+  constexpr int kOtherData = Qt::UserRole + 1;  // the item was of other data when filled
+  struct Was {
+    bool checked, other;
+  };
+  QHash<QString, Was> before;
   for (int i = 0; i < list->count(); ++i)
-    if (list->item(i)->checkState() != Qt::Checked) unchecked << list->item(i)->text();
+    before.insert(list->item(i)->text(),
+                  {list->item(i)->checkState() == Qt::Checked, list->item(i)->data(kOtherData).toBool()});
   const QSignalBlocker block(list);
   list->clear();
   for (const auto& m : models) {
-    auto* item = new QListWidgetItem(nameOf(m), list);
+    const QString name = nameOf(m);
+    const bool own = ofOpenData(m, workspace);
+    auto* item = new QListWidgetItem(name, list);
     item->setFlags(Qt::ItemIsEnabled | Qt::ItemIsUserCheckable);
-    item->setCheckState(unchecked.contains(nameOf(m)) ? Qt::Unchecked : Qt::Checked);
+    item->setData(kOtherData, !own);
+    const auto was = before.constFind(name);
+    // A choice the user made stands while the model's data stay what they were.
+    const bool keep = was != before.constEnd() && was->other == !own;
+    item->setCheckState((keep ? was->checked : own) ? Qt::Checked : Qt::Unchecked);
+    item->setToolTip(QString::fromStdString(m.provenanceText()));
+    if (!own) {
+      item->setForeground(QColor(130, 130, 130));
+      item->setToolTip(QObject::tr("Of other data than the open log: %1").arg(QString::fromStdString(m.provenanceText())));
+    }
   }
 }
 

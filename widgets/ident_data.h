@@ -20,9 +20,15 @@ namespace flexarm {
 // A copy of a physical model that can be edited (the list shares const models).
 std::shared_ptr<PhysicalModel> clonePhysical(const ParametricModel& model);
 
-// Fills a list widget with the shared list's model names as check boxes; a name that was
-// unchecked before stays unchecked, new ones are checked.
-void fillModelChecklist(QListWidget* list, const std::vector<ModelEntry>& models);
+// Whether the entry belongs with the open data: made by hand, or estimated on the log that is
+// open (read and preprocessed alike; core's sameData).
+bool ofOpenData(const ModelEntry& entry, const Workspace& workspace);
+
+// Fills a list widget with the shared list's model names as check boxes. A model of the open
+// data is checked unless the user unchecked it; a model of other data is unchecked unless the
+// user checked it while it was, and its item says so (greyed, its data in the tooltip). So a
+// newly opened log shows its own models, not every estimate the list ever held.
+void fillModelChecklist(QListWidget* list, const std::vector<ModelEntry>& models, const Workspace& workspace);
 bool isModelChecked(const QListWidget* list, std::size_t index);
 
 // What the identification panels read from the workspace, taken on the GUI thread so that

@@ -101,8 +101,8 @@ ResidualsPanel::ResidualsPanel(Workspace* workspace, QWidget* parent)
   connect(range_, QOverload<int>::of(&QComboBox::currentIndexChanged), this, &ResidualsPanel::refresh);
   connect(lags_, QOverload<int>::of(&QSpinBox::valueChanged), this, &ResidualsPanel::refresh);
   connect(workspace_, &Workspace::modelsChanged, this, [this](int) { refillList(); });
-  for (auto sig : {&Workspace::currentChanged, &Workspace::rangesChanged})
-    connect(workspace_, sig, this, &ResidualsPanel::refresh);
+  connect(workspace_, &Workspace::currentChanged, this, &ResidualsPanel::refillList);
+  connect(workspace_, &Workspace::rangesChanged, this, &ResidualsPanel::refresh);
   refillList();
 }
 
@@ -110,9 +110,17 @@ void ResidualsPanel::refillList() {
   filling_ = true;
   const QString keep = model_->currentText();
   model_->clear();
-  for (const auto& m : workspace_->models()) model_->addItem(nameOf(m));
-  const int k = model_->findText(keep);
-  model_->setCurrentIndex(k >= 0 ? k : model_->count() - 1);  // default: the newest model
+  const auto& models = workspace_->models();
+  int newestOwn = -1;  // default: the newest model of the open data, else the newest
+  for (std::size_t i = 0; i < models.size(); ++i) {
+    model_->addItem(nameOf(models[i]));
+    model_->setItemData(static_cast<int>(i), QString::fromStdString(models[i].provenanceText()), Qt::ToolTipRole);
+    if (ofOpenData(models[i], *workspace_)) newestOwn = static_cast<int>(i);
+  }
+  // The model shown stays, unless another log made it a model of other data.
+  int k = model_->findText(keep);
+  if (k >= 0 && newestOwn >= 0 && !ofOpenData(models[static_cast<std::size_t>(k)], *workspace_)) k = -1;
+  model_->setCurrentIndex(k >= 0 ? k : newestOwn >= 0 ? newestOwn : model_->count() - 1);
   filling_ = false;
   refresh();
 }

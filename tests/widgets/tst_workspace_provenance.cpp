@@ -6,7 +6,9 @@
 // ranges, preprocessing and the undo history.
 #include <QAbstractButton>
 #include <QApplication>
+#include <QComboBox>
 #include <QFile>
+#include <QListWidget>
 #include <QMessageBox>
 #include <QPushButton>
 #include <QRegularExpression>
@@ -263,6 +265,25 @@ class WorkspaceProvenanceTest : public QObject {
     QVERIFY(b != QString::fromStdString(formatSignificant(kg, 6)));
     QVERIFY2(!text.contains(b), qPrintable(b + " (recomputed on the backlash log) is in the report"));
     QVERIFY(window_->sessionController()->staleEstimates().size() == 1);  // the chirp one stays
+    // Compare and Bode tick the models of the open log; the chirp's estimate is listed, greyed
+    // with its data in the tooltip, unticked. Residuals opens on the backlash log's estimate.
+    for (const char* name : {"compareModelList", "bodeModelList"}) {
+      auto* list = window_->findChild<QListWidget*>(name);
+      QVERIFY2(list, name);
+      QCOMPARE(list->count(), static_cast<int>(ws->models().size()));
+      for (int i = 0; i < list->count(); ++i) {
+        const QString item = list->item(i)->text();
+        if (item.contains("three_mass_estimation_chirp.csv")) {
+          QVERIFY2(list->item(i)->checkState() == Qt::Unchecked, qPrintable(QString(name) + ": " + item));
+          QVERIFY(list->item(i)->toolTip().startsWith("Of other data than the open log"));
+        } else if (item.contains("effect_backlash.csv")) {
+          QVERIFY2(list->item(i)->checkState() == Qt::Checked, qPrintable(QString(name) + ": " + item));
+        }
+      }
+    }
+    auto* residualsModel = window_->findChild<QComboBox*>("residualsModelCombo");
+    QVERIFY(residualsModel);
+    QCOMPARE(residualsModel->currentText(), nameOf(again));
   }
 
   void cleanupTestCase() {
