@@ -60,6 +60,7 @@ mkdir -p "$fuzzdir/corpus/fuzz_manifest"
 printf '# flexarm-fleet: 1\nrobot,axis,time,log,temperature_c,role\nR01,1,2026-03-01T06:00:00Z,R01/a.csv,24.5,reference\nR01,1,2026-03-02T06:00,R01/b.csv,,\nR02,3,2026-03-02,../x.csv,,\n' \
   > "$fuzzdir/corpus/fuzz_manifest/seed-plant"
 printf '\xef\xbb\xbf# flexarm-fleet: 1\nlog,time,axis,robot\nb.csv,2026-03-05T06:00,2,R07\n' > "$fuzzdir/corpus/fuzz_manifest/seed-bom"
+seed fuzz_manifest "$d"/fuzz/manifest_*.csv
 # A store as FlexArm lays it out (its schema read from core/fleet/store.cpp), one log in it;
 # the first byte selects the store half of the target.
 mkdir -p "$fuzzdir/corpus/fuzz_store"

@@ -364,6 +364,19 @@ void LogPanel::placeRect(QCPItemRect* item, double t0, double t1, bool visible) 
   item->setVisible(visible);
 }
 
+QString LogPanel::secondsText(double t) const {
+  // To a tenth of the log's sample time: a .mat log's 0.5119999871 reads 0.512.
+  const IdData* data = workspace_->current();
+  const double ts = data && data->sampleTime > 0.0 ? data->sampleTime : 1e-9;
+  const int decimals = std::clamp(static_cast<int>(std::ceil(-std::log10(ts / 10.0))), 0, 9);
+  QString text = QString::number(t, 'f', decimals);
+  if (text.contains('.')) {
+    while (text.endsWith('0')) text.chop(1);
+    if (text.endsWith('.')) text.chop(1);
+  }
+  return text;
+}
+
 void LogPanel::updateRanges() {
   struct Row {
     RangeKind kind;
@@ -378,8 +391,7 @@ void LogPanel::updateRanges() {
     for (auto* item : *row.rects) placeRect(item, r ? r->start : 0, r ? r->end : 0, r.has_value());
     const SampleRange s = workspace_->samples(row.kind);
     QStringList cells = {row.kind == RangeKind::Estimation ? tr("Estimation") : tr("Validation"),
-                         r ? QString::number(r->start, 'g', 10) : QString("-"),
-                         r ? QString::number(r->end, 'g', 10) : QString("-"),
+                         r ? secondsText(r->start) : QString("-"), r ? secondsText(r->end) : QString("-"),
                          r ? QString::number(s.size()) : tr("drag in the plot")};
     const QSignalBlocker block(rangeTable_);  // filling is no edit
     for (int c = 0; c < 4; ++c) {

@@ -70,6 +70,8 @@ class LogPanel : public QWidget {
  private:
   void rebuild();
   void updateRanges();
+  // A time of the range table, to the log's resolution.
+  QString secondsText(double t) const;
   void onMousePress(QMouseEvent* e);
   void onMouseMove(QMouseEvent* e);
   void onMouseRelease(QMouseEvent* e);

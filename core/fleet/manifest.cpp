@@ -234,9 +234,10 @@ std::optional<FleetManifest> parseFleetManifest(std::string_view text, const std
     FleetEntry e;
     e.line = lineNo;
     e.robot = std::string(fields[static_cast<std::size_t>(iRobot)]);
+    // (A leading # would make the row a comment once the manifest is written back.)
     if (e.robot.empty() || e.robot.size() > 64 || e.robot.find_first_of("/\\\"") != std::string::npos ||
-        hasControl(e.robot))
-      return fail(lineNo, "robot", inQuotes(e.robot) + ": a robot needs a name of 1 to 64 characters without / \\ \" or control characters");
+        e.robot[0] == '#' || hasControl(e.robot))
+      return fail(lineNo, "robot", inQuotes(e.robot) + ": a robot needs a name of 1 to 64 characters without / \\ \", control characters or a leading #");
     {
       const std::string a(fields[static_cast<std::size_t>(iAxis)]);
       if (a.empty() || a.size() > 2 || a.find_first_not_of("0123456789") != std::string::npos ||

@@ -163,7 +163,13 @@ std::string schemaProblem(sqlite3* db) {
   return {};
 }
 
-std::string errorOf(sqlite3* db) { return db ? sqlite3_errmsg(db) : "out of memory"; }
+// SQLite's sentence for the last failure; "not an error" (its text for SQLITE_OK, as after a
+// ROLLBACK) is never passed on as one.
+std::string errorOf(sqlite3* db) {
+  if (!db) return "out of memory";
+  if (sqlite3_errcode(db) == SQLITE_OK) return "a statement did not complete (SQLite gives no reason)";
+  return sqlite3_errmsg(db);
+}
 
 // Why a store could not be read, by SQLite's error code: a full disk or a locked file is not
 // "not a store".

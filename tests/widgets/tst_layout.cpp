@@ -345,6 +345,10 @@ class LayoutTest : public QObject {
     QCOMPARE(r->start, 0.5);
     QCOMPARE(r->end, 12.0);
     QCOMPARE(table->item(0, 1)->text(), QString("0.5"));
+    // Shown to the log's resolution (a tenth of its sample time), not a float's noise.
+    table->item(0, 1)->setText("0.5119999871");
+    QCOMPARE(table->item(0, 1)->text(), QString("0.512"));
+    table->item(0, 1)->setText("0.5");
     // Nonsense is refused and the range stays.
     table->item(0, 2)->setText("twelve");
     QCOMPARE(window_->workspace()->range(RangeKind::Estimation)->end, 12.0);

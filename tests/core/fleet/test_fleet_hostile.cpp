@@ -334,6 +334,9 @@ TEST(FleetHostile, AManifestsEncodingAndSizeAreNamed) {
     EXPECT_FALSE(parseFleetManifest("# flexarm-fleet: 1\nrobot,axis,time,log\n" + row + "\n", "fleet.csv", &e)) << row;
     EXPECT_EQ(e.column, "axis") << row;
   }
+  // Found by fuzz_manifest: a robot "#R07" reads, but its row written back is a comment.
+  EXPECT_FALSE(parseFleetManifest("# flexarm-fleet: 1\nlog,time,axis,robot\nb.csv,2026-03-05T06:00,2,#R07\n", "fleet.csv", &e));
+  EXPECT_EQ(e.column, "robot");
   EXPECT_FALSE(parseFleetManifest("# flexarm-fleet: 1\nrobot,axis,time,log,temperature_c\nR1,1,2026-03-01,a.csv,0x1p4\n",
                                   "fleet.csv", &e));
   EXPECT_EQ(e.column, "temperature_c");
