@@ -152,22 +152,12 @@ long ArgParser::integer(const std::string& name) const {
   return static_cast<long>(wholeNumber(text(name)).value_or(0));
 }
 
-namespace {
-
-std::string shortNumber(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%g", v);
-  return buf;
-}
-
-}  // namespace
-
 bool ArgParser::number(const std::string& name, double& out, double min, double max) {
   auto v = value(name);
   if (!v) return true;
   const auto x = finiteNumber(*v);
   if (!x || *x < min || *x > max) {
-    error_ = "--" + name + " expects a number from " + shortNumber(min) + " to " + shortNumber(max) + ", got " +
+    error_ = "--" + name + " expects a number from " + shortNumber(min, 6) + " to " + shortNumber(max, 6) + ", got " +
              inQuotes(*v);
     return false;
   }
