@@ -11,6 +11,12 @@ std::string inQuotes(std::string_view value, std::size_t most) {
   return out + "...' (" + std::to_string(value.size()) + " characters)";
 }
 
+bool hasControlCharacter(std::string_view text) {
+  for (unsigned char c : text)
+    if (c < 0x20 || c == 0x7f) return true;
+  return false;
+}
+
 std::string shortNumber(double value, int digits) {
   char buf[48];
   std::snprintf(buf, sizeof buf, "%.*g", digits, value);

@@ -7,6 +7,7 @@
 #include <stdexcept>
 #include <sys/stat.h>
 
+#include "core/common/text.h"
 #include "core/fleet/work.h"
 #include "core/session/sha256.h"
 
@@ -66,11 +67,7 @@ bool SlurmOptions::isValid(std::string* why) const {
   if (!(timeoutS > 0.0 && timeoutS <= 30 * 86400.0))
     return fail("the Slurm timeout (--slurm-timeout) must lie between 0 and 2592000 s (30 days)");
   if (!(pollS > 0.0 && pollS <= 3600.0)) return fail("the Slurm poll interval must lie between 0 and 3600 s");
-  auto plain = [](const std::string& s) {
-    for (unsigned char c : s)
-      if (c < 0x20 || c == 0x7f) return false;
-    return true;
-  };
+  auto plain = [](const std::string& s) { return !hasControlCharacter(s); };
   if (!plain(workDir)) return fail("--slurm-dir holds a line break or another control character; give a plain path");
   if (!plain(executable)) return fail("--flexarm holds a line break or another control character; give a plain path");
   for (const auto& a : sbatchArguments)

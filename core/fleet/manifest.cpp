@@ -59,12 +59,6 @@ bool readInt(std::string_view s, std::size_t digits, long& out) {
   return true;
 }
 
-bool hasControl(std::string_view s) {
-  for (unsigned char c : s)
-    if (c < 0x20 || c == 0x7f) return true;
-  return false;
-}
-
 // A decimal number, whole (no hex, no inf or nan, nothing after it).
 std::optional<double> decimal(std::string_view s) {
   if (s.empty() || s.size() > 40 || s.find_first_not_of("0123456789+-.eE") != std::string_view::npos) return std::nullopt;
@@ -215,7 +209,7 @@ std::optional<FleetManifest> parseFleetManifest(std::string_view text, const std
                   : name == "log" ? &iLog : name == "temperature_c" ? &iTemp : name == "role" ? &iRole
                   : nullptr;
         if (!slot)
-          return fail(lineNo, name.size() <= 100 && !hasControl(name) ? name : inQuotes(name), "unknown column (robot, axis, time, log, temperature_c, role)");
+          return fail(lineNo, name.size() <= 100 && !hasControlCharacter(name) ? name : inQuotes(name), "unknown column (robot, axis, time, log, temperature_c, role)");
         if (*slot >= 0) return fail(lineNo, name, "the column appears twice");
         *slot = static_cast<int>(i);
         header.push_back(name);
@@ -236,7 +230,7 @@ std::optional<FleetManifest> parseFleetManifest(std::string_view text, const std
     e.robot = std::string(fields[static_cast<std::size_t>(iRobot)]);
     // (A leading # would make the row a comment once the manifest is written back.)
     if (e.robot.empty() || e.robot.size() > 64 || e.robot.find_first_of("/\\\"") != std::string::npos ||
-        e.robot[0] == '#' || hasControl(e.robot))
+        e.robot[0] == '#' || hasControlCharacter(e.robot))
       return fail(lineNo, "robot", inQuotes(e.robot) + ": a robot needs a name of 1 to 64 characters without / \\ \", control characters or a leading #");
     {
       const std::string a(fields[static_cast<std::size_t>(iAxis)]);
@@ -250,7 +244,7 @@ std::optional<FleetManifest> parseFleetManifest(std::string_view text, const std
     e.day = *day;
     e.log = std::string(fields[static_cast<std::size_t>(iLog)]);
     if (e.log.empty()) return fail(lineNo, "log", "the log's path is empty");
-    if (hasControl(e.log)) return fail(lineNo, "log", inQuotes(e.log) + ": a path with control characters");
+    if (hasControlCharacter(e.log)) return fail(lineNo, "log", inQuotes(e.log) + ": a path with control characters");
     const std::filesystem::path lp(e.log);
     e.path = lp.is_absolute() || folder.empty() ? e.log : (folder / lp).string();
     if (!options.allowLogsOutside && !insideFolder(e.path, inside))

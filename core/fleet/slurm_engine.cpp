@@ -21,6 +21,7 @@
 #include <thread>
 #include <unistd.h>
 
+#include "core/common/text.h"
 #include "core/fleet/work.h"
 #include "core/io/log_io.h"
 
@@ -103,12 +104,6 @@ std::string tail(const std::string& path, std::size_t bytes) {
   if (text.size() > bytes) text = "..." + text.substr(text.size() - bytes);
   while (!text.empty() && (text.back() == '\n' || text.back() == ' ')) text.pop_back();
   return text.empty() ? "no output" : text;
-}
-
-bool hasControlCharacter(const std::string& s) {
-  for (unsigned char c : s)
-    if (c < 0x20 || c == 0x7f) return true;
-  return false;
 }
 
 // Makes dir (mode 0700), or accepts it when it is already a folder of this user and not a
