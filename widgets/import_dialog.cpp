@@ -152,6 +152,20 @@ ImportDialog::ImportDialog(const QString& path, SourceListing listing, const Log
   gearRatio_ = new QLineEdit(QString::fromStdString(start.mapping.gearRatio));
   gearRatio_->setObjectName("importGearRatio");
   gearRatio_->setPlaceholderText(tr("arm/motor, e.g. 1/256.86"));
+  // A ratio above 1 is a gear ratio typed as datasheets give it (motor turns per arm turn):
+  // its inverse is offered beside the field as soon as it is typed, before anything is read.
+  invertGear_ = new QPushButton;
+  invertGear_->setObjectName("importGearInvert");
+  invertGear_->hide();
+  connect(invertGear_, &QPushButton::clicked, this, [this] {
+    gearRatio_->setText(QString::fromStdString(invertedGearRatio(gearRatio_->text().toStdString())));
+  });
+  connect(gearRatio_, &QLineEdit::textChanged, this, &ImportDialog::checkGearRatio);
+  auto* gearBox = new QWidget;
+  auto* gearRow = new QHBoxLayout(gearBox);
+  gearRow->setContentsMargins(0, 0, 0, 0);
+  gearRow->addWidget(gearRatio_, 1);
+  gearRow->addWidget(invertGear_);
   inputScale_ = new QDoubleSpinBox;
   inputScale_->setObjectName("importInputScale");
   inputScale_->setDecimals(6);
@@ -169,7 +183,7 @@ ImportDialog::ImportDialog(const QString& path, SourceListing listing, const Log
   auto* units = new QGridLayout;
   const std::pair<QString, QWidget*> unitRows[] = {
       {tr("Output unit"), outputUnit_}, {tr("Output given on"), outputSide_},
-      {tr("Arm angle unit"), armUnit_}, {tr("Gear ratio"), gearRatio_},
+      {tr("Arm angle unit"), armUnit_}, {tr("Gear ratio"), gearBox},
       {tr("Input scale"), inputScale_}, {tr("Sample time (no time)"), sampleTime_}};
   for (int i = 0; i < 6; ++i) {
     units->addWidget(new QLabel(unitRows[i].first), i / 2, 2 * (i % 2));
@@ -206,6 +220,7 @@ ImportDialog::ImportDialog(const QString& path, SourceListing listing, const Log
   connect(selected_, &QLineEdit::editingFinished, this, [this] { showPreview(selected_->text().trimmed()); });
   connect(&previewer_, &QFutureWatcher<Preview>::finished, this, &ImportDialog::onPreviewRead);
   onItemChanged();
+  checkGearRatio();
   // Fits a 1366x768 screen.
   const QRect screen = parent && parent->screen() ? parent->screen()->availableGeometry() : QRect(0, 0, 1366, 768);
   resize(std::min(1120, screen.width() - 40), std::min(680, screen.height() - 60));
@@ -387,6 +402,29 @@ LogReadOptions ImportDialog::options() const {
   o.sampleTime = sampleTime_->value();
   return o;
 }
+
+void ImportDialog::checkGearRatio() {
+  const std::string text = gearRatio_->text().trimmed().toStdString();
+  const std::optional<double> r = text.empty() ? std::nullopt : parseGearRatio(text, nullptr);
+  const bool above = r && *r > 1.0;
+  if (above) {
+    const QString inverse = QString::fromStdString(invertedGearRatio(text));
+    invertGear_->setText(tr("Use %1").arg(inverse));
+    invertGear_->setToolTip(tr("The gear ratio is arm/motor: a reduction of %1 motor turns per arm turn is %2")
+                                .arg(QString::fromStdString(text), inverse));
+    std::string why;
+    LogMapping m;
+    m.gearRatio = text;
+    m.isValid(&why);
+    why[0] = static_cast<char>(std::toupper(static_cast<unsigned char>(why[0])));
+    setProblem(QString::fromStdString(why) + ".");
+  } else if (!invertGear_->isHidden()) {
+    setProblem({});
+  }
+  invertGear_->setVisible(above);
+}
+
+bool ImportDialog::gearRatioInversionOffered() const { return !invertGear_->isHidden(); }
 
 void ImportDialog::setProblem(const QString& text) {
   problem_->setText(text);

@@ -57,6 +57,8 @@ class ImportDialog : public QDialog {
   // Open: checks the choices (input and output given, a gear ratio for an arm side, ...) and
   // closes only when they hold; otherwise says why above the buttons.
   void accept() override;
+  // A gear ratio above 1 is typed: its inverse is offered (the importGearInvert button).
+  bool gearRatioInversionOffered() const;
 
  signals:
   // A preview was drawn (points > 0) or could not be read (points 0, the title says why).
@@ -68,6 +70,7 @@ class ImportDialog : public QDialog {
   void updateSelection();
   void showPreview(const QString& expression);
   void onPreviewRead();
+  void checkGearRatio();
 
   QString path_;
   SourceListing listing_;
@@ -82,6 +85,7 @@ class ImportDialog : public QDialog {
   QComboBox* outputSide_;
   QComboBox* armUnit_;
   QLineEdit* gearRatio_;
+  QPushButton* invertGear_;
   QDoubleSpinBox* inputScale_;
   QDoubleSpinBox* sampleTime_;
   QLabel* problem_;

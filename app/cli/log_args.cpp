@@ -108,7 +108,10 @@ std::optional<LogReadOptions> logReadOptions(ArgParser& args, std::ostream& err)
   }
   std::string why;
   if (!o.isValid(&why)) {
-    err << "flexarm: " << why << "\n";
+    err << "flexarm: " << why;
+    if (const auto r = parseGearRatio(m.gearRatio, nullptr); r && *r > 1.0)
+      err << "; give --gear-ratio " << invertedGearRatio(m.gearRatio);
+    err << "\n";
     return std::nullopt;
   }
   return o;

@@ -3,6 +3,7 @@
 #include <cmath>
 #include <cstdio>
 
+#include "core/common/text.h"
 #include "core/io/reader_support.h"
 
 namespace flexarm {
@@ -105,12 +106,31 @@ std::optional<double> parseGearRatio(std::string_view text, std::string* why) {
   return value;
 }
 
+std::string invertedGearRatio(std::string_view text) {
+  if (!parseGearRatio(text, nullptr)) return {};
+  const std::string t = io::trim(text);
+  const std::size_t slash = t.find('/');
+  if (slash == std::string::npos) return "1/" + t;
+  const std::string a = io::trim(std::string_view(t).substr(0, slash));
+  const std::string b = io::trim(std::string_view(t).substr(slash + 1));
+  double one = 0.0;
+  if (io::parseNumber(a, one) == io::FieldStatus::Ok && one == 1.0) return b;
+  return b + "/" + a;
+}
+
 bool LogMapping::isValid(std::string* why) const {
-  if (!gearRatio.empty() && !parseGearRatio(gearRatio, why)) return false;
   auto fail = [&](const std::string& m) {
     if (why) *why = m;
     return false;
   };
+  if (!gearRatio.empty()) {
+    const std::optional<double> r = parseGearRatio(gearRatio, why);
+    if (!r) return false;
+    if (*r > 1.0)
+      return fail("the gear ratio " + inQuotes(io::trim(gearRatio)) +
+                  " is above 1: it is arm turns per motor turn (arm/motor), and a reduction of " +
+                  io::trim(gearRatio) + " motor turns per arm turn is " + invertedGearRatio(gearRatio));
+  }
   if (!std::isfinite(inputScale) || inputScale == 0.0)
     return fail("the input scale must be a finite number other than 0");
   if (armUnit && (isLinear(*armUnit) || isVelocity(*armUnit)))
@@ -284,10 +304,6 @@ bool applyMapping(IdData& data, const MappedChannels& found, const LogMapping& m
   if (arm && arm->role != ChannelRole::None) arm->role = ChannelRole::None;
   if (ratio > 0.0) {
     data.setMeta("gear_ratio", number(ratio));
-    if (ratio > 1.0)
-      warnings.push_back("the gear ratio " + m.gearRatio +
-                         " is arm/motor: above 1 the arm turns faster than the motor (a reduction of "
-                         "N:1 is written 1/N)");
   } else if (m.convertsOutput() && !prismatic && data.meta("gear_ratio").empty()) {
     warnings.push_back("no gear ratio was given (--gear-ratio, arm/motor, e.g. 1/256.86): a physical "
                        "model keeps its own");

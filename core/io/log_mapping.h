@@ -46,6 +46,12 @@ std::optional<EncoderSide> encoderSideFromString(std::string_view s);
 // a sentence unless positive and finite.
 std::optional<double> parseGearRatio(std::string_view text, std::string* why);
 
+// The ratio written the other way round: "256.86" -> "1/256.86", "1/118" -> "118",
+// "10/3" -> "3/10". For a gear ratio given as datasheets give it (motor turns per arm turn),
+// which a mapping refuses (above 1) and the dialog and the command line offer inverted. Empty
+// when the text is not a positive ratio.
+std::string invertedGearRatio(std::string_view text);
+
 struct LogMapping {
   // Where each signal is: a MATLAB expression in a .mat file (rec.act_torque_abs_nm(1,:)), a
   // header name in a CSV file (torque_motor_Nm), "column N" in a headerless table. Empty:
@@ -57,6 +63,9 @@ struct LogMapping {
   std::string gearRatio;   // as given ("1/256.86"); empty: not given
   double inputScale = 1.0; // the input times this is the torque in N m (force in N)
 
+  // False with a sentence for what cannot be read as said, among them a gear ratio above 1 (the
+  // arm faster than the motor: a gear ratio typed motor/arm, which would scale an arm-side
+  // angle the wrong way by the ratio squared); the sentence then names the inverse.
   bool isValid(std::string* why) const;
   // True when the units of the output are said (the output is converted and renamed).
   bool convertsOutput() const { return outputUnit.has_value() || outputSide.has_value(); }

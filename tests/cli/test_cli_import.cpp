@@ -97,6 +97,11 @@ TEST(CliImport, BadExpressionsAndUnitsNameTheFileAndTheProblem) {
   r = runFlexarm(axisOne({"--gear-ratio", "1/0"}));
   EXPECT_EQ(r.code, 2);
   EXPECT_NE(r.err.find("the gear ratio '1/0' must be a positive number arm/motor"), std::string::npos) << r.err;
+  // The ratio as a datasheet gives it: refused before the file is read, the inverse named.
+  r = runFlexarm(axisOne({"--gear-ratio", "256.86"}));
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("is above 1"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("give --gear-ratio 1/256.86"), std::string::npos) << r.err;
   // Without a mapping the file's variables are listed and the way to name them is shown.
   r = runFlexarm({"info", kKuka});
   EXPECT_EQ(r.code, 3);

@@ -11,6 +11,7 @@
 #include <QLabel>
 #include <QLineEdit>
 #include <QMessageBox>
+#include <QPushButton>
 #include <QSignalSpy>
 #include <QTemporaryDir>
 #include <QTreeWidget>
@@ -170,6 +171,37 @@ class ImportDialogTest : public QObject {
              qPrintable(again->findChild<QLabel*>("importProblem")->text()));
     QCOMPARE(again->findChild<QLineEdit*>("importRole_input")->text(), QString("rec.act_torque_abs_nm(1,:)"));
     again->reject();
+  }
+
+  // A gear ratio typed as datasheets give it (256.86, motor turns per arm turn) would scale the
+  // arm-side angle the wrong way (-0.002 rad instead of -128 rad): its inverse is offered as
+  // it is typed, Open refuses it until chosen, and one click reads the axis right.
+  void aGearRatioAboveOneIsOfferedInverted() {
+    ImportDialog* d = openDialog();
+    QVERIFY(d);
+    QVERIFY(chooseAxis(d, 1));
+    auto* gear = d->findChild<QLineEdit*>("importGearRatio");
+    auto* invert = d->findChild<QPushButton*>("importGearInvert");
+    QVERIFY(gear && invert);
+    QVERIFY(!d->gearRatioInversionOffered());
+    gear->setText("256.86");
+    QVERIFY(d->gearRatioInversionOffered());
+    QCOMPARE(invert->text(), QString("Use 1/256.86"));
+    auto* problem = d->findChild<QLabel*>("importProblem");
+    QVERIFY2(problem->text().contains("above 1") && problem->text().contains("1/256.86"), qPrintable(problem->text()));
+    test::saveShot(d->grab().toImage(), "import_gear_ratio_inverted");
+    d->accept();
+    QVERIFY(d->isVisible());
+    invert->click();
+    QCOMPARE(gear->text(), QString("1/256.86"));
+    QVERIFY(!d->gearRatioInversionOffered());
+    QVERIFY(problem->text().isEmpty());
+    QVERIFY(clickOpen(d));
+    if (QMessageBox* box = nullptr; QTest::qWaitFor([&] { return (box = test::findBox("readWarningsBox")) != nullptr; }, 5000))
+      box->close();
+    const Channel* motor = window_->workspace()->raw()->channel(columns::kMotorAngle);
+    QVERIFY(motor);
+    QVERIFY(std::abs(motor->values[1000] - kMotDeg[0] * kGear[0] * kPi / 180.0) < 1e-9);
   }
 
   void opensAxesOneToThreeConverted() {

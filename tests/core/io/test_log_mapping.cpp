@@ -298,6 +298,20 @@ TEST(LogMapping, UnitsSidesAndGearRatioAreConvertedAndRecorded) {
   EXPECT_NEAR(parseGearRatio("1/256.86", &why).value_or(0), 1 / 256.86, 1e-18);
   EXPECT_NEAR(parseGearRatio(" 0.0085 ", &why).value_or(0), 0.0085, 1e-18);
   for (const char* bad : {"", "0", "-1/3", "1/0", "abc", "1/2/3"}) EXPECT_FALSE(parseGearRatio(bad, &why)) << bad;
+  // Motor turns per arm turn, as datasheets write it, is refused by the mapping with its inverse.
+  EXPECT_EQ(invertedGearRatio("256.86"), "1/256.86");
+  EXPECT_EQ(invertedGearRatio(" 1/118 "), "118");
+  EXPECT_EQ(invertedGearRatio("10/3"), "3/10");
+  EXPECT_EQ(invertedGearRatio("-2"), "");
+  LogMapping m;
+  m.gearRatio = "256.86";
+  EXPECT_FALSE(m.isValid(&why));
+  EXPECT_NE(why.find("above 1"), std::string::npos) << why;
+  EXPECT_NE(why.find("1/256.86"), std::string::npos) << why;
+  m.gearRatio = "1";  // a direct drive
+  EXPECT_TRUE(m.isValid(&why)) << why;
+  m.gearRatio = invertedGearRatio("256.86");
+  EXPECT_TRUE(m.isValid(&why)) << why;
   fs::remove_all(tempDir());
 }
 
