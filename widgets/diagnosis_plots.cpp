@@ -225,7 +225,11 @@ void DiagnosisPanel::showAt(double t) {
     verdict = tr("Fault in %1 - isolated at %2").arg(parameter, seconds(*r.decision.verdictTime));
     color = "color: rgb(200,40,40)";
   } else if (r.decision.detectionTime && now >= *r.decision.detectionTime - 1e-9) {
-    verdict = tr("Fault detected at %1, not isolated yet").arg(seconds(*r.decision.detectionTime));
+    QStringList named;
+    for (const auto& n : r.namedByTests()) named << QString::fromStdString(n);
+    verdict = k + 1 < r.time.size() ? tr("Change detected at %1, not isolated yet").arg(seconds(*r.decision.detectionTime))
+                                    : tr("Change detected at %1, not isolated to one parameter").arg(seconds(*r.decision.detectionTime));
+    if (!named.isEmpty()) verdict += tr(" (the tests on their own name %1)").arg(named.join(", "));
     color = "color: rgb(220,140,0)";
   } else {
     verdict = k + 1 < r.time.size() ? tr("No fault so far (%1)").arg(seconds(now)) : tr("No fault: the axis is healthy");

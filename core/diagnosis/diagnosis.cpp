@@ -82,11 +82,21 @@ TestOutcome evaluateTests(const std::vector<const TestTrace*>& traces,
 
 std::string DiagnosisResult::verdictName() const {
   if (modelCheck.mismatch) return "model_mismatch";
-  return decision.verdict ? faults.at(*decision.verdict) : "none";
+  if (decision.verdict) return faults.at(*decision.verdict);
+  return decision.detectionTime ? "detected" : "none";
 }
 
 std::optional<double> DiagnosisResult::verdictTime() const {
-  return modelCheck.mismatch ? modelCheck.time : decision.verdictTime;
+  if (modelCheck.mismatch) return modelCheck.time;
+  return decision.verdict ? decision.verdictTime : decision.detectionTime;
+}
+
+std::vector<std::string> DiagnosisResult::namedByTests() const {
+  std::vector<std::string> named;
+  for (const auto& o : outcomes)
+    if (o.verdict && std::find(named.begin(), named.end(), faults.at(*o.verdict)) == named.end())
+      named.push_back(faults.at(*o.verdict));
+  return named;
 }
 
 std::string DiagnosisResult::windowText() const {
@@ -122,8 +132,15 @@ std::string DiagnosisResult::summary() const {
         (decision.verdict ? "; the tests' " + faults.at(*decision.verdict) + " is not reported as a fault." : ".");
   else if (decision.verdict)
     s = "Verdict: " + verdictName() + " changed, isolated at " + seconds2(*decision.verdictTime) + ".";
-  else if (decision.detectionTime)
-    s = "A fault was detected at " + seconds2(*decision.detectionTime) + " but not isolated.";
+  else if (decision.detectionTime) {
+    const std::vector<std::string> named = namedByTests();
+    std::string names;
+    for (const auto& n : named) names += (names.empty() ? "" : ", ") + n;
+    s = "Verdict: detected: a change at " + seconds2(*decision.detectionTime) +
+        " that the decision does not isolate to one parameter" +
+        (named.empty() ? std::string(" (no test names one).")
+                       : "; the tests on their own name " + names + ".");
+  }
   else
     s = "Verdict: none (no fault detected).";
   std::string used;

@@ -86,11 +86,17 @@ struct DiagnosisResult {
   // What the temperatures did to theta_0's f_m (diagnose() from a log; empty otherwise).
   TemperatureCorrection temperature;
 
-  // "none", the changed parameter's model name (k_T, J_a, f_m), or "model_mismatch" when the
+  // "none", the changed parameter's model name (k_T, J_a, f_m), "detected" when the decision
+  // detected a change but isolated no single parameter (a fault of two parameters, or one the
+  // tests disagree on: a detection is never reported as none), or "model_mismatch" when the
   // model no longer fits the data (then no parameter is named).
   std::string verdictName() const;
-  // When the verdict was reached (the mismatch's time for model_mismatch), if it was.
+  // When the verdict was reached (the detection's time for detected, the mismatch's for
+  // model_mismatch), if it was.
   std::optional<double> verdictTime() const;
+  // The parameters the tests name on their own (each test's verdict), in test order, once each:
+  // what a detected change points at.
+  std::vector<std::string> namedByTests() const;
   // "cumulative (from the first sample, as the seed)" or "sliding, the last 5 s".
   std::string windowText() const;
   // The trace and outcome of a test, or nullptr when it did not run.

@@ -38,6 +38,8 @@ nlohmann::json diagnosisResultJson(const DiagnosisResult& r) {
   j["alarm_time_s"] = optionalTime(r.verdictTime());
   // The tests' own verdict, which model_mismatch keeps from being reported as a fault.
   j["tests_verdict"] = r.decision.verdict ? nlohmann::json(r.faults.at(*r.decision.verdict)) : nlohmann::json("none");
+  // For a change detected but not isolated: the parameters the tests name on their own.
+  j["named_by_tests"] = r.namedByTests();
   const ModelCheck& mc = r.modelCheck;
   j["model_check"] = {{"checked", mc.checked},
                       {"fits", !mc.mismatch},

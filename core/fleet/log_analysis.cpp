@@ -82,11 +82,13 @@ bool isValidFleetLogResult(const FleetLogResult& r, std::string* why) {
   };
   if (!isSha256(r.sha256)) return fail("the log's checksum is not 64 hex digits");
   if (!isSha256(r.referenceSha256)) return fail("the reference's checksum is not 64 hex digits");
-  // A verdict is none, model_mismatch, or one of the monitored parameters.
-  bool known = r.verdict == "none" || r.verdict == "model_mismatch";
+  // A verdict is none, detected (a change not isolated), model_mismatch, or one of the
+  // monitored parameters.
+  bool known = r.verdict == "none" || r.verdict == "detected" || r.verdict == "model_mismatch";
   for (const auto& e : r.estimates) known = known || (r.ok && e.name == r.verdict);
   if (!known)
-    return fail("the verdict '" + r.verdict.substr(0, 40) + "' is not none, model_mismatch or a monitored parameter");
+    return fail("the verdict '" + r.verdict.substr(0, 40) +
+                "' is not none, detected, model_mismatch or a monitored parameter");
   if (r.verdictTimeS && !(std::isfinite(*r.verdictTimeS) && *r.verdictTimeS >= 0.0))
     return fail("the verdict's time " + number(*r.verdictTimeS) + " s is not a time in the log");
   if (!(std::isfinite(r.seconds) && r.seconds >= 0.0)) return fail("the analysis time " + number(r.seconds) + " s is not a duration");
@@ -204,7 +206,7 @@ FleetLogResult analyseFleetLog(const std::string& logPath, const DiagnosisRefere
     out.estimates.push_back(e);
   }
   out.verdict = d.verdictName();
-  out.verdictTimeS = d.decision.verdictTime;
+  out.verdictTimeS = d.verdictTime();
   out.ok = true;
   return finish(d.summary());
 }

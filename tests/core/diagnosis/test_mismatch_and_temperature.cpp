@@ -4,9 +4,11 @@
 // unmodelled backlash, a parameter step, or a friction moved by a warmer gearbox.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 
 #include "core/diagnosis/diagnosis.h"
+#include "core/diagnosis/diagnosis_json.h"
 #include "core/diagnosis/diagnosis_temperature.h"
 #include "core/models/effects.h"
 #include "core/sim/closed_loop.h"
@@ -180,6 +182,37 @@ TEST(DiagnosisTemperature, AlphaFromHealthyLogsAtThreeTemperatures) {
       *makeModel("three-mass"), pointers, {"20 degC", "35 degC", "50 degC"}, DiagnosisOptions{}, 20.0);
   EXPECT_EQ(missing.termination, Termination::Failed);
   EXPECT_NE(missing.message.find("35 degC"), std::string::npos) << missing.message;
+}
+
+// A change the decision detects but does not isolate to one parameter is its own verdict,
+// never "none": on a backlash log decided by the CUSUM test alone (which detects at 2 s and
+// names no parameter) with the model check off, the verdict is detected at the detection's
+// time, and the parameters the other tests name on their own are listed with it.
+TEST(DiagnosisVerdict, ADetectionThatIsNotIsolatedIsTheVerdictDetected) {
+  DiagnosisOptions o;
+  o.decision = {DiagnosisTest::Cusum};
+  o.checkModel = false;
+  Effect backlash = Effect::withDefaults(EffectKind::Backlash);
+  backlash.values[0] = 5e-5;
+  const DiagnosisResult r = diagnose(reference(), simulated(*arm(), 11, {backlash}), o);
+  ASSERT_EQ(r.termination, Termination::Converged) << r.message;
+  ASSERT_FALSE(r.decision.verdict) << r.summary();
+  ASSERT_TRUE(r.decision.detectionTime) << r.summary();
+  EXPECT_EQ(r.verdictName(), "detected") << r.summary();
+  ASSERT_TRUE(r.verdictTime());
+  EXPECT_DOUBLE_EQ(*r.verdictTime(), *r.decision.detectionTime);
+  EXPECT_LT(*r.verdictTime(), 5.0);
+  const auto named = r.namedByTests();
+  EXPECT_NE(std::find(named.begin(), named.end(), "J_a"), named.end()) << r.summary();
+  EXPECT_EQ(r.summary().rfind("Verdict: detected", 0), 0u) << r.summary();
+  const nlohmann::json j = diagnosisResultJson(r);
+  EXPECT_EQ(j["verdict"], "detected");
+  EXPECT_DOUBLE_EQ(j["alarm_time_s"].get<double>(), *r.decision.detectionTime);
+  EXPECT_EQ(j["named_by_tests"].size(), named.size());
+  // A healthy log is still none, with nothing named.
+  const DiagnosisResult healthy = diagnose(reference(), simulated(*arm(), 2), o);
+  EXPECT_EQ(healthy.verdictName(), "none") << healthy.summary();
+  EXPECT_FALSE(healthy.verdictTime());
 }
 
 }  // namespace

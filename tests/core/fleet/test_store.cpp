@@ -73,6 +73,30 @@ TEST(FleetStore, IsVersionedInWalAndKeepsWhatItWasGiven) {
   EXPECT_TRUE(store->logs("R01", 1).empty());
 }
 
+// The verdicts a diagnosis gives are the verdicts a store keeps: detected (a change not
+// isolated) beside none, model_mismatch and the parameters; anything else is refused.
+TEST(FleetStore, KeepsEveryVerdictADiagnosisGives) {
+  const auto path = scratch("verdicts.sqlite").string();
+  std::string why;
+  auto store = FleetStore::open(path, true, &why);
+  ASSERT_TRUE(store) << why;
+  ASSERT_TRUE(store->putAxis({"R01", 2, kRef, "R01/ax2/ref.csv", 21.5, "{}"}, &why)) << why;
+  const long run = store->beginRun("local", "m.csv", &why);
+  StoredLog detected = logOf("d", 2, 1.0);
+  detected.result.verdict = "detected";
+  StoredLog mismatch = logOf("e", 3, 1.0);
+  mismatch.result.verdict = "model_mismatch";
+  ASSERT_TRUE(store->putLogs({detected, mismatch}, run, &why)) << why;
+  const auto logs = store->logs("R01", 2, kRef);
+  ASSERT_EQ(logs.size(), 2u);
+  EXPECT_EQ(logs[0].result.verdict, "detected");
+  EXPECT_EQ(logs[1].result.verdict, "model_mismatch");
+  StoredLog other = logOf("f", 4, 1.0);
+  other.result.verdict = "fault";
+  EXPECT_FALSE(store->putLogs({other}, run, &why));
+  EXPECT_NE(why.find("not none, detected, model_mismatch"), std::string::npos) << why;
+}
+
 TEST(FleetStore, OneWriterAndReadersWhileItWrites) {
   const auto path = scratch("b.sqlite").string();
   std::string why;
