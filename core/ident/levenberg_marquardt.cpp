@@ -184,7 +184,35 @@ LeastSquaresSolution levenbergMarquardt(const LeastSquaresProblem& problem,
       Rl = r.R;
       Rl.diagonal() += mu * scale;
       trialPhi = r.phi + Rl.ldlt().solve(g);
-      if (problem.project) problem.project(trialPhi);
+      if (problem.project) {
+        // A parameter already on its bound that the step pushes past it is held there and the
+        // step solved again for the others: clipping the full step instead moves the others
+        // as if the held one had moved too, and the search crawls along the bound (a two-mass
+        // fit of the three-mass chirp log, d_a on 0: 118 iterations instead of a few).
+        Eigen::VectorXd clipped = trialPhi;
+        problem.project(clipped);
+        std::vector<Eigen::Index> moving;
+        for (Eigen::Index j = 0; j < clipped.size(); ++j) {
+          const bool onBound = clipped[j] != trialPhi[j] &&
+                               std::abs(clipped[j] - r.phi[j]) <= 1e-12 * (1.0 + std::abs(r.phi[j]));
+          if (!onBound) moving.push_back(j);
+        }
+        if (static_cast<Eigen::Index>(moving.size()) < clipped.size() && !moving.empty()) {
+          const auto m = static_cast<Eigen::Index>(moving.size());
+          Eigen::MatrixXd Rm(m, m);
+          Eigen::VectorXd gm(m);
+          for (Eigen::Index a = 0; a < m; ++a) {
+            gm[a] = g[moving[a]];
+            for (Eigen::Index b = 0; b < m; ++b) Rm(a, b) = Rl(moving[a], moving[b]);
+          }
+          const Eigen::VectorXd step = Rm.ldlt().solve(gm);
+          trialPhi = r.phi;
+          for (Eigen::Index a = 0; a < m; ++a) trialPhi[moving[a]] += step[a];
+          problem.project(trialPhi);
+        } else {
+          trialPhi = clipped;
+        }
+      }
       double ss = INFINITY;
       if (normal) {
         // The first trial of an iteration, usually accepted, brings R and g with its loss; a

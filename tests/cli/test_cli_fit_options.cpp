@@ -151,4 +151,18 @@ TEST(CliFitOptions, MaxIterationsIsAWarning) {
   EXPECT_NE(r.out.find("warning: the estimator stopped at its limit of 3 iterations"), std::string::npos) << r.out;
 }
 
+// The first fits a new user makes converge at the defaults: the bundled chirp log of the
+// three-mass truth fitted as two-, three- and four-mass. The two-mass fit has d_a on its bound
+// 0 (the truth's gear damping is negative); it used to crawl along the bound to the iteration
+// limit, and now holds d_a there and converges.
+TEST(CliFitOptions, DefaultFitsOfTheBundledChirpLogConverge) {
+  const std::string chirp = std::string(FLEXARM_SAMPLE_DIR) + "/three_mass_estimation_chirp.csv";
+  for (const char* model : {"two-mass", "three-mass", "four-mass"}) {
+    const json j = jsonRun({"fit", chirp, "--model", model});
+    EXPECT_EQ(j["termination"], "converged") << model << ": " << j.value("message", "");
+    EXPECT_LT(j.value("iterations", 1000), 50) << model;
+    EXPECT_EQ(codeCount(j, "max-iterations"), 0) << model << ": " << warnings(j);
+  }
+}
+
 }  // namespace
