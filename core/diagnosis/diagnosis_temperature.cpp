@@ -4,6 +4,8 @@
 #include <cstdio>
 #include <stdexcept>
 
+#include "core/signal/seconds_range.h"
+
 namespace flexarm {
 
 namespace {
@@ -131,8 +133,21 @@ FrictionTemperatureFit frictionFromHealthyLogs(const PhysicalModel& start,
   // may give theta_0 (on simulated logs the loop predictor puts f_m 0.006 low at every
   // temperature, which would inflate alpha by a fifth).
   const ReferenceOptions ro;
+  auto nameOf = [&](std::size_t i) { return i < names.size() ? names[i] : "log " + std::to_string(i + 1); };
+  // A log given twice (or two files of the same samples) is one point: counted twice it
+  // would narrow alpha's interval with no new evidence.
+  std::string repeated;
+  std::vector<std::size_t> used;
   for (std::size_t i = 0; i < logs.size(); ++i) {
-    const std::string name = i < names.size() ? names[i] : "log " + std::to_string(i + 1);
+    const std::string name = nameOf(i);
+    bool again = false;
+    for (std::size_t k : used)
+      if (!again && sameSamples(*logs[k], std::nullopt, *logs[i], std::nullopt)) {
+        repeated += (repeated.empty() ? "" : "; ") + name + " holds the samples of " + nameOf(k);
+        again = true;
+      }
+    if (again) continue;
+    used.push_back(i);
     FrictionTemperatureFit failed;
     const LogTemperature t = logTemperature(*logs[i]);
     if (!t.celsius) {
@@ -164,7 +179,10 @@ FrictionTemperatureFit frictionFromHealthyLogs(const PhysicalModel& start,
   }
   bool weighted = true;
   for (double s : fmStd) weighted = weighted && s > 0.0;
-  return fitFrictionTemperature(temperature, fm, weighted ? fmStd : std::vector<double>{}, referenceC);
+  FrictionTemperatureFit fit =
+      fitFrictionTemperature(temperature, fm, weighted ? fmStd : std::vector<double>{}, referenceC);
+  if (!repeated.empty()) fit.message += " Logs counted once: " + repeated + ".";
+  return fit;
 }
 
 }  // namespace flexarm

@@ -6,6 +6,7 @@
 
 #include "core/ident/evaluation.h"
 #include "core/ident/fit_internal.h"
+#include "core/signal/seconds_range.h"
 
 namespace flexarm {
 
@@ -301,6 +302,7 @@ const char* toString(FitWarning w) {
     case FitWarning::LinearPartResponse: return "linear-part-response";
     case FitWarning::RandomStartsUnused: return "random-starts-unused";
     case FitWarning::DeflectionDiverges: return "deflection-diverges";
+    case FitWarning::RepeatedExperiment: return "repeated-experiment";
   }
   return "other";
 }
@@ -520,12 +522,38 @@ bool prepareValidation(const FitOptions& o, const FitDataOptions& base, FitResul
 
 }  // namespace
 
-FitResult fitModel(const FitOptions& options, const ProgressCallback& progress) {
+FitResult fitModel(const FitOptions& given, const ProgressCallback& progress) {
   std::string why;
-  if (!options.isValid(&why)) throw std::invalid_argument("fitModel: " + why);
+  if (!given.isValid(&why)) throw std::invalid_argument("fitModel: " + why);
   const auto t0 = std::chrono::steady_clock::now();
   FitResult r;
-  r.model = options.model;
+  r.model = given.model;
+  // Evidence counted once: an experiment that holds the samples of an earlier one of its list
+  // (the same log given twice, two copies of one file) is dropped with a warning, so that the
+  // intervals do not narrow for data that add nothing.
+  FitOptions deduplicated = given;
+  auto countOnce = [&](std::vector<FitExperiment>& list, const char* kind) {
+    std::vector<FitExperiment> kept;
+    std::vector<std::size_t> number;  // of each kept one in the list as given, from 1
+    for (std::size_t i = 0; i < list.size(); ++i) {
+      std::size_t same = kept.size();
+      for (std::size_t k = 0; k < kept.size() && same == kept.size(); ++k)
+        if (sameSamples(*kept[k].data, kept[k].range, *list[i].data, list[i].range)) same = k;
+      if (same == kept.size()) {
+        kept.push_back(list[i]);
+        number.push_back(i + 1);
+        continue;
+      }
+      r.warn(FitWarning::RepeatedExperiment,
+             std::string(kind) + " experiment " + std::to_string(i + 1) + " holds the same samples as " + kind +
+                 " experiment " + std::to_string(number[same]) + " and is counted once");
+    }
+    list = std::move(kept);
+    return number;
+  };
+  const std::vector<std::size_t> estimationGiven = countOnce(deduplicated.estimation, "estimation");
+  const std::vector<std::size_t> validationGiven = countOnce(deduplicated.validation, "validation");
+  const FitOptions& options = deduplicated;
   auto finish = [&](Termination t, std::string message) -> FitResult {
     r.termination = t;
     r.message = std::move(message);
@@ -563,6 +591,8 @@ FitResult fitModel(const FitOptions& options, const ProgressCallback& progress) 
     r.status = FitStatus::BadData;
     return finish(r.termination, r.message);
   }
+  for (std::size_t i = 0; i < r.estimation.size(); ++i) r.estimation[i].given = estimationGiven[i] - 1;
+  for (std::size_t i = 0; i < r.validation.size(); ++i) r.validation[i].given = validationGiven[i] - 1;
   const bool nonparametric = options.model.kind == FitModelKind::Spa || options.model.kind == FitModelKind::Etfe;
   bool constant = true;
   for (const auto& e : r.estimation) {

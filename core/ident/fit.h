@@ -245,6 +245,9 @@ struct FitParameter {
 // sample, as the estimator saw it.
 struct FitValidation {
   PreparedData data;
+  // Its place in the experiment list as given (FitOptions::estimation or ::validation, from 0):
+  // a repeated experiment is counted once, so a list may hold fewer than were given.
+  std::size_t given = 0;
   std::optional<double> fitPercent;       // the seed's (5.2)
   std::optional<double> fitPercentNrmse;  // MATLAB compare's NRMSE fit (evaluation.h)
   FitBasis basis;  // what the fit % is of (model_output.h): the output, start, rate, samples
@@ -313,6 +316,7 @@ enum class FitWarning {
   LinearPartResponse,  // the response of a fit with effects is its linear part's
   RandomStartsUnused,  // a fit with effects starts from the values given only
   DeflectionDiverges,  // the deflection check could not simulate the estimate
+  RepeatedExperiment,  // an experiment holds the samples of another: counted once
 };
 const char* toString(FitWarning w);  // "other", "max-iterations", "on-bound", ...
 

@@ -17,7 +17,8 @@ json experimentsJson(const std::vector<FitValidation>& list, const std::vector<s
   for (std::size_t i = 0; i < list.size(); ++i) {
     const PreparedData& d = list[i].data;
     const SampleRange& range = validation ? d.validation : d.estimation;
-    a.push_back({{"log", i < names.size() ? names[i] : std::string()},
+    const std::size_t given = list[i].given;
+    a.push_back({{"log", given < names.size() ? names[given] : std::string()},
                  {"range_s", {d.timeAt(range.begin), d.timeAt(range.end - 1)}},
                  {"samples", range.size()},
                  {"fit_percent", fitPercentJson(list[i].fitPercent)},

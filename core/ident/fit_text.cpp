@@ -140,10 +140,11 @@ std::vector<std::string> fitSummaryLines(const FitResult& r, const std::string& 
     for (std::size_t i = 0; i < list.size(); ++i) {
       const PreparedData& d = list[i].data;
       const SampleRange& range = validation ? d.validation : d.estimation;
-      const std::string where = (i < names.size() ? fileName(names[i]) : std::string()) + ", " +
+      const std::size_t given = list[i].given;
+      const std::string where = (given < names.size() ? fileName(names[given]) : std::string()) + ", " +
                                 format("%g", d.timeAt(range.begin)) + "-" + format("%g", d.timeAt(range.end - 1)) +
                                 " s";
-      const std::string head = std::string(what) + " experiment " + std::to_string(i + 1) + " (" + where + "): ";
+      const std::string head = std::string(what) + " experiment " + std::to_string(given + 1) + " (" + where + "): ";
       lines.push_back(list[i].fitPercent ? head + "fit " + format("%.1f", *list[i].fitPercent) + " % (5.2), " +
                                                format("%.1f", list[i].fitPercentNrmse.value_or(NAN)) + " % NRMSE."
                                          : head + "no fit % (the simulated output diverges).");

@@ -1,9 +1,11 @@
 #include "core/signal/seconds_range.h"
-#include "core/common/text.h"
 
+#include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <cstdio>
+
+#include "core/common/text.h"
 
 namespace flexarm {
 
@@ -43,6 +45,24 @@ SampleRange samplesIn(const IdData& data, const SecondsRange& r) {
 SecondsRange secondsOf(const IdData& data, const SampleRange& r) {
   const std::size_t last = r.end > r.begin ? r.end - 1 : r.begin;
   return {data.timeAt(r.begin), data.timeAt(last)};
+}
+
+bool sameSamples(const IdData& a, const std::optional<SecondsRange>& rangeA, const IdData& b,
+                 const std::optional<SecondsRange>& rangeB) {
+  const SampleRange sa = rangeA ? samplesIn(a, *rangeA) : SampleRange{0, a.samples()};
+  const SampleRange sb = rangeB ? samplesIn(b, *rangeB) : SampleRange{0, b.samples()};
+  if (sa.empty() || sa.size() != sb.size() || a.channels.size() != b.channels.size() ||
+      a.sampleTime != b.sampleTime)
+    return false;
+  for (const Channel& ca : a.channels) {
+    const Channel* cb = b.channel(ca.name);
+    if (!cb || cb->unit != ca.unit) return false;
+    if (!std::equal(ca.values.begin() + static_cast<std::ptrdiff_t>(sa.begin),
+                    ca.values.begin() + static_cast<std::ptrdiff_t>(sa.end),
+                    cb->values.begin() + static_cast<std::ptrdiff_t>(sb.begin)))
+      return false;
+  }
+  return true;
 }
 
 }  // namespace flexarm

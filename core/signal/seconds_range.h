@@ -30,4 +30,11 @@ SampleRange samplesIn(const IdData& data, const SecondsRange& r);
 // The seconds of a sample range of data: from its first to its last sample's time.
 SecondsRange secondsOf(const IdData& data, const SampleRange& r);
 
+// Whether two experiments (a log, or a range of it: unset, the whole log) hold the same
+// samples: the same sample time, the same channels by name and unit, and the same values. A
+// repeated experiment is the same evidence whatever file or range it was read from, and an
+// estimator that counted it twice would narrow its intervals by sqrt(2).
+bool sameSamples(const IdData& a, const std::optional<SecondsRange>& rangeA, const IdData& b,
+                 const std::optional<SecondsRange>& rangeB);
+
 }  // namespace flexarm

@@ -176,6 +176,21 @@ TEST(DiagnosisTemperature, AlphaFromHealthyLogsAtThreeTemperatures) {
   EXPECT_EQ(fit.model.logs, 3);
   EXPECT_NEAR(fit.model.alpha, alpha, 3.0 * fit.model.alphaStd) << fit.message;
   EXPECT_NEAR(fit.model.alpha, alpha, 0.1 * alpha) << fit.message;
+  // The same logs given again (one by another name) are the same three points: alpha and its
+  // interval as before, and the message says which were counted once.
+  const IdData copy = logs[2];
+  std::vector<const IdData*> again = pointers;
+  again.push_back(&copy);
+  again.push_back(pointers[0]);
+  const FrictionTemperatureFit repeated = frictionFromHealthyLogs(
+      *makeModel("three-mass"), again, {"20 degC", "35 degC", "50 degC", "copy", "20 again"}, DiagnosisOptions{}, 20.0);
+  ASSERT_EQ(repeated.termination, Termination::Converged) << repeated.message;
+  EXPECT_EQ(repeated.model.logs, 3);
+  EXPECT_DOUBLE_EQ(repeated.model.alpha, fit.model.alpha);
+  EXPECT_DOUBLE_EQ(repeated.model.alphaStd, fit.model.alphaStd);
+  EXPECT_NE(repeated.message.find("copy holds the samples of 50 degC; 20 again holds the samples of 20 degC"),
+            std::string::npos)
+      << repeated.message;
   // A log without a temperature is named.
   logs[1].metadata.clear();
   const FrictionTemperatureFit missing = frictionFromHealthyLogs(

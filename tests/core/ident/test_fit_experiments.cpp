@@ -182,6 +182,50 @@ TEST(FitExperiments, OutputErrorOnTwoLogs) {
   EXPECT_TRUE(both.estimation[0].fitPercent && both.estimation[1].fitPercent);
 }
 
+// The same evidence counted once: a log given twice (the same object, or a copy of its
+// samples read from another file) leaves the estimate and its intervals as one gives them,
+// with a warning naming the experiment it repeats; a second log that differs stays two.
+TEST(FitExperiments, ARepeatedExperimentIsCountedOnce) {
+  FitOptions o;
+  o.model.kind = FitModelKind::BlackBox;
+  o.model.structure = PolyStructure::Oe;
+  o.model.orders = PolyOrders{0, 2, 0, 0, 2, 1};
+  const auto first = twoMassLog(1500, 0, 31);
+  o.estimation = {{first, std::nullopt}};
+  const FitResult one = fitModel(o);
+  ASSERT_TRUE(one.ok()) << one.message;
+  EXPECT_FALSE(one.warned(FitWarning::RepeatedExperiment));
+  const auto copy = std::make_shared<const IdData>(*first);  // the same bytes, another file
+  const auto other = twoMassLog(1500, 0, 32);
+  o.estimation = {{first, std::nullopt}, {other, std::nullopt}, {copy, std::nullopt}, {first, std::nullopt}};
+  const FitResult repeated = fitModel(o);
+  ASSERT_TRUE(repeated.ok()) << repeated.message;
+  ASSERT_EQ(repeated.estimation.size(), 2u);
+  EXPECT_EQ(repeated.estimation[1].given, 1u);
+  int warnings = 0;
+  for (std::size_t i = 0; i < repeated.warnings.size(); ++i)
+    if (repeated.warningCode(i) == FitWarning::RepeatedExperiment) {
+      ++warnings;
+      EXPECT_NE(repeated.warnings[i].find("as estimation experiment 1 and is counted once"), std::string::npos)
+          << repeated.warnings[i];
+    }
+  EXPECT_EQ(warnings, 2);
+  o.estimation = {{first, std::nullopt}, {copy, std::nullopt}};
+  const FitResult twice = fitModel(o);
+  ASSERT_TRUE(twice.ok()) << twice.message;
+  ASSERT_EQ(twice.parameters.size(), one.parameters.size());
+  for (std::size_t i = 0; i < one.parameters.size(); ++i) {
+    EXPECT_DOUBLE_EQ(twice.parameters[i].value, one.parameters[i].value) << one.parameters[i].name;
+    EXPECT_DOUBLE_EQ(twice.parameters[i].std, one.parameters[i].std) << one.parameters[i].name;
+  }
+  // A range of the same log that is not the same samples is another experiment.
+  o.estimation = {{first, SecondsRange{0.0, 0.7}}, {first, SecondsRange{0.7, 1.4}}};
+  const FitResult halves = fitModel(o);
+  ASSERT_TRUE(halves.ok()) << halves.message;
+  EXPECT_EQ(halves.estimation.size(), 2u);
+  EXPECT_FALSE(halves.warned(FitWarning::RepeatedExperiment));
+}
+
 // Noise-free ARX data of two experiments, each from rest: least squares over regressors that
 // stay inside their experiment recovers the truth exactly; joined, the rows at the seam mix
 // the two and the estimate is off.
