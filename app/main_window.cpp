@@ -222,7 +222,7 @@ MainWindow::MainWindow(QWidget* parent)
 MainWindow::~MainWindow() { reader_.waitForFinished(); }
 
 bool MainWindow::isBusy() const {
-  return reader_.isRunning() || session_->isBusy() || comparePanel_->isBusy() ||
+  return reader_.isRunning() || session_->isBusy() || logPanel_->isBusy() || comparePanel_->isBusy() ||
          residualsPanel_->isBusy() || bodePanel_->isBusy() || preprocessPanel_->isBusy();
 }
 

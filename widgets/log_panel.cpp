@@ -39,7 +39,7 @@ QString label(const Channel& c) {
 LogPanel::LogPanel(Workspace* workspace, QWidget* parent)
     : QWidget(parent), workspace_(workspace), plot_(new QCustomPlot(this)),
       readout_(new QLabel(this)), rangeTable_(new QTableWidget(2, 4, this)),
-      playheadCursor_(new PlayheadCursor(plot_, this)) {
+      playheadCursor_(new PlayheadCursor(plot_, this)), drawer_(new BackgroundRefresh(this)) {
   setObjectName("logPanel");
   auto* tools = new QHBoxLayout;
   auto makeButton = [&](const QString& text, const QString& tip, const QString& shortcut) {
@@ -204,6 +204,7 @@ void LogPanel::rebuild() {
   overlay_ = plot_->layer("cursor");
   overlay_->setMode(QCPLayer::lmBuffered);
   if (!data || data->channels.empty()) {
+    drawer_->cancel();
     plot_->replot();
     updateRanges();
     playheadCursor_->attach();
@@ -228,22 +229,6 @@ void LogPanel::rebuild() {
     for (QCPAxis* a : rect->axes()) a->setLayer("axes");
     auto* g = plot_->addGraph(x, y);
     g->setPen(QPen(kTraceColors[c % 8], 1.2));
-    // Millions of samples are drawn through a min/max envelope of the visible range, so
-    // opening, zooming and panning cost the same for a 10-minute log as for a short one.
-    if (std::any_of(ch.values.begin(), ch.values.end(), [](double v) { return std::isnan(v); })) {
-      // A channel logged at a lower rate than the rows: drawn through its own samples.
-      std::vector<double> held = ch.values;
-      double previous = 0.0;
-      for (double v : held)
-        if (!std::isnan(v)) {
-          previous = v;
-          break;
-        }
-      for (double& v : held) std::isnan(v) ? (v = previous) : (previous = v);
-      envelopes_.push_back(std::make_unique<EnvelopePyramid>(held));
-    } else {
-      envelopes_.push_back(std::make_unique<EnvelopePyramid>(ch.values));
-    }
     double lo = HUGE_VAL, hi = -HUGE_VAL;  // NaN marks "not sampled here" in irregular logs
     for (double v : ch.values)
       if (!std::isnan(v)) {
@@ -305,12 +290,44 @@ void LogPanel::rebuild() {
   updateRanges();
   updateLoopSelection();
   playheadCursor_->attach();
+  // Millions of samples are drawn through a min/max envelope of the visible range, so zooming
+  // and panning cost the same for a 10-minute log as for a short one; the envelopes are formed
+  // in the background and the curves drawn when they are ready.
+  const std::shared_ptr<const IdData> shared = workspace_->shownShared();
+  drawer_->run([this, shared](const std::atomic<bool>& stop) -> BackgroundRefresh::Apply {
+    auto formed = std::make_shared<std::vector<std::shared_ptr<const EnvelopePyramid>>>();
+    for (const Channel& ch : shared->channels) {
+      if (stop) return {};
+      if (std::any_of(ch.values.begin(), ch.values.end(), [](double v) { return std::isnan(v); })) {
+        // A channel logged at a lower rate than the rows: drawn through its own samples.
+        std::vector<double> held = ch.values;
+        double previous = 0.0;
+        for (double v : held)
+          if (!std::isnan(v)) {
+            previous = v;
+            break;
+          }
+        for (double& v : held) std::isnan(v) ? (v = previous) : (previous = v);
+        formed->push_back(std::make_shared<const EnvelopePyramid>(held));
+      } else {
+        formed->push_back(std::make_shared<const EnvelopePyramid>(ch.values));
+      }
+    }
+    return [this, shared, formed] {
+      if (workspace_->shownShared() != shared || formed->size() != rects_.size()) return;
+      envelopes_ = std::move(*formed);
+      for (std::size_t c = 0; c < envelopes_.size(); ++c) refreshChannel(c);
+      plot_->replot();
+    };
+  });
   readout_->setText(tr("%1 channels, %2 samples at %3 Hz, %4 s")
                         .arg(data->channels.size())
                         .arg(n)
                         .arg(data->sampleRateHz(), 0, 'g', 6)
                         .arg(data->duration(), 0, 'g', 6));
 }
+
+bool LogPanel::isBusy() const { return drawer_->isBusy(); }
 
 void LogPanel::showAll() {
   const IdData* data = workspace_->shown();

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "core/signal/envelope.h"
+#include "widgets/background_refresh.h"
 
 #include "widgets/workspace.h"
 
@@ -56,6 +57,8 @@ class LogPanel : public QWidget {
   QString readoutText() const;
   // Shows the whole log.
   void showAll();
+  // The channels' envelopes are being formed for the log shown (its curves follow).
+  bool isBusy() const;
   QTableWidget* rangeTable() const { return rangeTable_; }
   // Sets a range from typed times in seconds ("0.5", "12 s"; empty means the log's start or
   // end), exactly as typed when inside the log. False with the reason otherwise.
@@ -97,7 +100,10 @@ class LogPanel : public QWidget {
   std::vector<QCPAxisRect*> rects_;
   std::vector<QCPItemStraightLine*> cursors_;
   std::vector<QCPItemRect*> estimationRects_, validationRects_, loopRects_;
-  std::vector<std::unique_ptr<EnvelopePyramid>> envelopes_;
+  // Each channel's envelope, formed off the GUI thread (it grows with the log): empty until
+  // drawer_ has applied them for the data shown.
+  std::vector<std::shared_ptr<const EnvelopePyramid>> envelopes_;
+  BackgroundRefresh* drawer_;
   Mode mode_ = Mode::Navigate;
   bool selecting_ = false;
   double selectStart_ = 0.0;

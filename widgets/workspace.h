@@ -83,6 +83,11 @@ class Workspace : public QObject {
   }
   // What the Log panel draws: current(), or the raw log when it waits for resampling.
   const IdData* shown() const { return processed_ ? processed_.get() : raw_.get(); }
+  // shown() shared, for the Log panel's work off the GUI thread.
+  std::shared_ptr<const IdData> shownShared() const {
+    if (processed_) return processed_;
+    return raw_;
+  }
   // The raw log has irregular time stamps and no resampling has been applied yet.
   bool needsResampling() const { return raw_ && !raw_->isUniform() && !processed_; }
   bool isPreprocessed() const { return processed_ != nullptr; }

@@ -61,6 +61,9 @@ class MainWindowTest : public QObject {
     QVERIFY2(window_->logPanel()->readoutText().contains("at 2000 Hz"),
              qPrintable(window_->logPanel()->readoutText()));
     QVERIFY(window_->recentFiles().contains(QFileInfo(kSampleLog).absoluteFilePath()));
+    // The curves are drawn once their envelopes, formed in the background, are ready.
+    QTRY_VERIFY(!window_->logPanel()->isBusy());
+    QVERIFY(window_->logPanel()->plot()->graph(0)->dataCount() > 10);
   }
 
   void dragSelectsEstimationRange() {
