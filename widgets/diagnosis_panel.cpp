@@ -100,7 +100,8 @@ DiagnosisPanel::DiagnosisPanel(Workspace* workspace, QWidget* parent)
   bold.setPointSizeF(bold.pointSizeF() * 1.2);
   verdict_->setFont(bold);
   verdict_->setText(tr("Choose the fault-free reference and press \"Diagnose\"."));
-  for (QLabel* l : {statement_, thresholds_, stage_, referenceName_}) {
+  // The verdict wraps too: a restored session's summary is a paragraph.
+  for (QLabel* l : {verdict_, statement_, thresholds_, stage_, referenceName_}) {
     l->setWordWrap(true);
     l->setTextInteractionFlags(Qt::TextSelectableByMouse);
   }

@@ -15,6 +15,7 @@
 #include <QSignalSpy>
 #include <QTableWidget>
 #include <QTemporaryDir>
+#include <QScrollArea>
 #include <QtTest>
 #include <qcustomplot.h>
 
@@ -166,6 +167,26 @@ class DiagnosisPanelTest : public QObject {
     QVERIFY(opened.wait(30000));
     QVERIFY(!other.diagnosisPanel()->isBusy());
     QVERIFY2(other.diagnosisPanel()->verdictText().contains("k_T"), qPrintable(other.diagnosisPanel()->verdictText()));
+    // The stored summary (a paragraph) wraps in the dock at 1366x768: the dock grows no
+    // horizontal scroll bar and the Diagnose button stays on the screen.
+    other.resize(1366, 768);
+    other.docks()->arrange(PanelDocks::Layout::Compact);
+    other.show();
+    QVERIFY(QTest::qWaitForWindowExposed(&other));
+    auto* dock = other.findChild<QDockWidget*>("diagnosisDock");
+    QVERIFY(dock);
+    dock->show();
+    dock->raise();
+    QTest::qWait(100);
+    auto* scroll = qobject_cast<QScrollArea*>(dock->widget());
+    QVERIFY(scroll);
+    QVERIFY2(scroll->widget()->width() <= scroll->viewport()->width(),
+             qPrintable(QString("panel %1 px wide in a %2 px dock").arg(scroll->widget()->width()).arg(scroll->viewport()->width())));
+    auto* diagnose = other.diagnosisPanel()->findChild<QPushButton*>("diagnose");
+    QVERIFY(diagnose);
+    const QRect button(diagnose->mapTo(&other, QPoint(0, 0)), diagnose->size());
+    QVERIFY2(other.rect().contains(button), qPrintable(QString("Diagnose at x %1").arg(button.x())));
+    test::saveShot(dock->grab().toImage(), "diagnosis_restored_1366");
     const Session again = other.sessionController()->capture(path);
     QVERIFY(again.parts.contains("diagnosis"));
     QCOMPARE(again.parts["diagnosis"]["result"]["verdict"].get<std::string>(), std::string("k_T"));
