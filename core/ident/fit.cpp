@@ -4,6 +4,7 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "core/common/text.h"
 #include "core/ident/evaluation.h"
 #include "core/ident/fit_internal.h"
 #include "core/signal/seconds_range.h"
@@ -520,6 +521,34 @@ bool prepareValidation(const FitOptions& o, const FitDataOptions& base, FitResul
   return true;
 }
 
+// What to try when the estimator stopped at its iteration limit, from what the fit shows: a
+// loss still falling (more iterations); one that has stopped falling, with parameters the
+// data do not determine (hold them: the search only wanders along them) or without (another
+// start).
+std::string iterationLimitAdvice(const FitResult& r, int limit) {
+  std::string s = "the estimator stopped at its limit of " + std::to_string(limit) +
+                  " iterations before it converged, so the estimate may not be the loss's minimum and its "
+                  "intervals may not hold; ";
+  std::string undetermined;
+  for (const auto& p : r.parameters)
+    if (p.free && !p.determined) undetermined += (undetermined.empty() ? "" : ", ") + p.name;
+  const auto& h = r.summary.lossHistory;
+  const std::size_t back = std::min<std::size_t>(10, h.size() > 0 ? h.size() - 1 : 0);
+  const double before = back > 0 ? h[h.size() - 1 - back] : 0.0;
+  const double fell = back > 0 && before > 0.0 ? (before - h.back()) / before : 0.0;
+  const std::string percent = shortNumber(100.0 * fell, 2) + " %";
+  if (fell >= 1e-3)
+    return s + "the loss still fell " + percent + " over the last " + std::to_string(back) +
+           " iterations: raise the iteration limit (--max-iterations, the Fit panel's Max iterations)";
+  const std::string flat = "the loss fell only " + percent + " over the last " + std::to_string(back) +
+                           " iterations, so more of them will change little: ";
+  if (!undetermined.empty())
+    return s + flat + "the data do not determine " + undetermined +
+           ", and the search only moves along them; hold them (--fix, or untick them in the Fit panel) or fit a "
+           "smaller model";
+  return s + flat + "start from other values (--start, --starts)";
+}
+
 }  // namespace
 
 FitResult fitModel(const FitOptions& given, const ProgressCallback& progress) {
@@ -646,11 +675,6 @@ FitResult fitModel(const FitOptions& given, const ProgressCallback& progress) {
     return finish(Termination::Failed, std::string("the estimator met numerical trouble: ") + e.what());
   }
   if (!r.summary.ok()) return finish(r.summary.termination, r.summary.message);
-  if (r.summary.termination == Termination::MaxIterations)
-    r.warn(FitWarning::MaxIterations, "the estimator stopped at its limit of " +
-                                          std::to_string(options.maxIterations) +
-                                          " iterations before it converged, so the estimate may not be the "
-                                          "loss's minimum and its intervals may not hold; raise the iteration limit");
 
   // 5. Evaluation.
   try {
@@ -660,6 +684,8 @@ FitResult fitModel(const FitOptions& given, const ProgressCallback& progress) {
   } catch (const std::exception& e) {
     return finish(Termination::Failed, std::string("the estimate could not be evaluated: ") + e.what());
   }
+  if (r.summary.termination == Termination::MaxIterations)
+    r.warn(FitWarning::MaxIterations, iterationLimitAdvice(r, options.maxIterations));
   return finish(r.summary.termination, r.summary.message);
 }
 

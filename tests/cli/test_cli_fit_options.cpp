@@ -149,6 +149,9 @@ TEST(CliFitOptions, MaxIterationsIsAWarning) {
   const auto r = runFlexarm(args);
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_NE(r.out.find("warning: the estimator stopped at its limit of 3 iterations"), std::string::npos) << r.out;
+  // It says what to try: after 3 iterations the loss is still falling, so more of them.
+  EXPECT_NE(r.out.find("the loss still fell"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("raise the iteration limit (--max-iterations"), std::string::npos) << r.out;
 }
 
 // The first fits a new user makes converge at the defaults: the bundled chirp log of the
