@@ -373,6 +373,22 @@ bool level4(const Byte* p, std::uint64_t n, std::string& problem) {
       problem = kNotMat;
       return false;
     }
+    // M names the byte order the numbers were written in (0 little-endian, 1 big-endian), and
+    // matio reads the rest of the header in it: a type that reads right only in the other order
+    // makes matio take the name length (and sizes) the wrong way round, gigabytes for a few bytes.
+    constexpr bool bigEndianHost = __BYTE_ORDER__ == __ORDER_BIG_ENDIAN__;
+    if (m != ((swap != bigEndianHost) ? 1 : 0)) {
+      problem = "variable " + std::to_string(index) + " states " + (m ? "big" : "little") +
+                "-endian numbers but its header is written the other way: damaged, or not a .mat file";
+      return false;
+    }
+    // A sparse matrix (t = 2) is stored as rows of (i, j, value) or (i, j, re, im): any other
+    // number of columns is not one, and matio would size its arrays by the rows alone.
+    if (t == 2 && cols != (imag ? 4 : 3) && cols != 4) {
+      problem = "variable " + std::to_string(index) + " is a sparse matrix stored with " + std::to_string(cols) +
+                " columns (a level-4 sparse matrix has 3 or 4): damaged, or not a .mat file";
+      return false;
+    }
     static const std::uint64_t sizes[] = {8, 4, 4, 2, 2, 1};
     const std::uint64_t bytes = static_cast<std::uint64_t>(rows) * static_cast<std::uint64_t>(cols) *
                                 sizes[prec] * (imag ? 2u : 1u);
