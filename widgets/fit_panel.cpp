@@ -59,9 +59,10 @@ FitPanel::FitPanel(Workspace* workspace, QWidget* parent)
       abort_(std::make_shared<std::atomic<bool>>(false)) {
   setObjectName("fitPanel");
   model_->setObjectName("fitModelCombo");
-  model_->setToolTip(tr("What to fit: a black box (4.8: ARX, ARMAX, OE, Box-Jenkins), a physical "
-                        "model of the shared list from its values, or a structure (5.1, 5.3) from "
-                        "its nominal values"));
+  model_->setToolTip(tr("What to fit: a black box (4.8: ARX, ARMAX, OE, Box-Jenkins), a state-space "
+                        "model by subspace identification refined by prediction error (its order is na; "
+                        "0 lets the data choose it by MDL), a physical model of the shared list from its "
+                        "values, or a structure (5.1, 5.3) from its nominal values"));
   const int defaults[] = {2, 4, 2, 2, 4, 1};
   auto* orderRow = new QGridLayout;  // two rows of three: the panel stays narrow
   orderRow->setContentsMargins(0, 0, 0, 0);
@@ -280,6 +281,7 @@ void FitPanel::refillModels() {
   model_->addItem(tr("ARMAX"), "armax");
   model_->addItem(tr("OE"), "oe");
   model_->addItem(tr("Box-Jenkins"), "bj");
+  model_->addItem(tr("State space (subspace, then PEM; order na, 0: by MDL)"), "ss");
   const auto& list = workspace_->models();
   for (std::size_t i = 0; i < list.size(); ++i)
     if (list[i].model)

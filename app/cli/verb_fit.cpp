@@ -10,6 +10,7 @@
 #include "core/ident/fit_experiments.h"
 #include "core/ident/fit_spec.h"
 #include "core/ident/fit_text.h"
+#include "core/ident/order_scan.h"
 #include "core/models/effects.h"
 
 namespace flexarm::cli {
@@ -46,7 +47,12 @@ OptionTable fitTable() {
                 "Estimates a model by prediction error (the seed's chapters 4 and 5) and reports its parameters "
                 "with standard deviations and 99 % intervals, loss, fit % (5.2) of the simulated output on the "
                 "estimation and validation data, and the notch and peak frequencies.");
-  t.add(fitOptionList(false)).group("Reading the log").add(logReadOptionList());
+  t.add(fitOptionList(false));
+  t.add(flagOption("scan", "instead of a fit, scan the orders (as arxstruc and selstruc): with --model arx:NA,NB,NK "
+                           "every ARX structure na <= NA, nb <= NB, nk up to NK by its loss on the validation data "
+                           "(else the estimation data), AIC and MDL, and the state-space orders' singular values "
+                           "and MDL; with --model ss[:N] the state-space orders up to N alone"));
+  t.group("Reading the log").add(logReadOptionList());
   t.note("Physical, black-box and non-parametric models give the motor velocity: a log whose output is the motor "
          "angle is differentiated first (central differences, Section 5.2).");
   t.note("Fit % is printed both ways, of the output simulated from zero initial state (input held between "
@@ -229,14 +235,17 @@ std::vector<Option> fitOptionList(bool nonparametric) {
   return v;
 }
 
-int runFitPipeline(ArgParser& args, const std::string& verb, FitResult& result, std::ostream& err,
-                   bool allowNonparametric, FitLogNames* logNames) {
+namespace {
+
+// The fit request the options name, its logs read and its experiments listed; the exit code
+// (kExitOk when o is ready to run).
+int readFitRequest(ArgParser& args, const std::string& verb, bool allowNonparametric, FitOptions& o,
+                   FitLogNames& logs, std::ostream& err) {
   const std::string pre = "flexarm " + verb + ": ";
   if (args.positional().size() != 1) {
     err << pre << "expected exactly one LOG\n";
     return kExitUsage;
   }
-  FitOptions o;
   if (!readChoices(args, allowNonparametric, o, pre, err)) return kExitUsage;
   auto readOptions = logReadOptions(args, err);
   if (!readOptions) return kExitUsage;
@@ -248,7 +257,7 @@ int runFitPipeline(ArgParser& args, const std::string& verb, FitResult& result, 
     err << "flexarm: " << path << ": the log has no input or no output channel\n";
     return kExitBadInput;
   }
-  FitLogNames logs{{path}, {}};
+  logs = FitLogNames{{path}, {}};
   FitExperiment est{data, std::nullopt};
   if (!rangeOption(args, "range", *data, data->estimationRange, est.range, pre, err)) return kExitUsage;
   o.estimation = {est};
@@ -266,11 +275,42 @@ int runFitPipeline(ArgParser& args, const std::string& verb, FitResult& result, 
     if (const int rc = experimentOption(text, "validation-log", *readOptions, true, read, o, logs, pre, err);
         rc != kExitOk)
       return rc;
-  if (logNames) *logNames = logs;
   if (const FitCheck c = o.check(); !c.ok()) {
     err << pre << c.message << "\n";
     return kExitUsage;
   }
+  return kExitOk;
+}
+
+// --scan: the order scan of the fit's data instead of the fit.
+int runScan(ArgParser& args, std::ostream& out, std::ostream& err) {
+  FitOptions o;
+  FitLogNames logs;
+  if (const int rc = readFitRequest(args, "fit", false, o, logs, err); rc != kExitOk) return rc;
+  std::string why;
+  const auto scan = OrderScanOptions::fromSpec(o.model, &why);
+  if (!scan) {
+    err << "flexarm fit: --scan: " << why << "\n";
+    return kExitUsage;
+  }
+  const OrderScan s = scanOrders(o, *scan, progressLine(err, "scan"));
+  if (args.flag("json")) out << orderScanJson(s).dump(2) << "\n";
+  else out << orderScanText(s);
+  if (s.ok) return kExitOk;
+  err << "flexarm fit: the order scan failed: " << s.message << "\n";
+  return kExitNumerical;
+}
+
+}  // namespace
+
+int runFitPipeline(ArgParser& args, const std::string& verb, FitResult& result, std::ostream& err,
+                   bool allowNonparametric, FitLogNames* logNames) {
+  const std::string pre = "flexarm " + verb + ": ";
+  FitOptions o;
+  FitLogNames logs;
+  if (const int rc = readFitRequest(args, verb, allowNonparametric, o, logs, err); rc != kExitOk) return rc;
+  if (logNames) *logNames = logs;
+  const std::string& path = logs.estimation.front();
   result = fitModel(o, progressLine(err, "fit"));
   switch (result.status) {
     case FitStatus::Ok: return kExitOk;
@@ -286,6 +326,7 @@ int runFitPipeline(ArgParser& args, const std::string& verb, FitResult& result, 
 int runFit(const std::vector<std::string>& argv, std::ostream& out, std::ostream& err) {
   ArgParser args(fitTable());
   if (auto rc = parseArguments(args, argv, "fit", out, err)) return *rc;
+  if (args.flag("scan")) return runScan(args, out, err);
   FitResult fit;
   FitLogNames logs;
   if (const int rc = runFitPipeline(args, "fit", fit, err, false, &logs); rc != kExitOk) return rc;

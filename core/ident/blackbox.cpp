@@ -1,7 +1,9 @@
 #include "core/ident/blackbox.h"
 
 #include "core/ident/levenberg_marquardt.h"
+#include "core/ident/experiment_segments.h"
 #include "core/ident/poly_predictor.h"
+#include "core/ident/subspace.h"
 
 #include <algorithm>
 #include <chrono>
@@ -19,12 +21,13 @@ const char* toString(PolyStructure s) {
     case PolyStructure::Armax: return "armax";
     case PolyStructure::Oe: return "oe";
     case PolyStructure::Bj: return "bj";
+    case PolyStructure::Ss: return "ss";
   }
   return "arx";
 }
 
 std::optional<PolyStructure> polyStructureFromString(std::string_view s) {
-  for (auto v : {PolyStructure::Arx, PolyStructure::Armax, PolyStructure::Oe, PolyStructure::Bj})
+  for (auto v : {PolyStructure::Arx, PolyStructure::Armax, PolyStructure::Oe, PolyStructure::Bj, PolyStructure::Ss})
     if (s == toString(v)) return v;
   return std::nullopt;
 }
@@ -44,12 +47,13 @@ const char* toString(PolyOrder o) {
 const std::vector<PolyOrder>& polyOrdersOf(PolyStructure s) {
   using O = PolyOrder;
   static const std::vector<PolyOrder> kArx{O::Na, O::Nb, O::Nk}, kArmax{O::Na, O::Nb, O::Nc, O::Nk},
-      kOe{O::Nb, O::Nf, O::Nk}, kBj{O::Nb, O::Nc, O::Nd, O::Nf, O::Nk};
+      kOe{O::Nb, O::Nf, O::Nk}, kBj{O::Nb, O::Nc, O::Nd, O::Nf, O::Nk}, kSs{O::Na};
   switch (s) {
     case PolyStructure::Arx: return kArx;
     case PolyStructure::Armax: return kArmax;
     case PolyStructure::Oe: return kOe;
     case PolyStructure::Bj: return kBj;
+    case PolyStructure::Ss: return kSs;
   }
   return kArx;
 }
@@ -73,7 +77,16 @@ int& PolyOrders::operator[](PolyOrder o) {
 
 int PolyOrders::operator[](PolyOrder o) const { return (*const_cast<PolyOrders*>(this))[o]; }
 
+PolyOrders PolyOrders::stateSpace(int n) {
+  PolyOrders o{0, 0, 0, 0, 0, 0};
+  o.na = o.nc = n;
+  o.nb = std::max(1, n);
+  o.nk = 1;
+  return o;
+}
+
 PolyOrders PolyOrders::of(PolyStructure s) const {
+  if (s == PolyStructure::Ss) return stateSpace(na);
   PolyOrders out{0, 0, 0, 0, 0, 0};
   for (PolyOrder o : polyOrdersOf(s)) out[o] = (*this)[o];
   return out;
@@ -159,6 +172,7 @@ bool PolyEstimateOptions::isValid(std::string* why) const {
 }
 
 std::string PolynomialModel::name() const {
+  if (structure == PolyStructure::Ss && orders.na == 0) return "ss";
   std::ostringstream s;
   s << toString(structure) << "[";
   const char* gap = "";
@@ -241,24 +255,8 @@ void checkData(const Eigen::VectorXd& u, const Eigen::VectorXd& y) {
     throw std::invalid_argument("input and output must have the same number of samples");
 }
 
-// An experiment's first sample and sample count in the joined u and y.
-struct Segment {
-  Eigen::Index from, n;
-};
+using Segment = ExperimentSegment;
 
-// The experiments of lengths (empty: one of every sample); throws when they do not add up.
-std::vector<Segment> segmentsOf(const std::vector<Eigen::Index>& lengths, Eigen::Index total) {
-  if (lengths.empty()) return {{0, total}};
-  std::vector<Segment> out;
-  Eigen::Index from = 0;
-  for (Eigen::Index n : lengths) {
-    out.push_back({from, n});
-    from += n;
-  }
-  if (from != total)
-    throw std::invalid_argument("the experiments' lengths must add up to the samples of u and y");
-  return out;
-}
 
 // Regression matrix whose columns are sign * signal(t - lag), rows t = first..N-1.
 struct Block {
@@ -420,7 +418,7 @@ Eigen::VectorXd predictionErrors(const PolynomialModel& m, const Eigen::VectorXd
 PolyEstimate arx(const Eigen::VectorXd& u, const Eigen::VectorXd& y, int na, int nb, int nk,
                  double sampleTime, const std::vector<Eigen::Index>& experimentLengths) {
   checkData(u, y);
-  const std::vector<Segment> segments = segmentsOf(experimentLengths, y.size());
+  const std::vector<Segment> segments = experimentSegments(experimentLengths, y.size());
   PolyOrders o;
   o.na = na;
   o.nb = nb;
@@ -504,7 +502,7 @@ PolyEstimate refinePolynomial(const Eigen::VectorXd& u, const Eigen::VectorXd& y
     s.message = "the data contain NaN or infinite values";
     return r;
   }
-  const std::vector<Segment> segments = segmentsOf(options.experimentLengths, n);
+  const std::vector<Segment> segments = experimentSegments(options.experimentLengths, n);
   PolynomialModel work = initial;
   // One predictor per experiment, each run from zero initial conditions at its own first
   // sample over its own criterion samples; the records outlive the predictors.
@@ -617,6 +615,41 @@ PolyEstimate refinePolynomial(const Eigen::VectorXd& u, const Eigen::VectorXd& y
   return r;
 }
 
+namespace {
+
+// Ss: the subspace estimate (its order chosen by the data when n = 0) as ARMAX polynomials,
+// refined by prediction error; the subspace result kept beside it.
+PolyEstimate stateSpaceEstimate(const Eigen::VectorXd& u, const Eigen::VectorXd& y, int n, double sampleTime,
+                                const PolyEstimateOptions& options, const ProgressCallback& progress) {
+  SubspaceOptions so;
+  so.order = n;
+  so.closedLoop = options.closedLoop;
+  so.experimentLengths = options.experimentLengths;
+  if (n > so.maxOrder) so.maxOrder = std::min(n, SubspaceOptions::kMaxOrder);
+  std::string why;
+  if (!so.isValid(&why)) throw std::invalid_argument("ss: " + why);
+  auto sub = std::make_shared<SubspaceEstimate>(subspaceEstimate(u, y, sampleTime, so));
+  PolyEstimate r;
+  r.subspace = sub;
+  r.model = PolynomialModel::zero(PolyStructure::Ss, PolyOrders::stateSpace(std::max(n, 0)), sampleTime);
+  if (!sub->ok) {
+    r.summary.message = sub->message;
+    return r;
+  }
+  PolynomialModel start = sub->model.polynomial();
+  reflectIntoUnitCircle(start.c);  // the predictor must be stable to be refined
+  if (std::string tooBig; !start.orders.fitsData(PolyStructure::Ss, y.size(), &tooBig)) {
+    r.summary.message = tooBig;
+    return r;
+  }
+  PolyEstimate refined = refinePolynomial(u, y, start, options, progress);
+  refined.subspace = sub;
+  if (refined.summary.termination == Termination::Failed) refined.model = start;
+  return refined;
+}
+
+}  // namespace
+
 PolyEstimate estimatePolynomial(const Eigen::VectorXd& u, const Eigen::VectorXd& y,
                                 PolyStructure structure, const PolyOrders& orders0,
                                 double sampleTime, const PolyEstimateOptions& options,
@@ -628,11 +661,17 @@ PolyEstimate estimatePolynomial(const Eigen::VectorXd& u, const Eigen::VectorXd&
   if (structure == PolyStructure::Armax) o.nd = o.nf = 0;
   if (structure == PolyStructure::Oe) o.na = o.nc = o.nd = 0;
   if (structure == PolyStructure::Bj) o.na = 0;
+  if (structure == PolyStructure::Ss) o = o.of(PolyStructure::Ss);
   std::string why;
   if (!o.isValid(&why)) throw std::invalid_argument(std::string(toString(structure)) + ": " + why);
   const auto t0 = Clock::now();
   if (structure == PolyStructure::Arx) return arx(u, y, o.na, o.nb, o.nk, sampleTime, options.experimentLengths);
-  segmentsOf(options.experimentLengths, y.size());  // throws when they do not add up
+  experimentSegments(options.experimentLengths, y.size());  // throws when they do not add up
+  if (structure == PolyStructure::Ss) {
+    PolyEstimate r = stateSpaceEstimate(u, y, o.na, sampleTime, options, progress);
+    r.summary.seconds = since(t0);
+    return r;
+  }
   if (std::string tooBig; !o.fitsData(structure, y.size(), &tooBig)) {
     PolyEstimate r;
     r.model = PolynomialModel::zero(structure, o, sampleTime);

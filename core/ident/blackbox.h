@@ -2,6 +2,7 @@
 // Black-box models of the general structure (4.8), A y = B/F u + C/D e, and their estimation
 // by prediction error: ARX by least squares via QR (4.13)-(4.16); ARMAX, OE and Box-Jenkins
 // by damped Gauss-Newton / Levenberg-Marquardt (4.17)-(4.21) with psi (4.20) from filtering.
+#include <memory>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -14,7 +15,11 @@
 
 namespace flexarm {
 
-enum class PolyStructure { Arx, Armax, Oe, Bj };
+// Ss: a state-space model of order n in innovations form (core/ident/subspace.h), kept as its
+// ARMAX polynomials (na = nb = nc = n, nk = 1), started by subspace identification and refined
+// by prediction error; its spec and name list only n ("ss:4", "ss[4]"), and n = 0 asks the
+// data for the order.
+enum class PolyStructure { Arx, Armax, Oe, Bj, Ss };
 const char* toString(PolyStructure s);
 std::optional<PolyStructure> polyStructureFromString(std::string_view s);
 
@@ -33,8 +38,10 @@ struct PolyOrders {
   int na = 0, nb = 1, nc = 0, nd = 0, nf = 0, nk = 1;
   int& operator[](PolyOrder o);
   int operator[](PolyOrder o) const;
-  // These orders with the ones structure s does not take set to 0.
+  // These orders with the ones structure s does not take set to 0 (Ss: nb = nc = na, nk = 1).
   PolyOrders of(PolyStructure s) const;
+  // The orders of a state-space model of order n (Ss); n = 0: to be chosen by the data.
+  static PolyOrders stateSpace(int n);
   // na + nb + nc + nd + nf, computed without overflow (saturates at INT_MAX).
   int parameters() const;
   bool isValid(std::string* why) const;
@@ -81,9 +88,12 @@ struct EstimateSummary {
   }
 };
 
+struct SubspaceEstimate;
 struct PolyEstimate {
   PolynomialModel model;
   EstimateSummary summary;
+  // Ss: the subspace estimate the fit started from (singular values, the order and why).
+  std::shared_ptr<const SubspaceEstimate> subspace;
 };
 
 struct PolyEstimateOptions {
@@ -102,6 +112,9 @@ struct PolyEstimateOptions {
   // pooled one (the likelihood's loss for experiments of different noise levels); ARX keeps
   // plain least squares.
   std::vector<Eigen::Index> experimentLengths;
+  // Ss: the data were logged in closed loop, so the subspace start takes the predictor route
+  // (PBSID), which feedback does not bias.
+  bool closedLoop = false;
   bool isValid(std::string* why) const;
 };
 

@@ -413,8 +413,10 @@ bool fitBlackBox(const FitOptions& o, FitResult& r, const ProgressCallback& prog
   po.maxIterations = o.maxIterations;
   const fit_detail::JoinedEstimation j = fit_detail::joinedEstimation(r);
   po.experimentLengths = j.lengths;
+  po.closedLoop = r.data.closedLoop;
   PolyEstimate e = estimatePolynomial(j.u, j.y, o.model.structure, o.model.orders, r.data.sampleTime, po, progress);
   r.summary = e.summary;
+  r.subspace = e.subspace;
   const auto names = e.model.parameterNames();
   const Eigen::VectorXd th = e.model.parameterVector(), sd = e.model.standardDeviations();
   const double z = twoSidedNormalQuantile(o.level);
@@ -551,11 +553,11 @@ std::string iterationLimitAdvice(const FitResult& r, int limit) {
 
 }  // namespace
 
-FitResult fitModel(const FitOptions& given, const ProgressCallback& progress) {
+PreparedFit prepareFit(const FitOptions& given) {
   std::string why;
-  if (!given.isValid(&why)) throw std::invalid_argument("fitModel: " + why);
-  const auto t0 = std::chrono::steady_clock::now();
-  FitResult r;
+  if (!given.isValid(&why)) throw std::invalid_argument("prepareFit: " + why);
+  PreparedFit out;
+  FitResult& r = out.result;
   r.model = given.model;
   // Evidence counted once: an experiment that holds the samples of an earlier one of its list
   // (the same log given twice, two copies of one file) is dropped with a warning, so that the
@@ -583,14 +585,12 @@ FitResult fitModel(const FitOptions& given, const ProgressCallback& progress) {
   const std::vector<std::size_t> estimationGiven = countOnce(deduplicated.estimation, "estimation");
   const std::vector<std::size_t> validationGiven = countOnce(deduplicated.validation, "validation");
   const FitOptions& options = deduplicated;
-  auto finish = [&](Termination t, std::string message) -> FitResult {
-    r.termination = t;
+  auto fail = [&](std::string message) {
+    r.termination = Termination::Failed;
     r.message = std::move(message);
-    if (t == Termination::Cancelled) r.status = FitStatus::Cancelled;
-    else if (r.ok()) r.status = FitStatus::Ok;
-    else if (r.status != FitStatus::BadData && r.status != FitStatus::BadRequest) r.status = FitStatus::Failed;
-    r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    return std::move(r);
+    r.status = FitStatus::BadData;
+    out.options = deduplicated;
+    return std::move(out);
   };
 
   // 1. Data. A log's gear ratio, the one source of a physical model's r, must be a ratio.
@@ -598,8 +598,7 @@ FitResult fitModel(const FitOptions& given, const ProgressCallback& progress) {
     for (const auto& e : options.estimation) {
       std::string bad;
       if (!logGearRatio(*e.data, &bad) && !bad.empty()) {
-        r.status = FitStatus::BadData;
-        return finish(Termination::Failed, bad);
+        return fail(bad);
       }
     }
   FitDataOptions d;
@@ -616,12 +615,30 @@ FitResult fitModel(const FitOptions& given, const ProgressCallback& progress) {
     d.decimatedInput = FitDataOptions::DecimatedInput::HeldMean;
   // The effects act on the real torque, velocity and angle: their means stay.
   d.removeMeans = options.removeMeans && !options.model.nonlinear() && !inverse;
-  if (!prepareEstimation(options, d, r) || !prepareValidation(options, d, r)) {
-    r.status = FitStatus::BadData;
-    return finish(r.termination, r.message);
-  }
+  if (!prepareEstimation(options, d, r) || !prepareValidation(options, d, r)) return fail(r.message);
   for (std::size_t i = 0; i < r.estimation.size(); ++i) r.estimation[i].given = estimationGiven[i] - 1;
   for (std::size_t i = 0; i < r.validation.size(); ++i) r.validation[i].given = validationGiven[i] - 1;
+  out.ok = true;
+  out.options = std::move(deduplicated);
+  return out;
+}
+
+FitResult fitModel(const FitOptions& given, const ProgressCallback& progress) {
+  const auto t0 = std::chrono::steady_clock::now();
+  PreparedFit prepared = prepareFit(given);
+  FitResult r = std::move(prepared.result);
+  const FitOptions& options = prepared.options;
+  auto finish = [&](Termination t, std::string message) -> FitResult {
+    r.termination = t;
+    r.message = std::move(message);
+    if (t == Termination::Cancelled) r.status = FitStatus::Cancelled;
+    else if (r.ok()) r.status = FitStatus::Ok;
+    else if (r.status != FitStatus::BadData && r.status != FitStatus::BadRequest) r.status = FitStatus::Failed;
+    r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    return std::move(r);
+  };
+  if (!prepared.ok) return finish(r.termination, r.message);
+  const bool inverse = options.method != FitMethod::PredictionError;
   const bool nonparametric = options.model.kind == FitModelKind::Spa || options.model.kind == FitModelKind::Etfe;
   bool constant = true;
   for (const auto& e : r.estimation) {

@@ -36,6 +36,7 @@
 #include "core/ident/nonparametric.h"
 #include "core/ident/pem.h"
 #include "core/ident/residuals.h"
+#include "core/ident/subspace.h"
 #include "core/models/physical_models.h"
 
 namespace flexarm {
@@ -364,6 +365,9 @@ struct FitResult {
   std::vector<int> freeIndices;
   CovarianceKind covarianceKind = CovarianceKind::White;
   std::shared_ptr<const PolynomialModel> polynomial;  // black-box estimate
+  // A state-space fit (ss): the subspace estimate it started from, with its singular values
+  // and the order chosen and why (core/ident/subspace.h).
+  std::shared_ptr<const SubspaceEstimate> subspace;
   NonparametricEstimate nonparametric;                // spa / etfe
   std::vector<FitParameter> parameters;
 
@@ -430,6 +434,17 @@ std::optional<double> logGearRatio(const IdData& data, std::string* why = nullpt
 // values moved are appended to notes (may be null). Throws std::invalid_argument as fitBounds,
 // or for a start value that is unknown or outside its bounds.
 std::shared_ptr<PhysicalModel> fitStartModel(const FitOptions& options, std::vector<std::string>* notes = nullptr);
+
+// Step 1 of the pipeline alone: the options with every repeated experiment counted once and
+// each experiment prepared (fit_data.h) as the fit would see it, in result.data, .estimation
+// and .validation. ok false with result.status BadData and a sentence when the data cannot be
+// used. What an order scan (order_scan.h) runs on, so it sees the fit's own data.
+struct PreparedFit {
+  bool ok = false;
+  FitOptions options;
+  FitResult result;
+};
+PreparedFit prepareFit(const FitOptions& options);
 
 // Runs the pipeline. Data failures (no usable data, a constant input, a method the log cannot
 // support, a diverged or failed estimator) end in termination Failed or Diverged with a

@@ -70,6 +70,26 @@ json idimJson(const FitResult& fit) {
           {"message", e.message}};
 }
 
+// A state-space fit's subspace start: the singular values, every order tried and the one chosen.
+json subspaceJson(const FitResult& fit) {
+  if (!fit.subspace) return nullptr;
+  const SubspaceEstimate& e = *fit.subspace;
+  json orders = json::array();
+  for (const auto& o : e.orders)
+    orders.push_back({{"order", o.order},
+                      {"loss", finiteOrNull(o.loss)},
+                      {"mdl", finiteOrNull(o.mdl)},
+                      {"stable_predictor", o.stablePredictor}});
+  return {{"method", toString(e.method)},
+          {"ok", e.ok},
+          {"message", e.message},
+          {"horizon", e.horizon},
+          {"singular_values", e.singularValues},
+          {"orders", orders},
+          {"chosen_order", e.chosenOrder},
+          {"order_reason", e.orderReason}};
+}
+
 // The deflection check: the fit's own keys, of the deflection r phi_m - phi_a.
 json deflectionJson(const FitResult& fit) {
   if (!fit.deflection) return nullptr;
@@ -171,6 +191,7 @@ json fitResultJson(const FitResult& fit, const FitLogNames& logs) {
             {"controller", controllerJson(fit)},
             {"reference_fit_percent", fitPercentJson(fit.referenceFitPercent)},
             {"covariance", toString(fit.covarianceKind)},
+            {"subspace", subspaceJson(fit)},
             {"residuals", residualsJson(fit)}});
   addFitParameters(j, fit.parameters);
   j["undetermined_direction"] = fit.undeterminedDirection.empty() ? json(nullptr) : json(fit.undeterminedDirection);

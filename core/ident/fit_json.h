@@ -17,6 +17,8 @@
 //   sample_time_s, samples_estimation, samples_validation, data (how they were prepared)
 //   closed_loop, closed_loop_method, closed_loop_description, closed_loop_reason, controller,
 //     reference_fit_percent; idim, idim_start; deflection; residuals; seconds (the run's time)
+//   subspace (state-space fits, else null): {method, ok, message, horizon, singular_values,
+//     orders [{order, loss, mdl, stable_predictor}], chosen_order, order_reason}
 // Version 1 was the command line's alone; version 2 adds format, version, status,
 // parameter_rows, warning_codes and residuals, and sessions and reports took its names
 // (fit_estimation_percent -> fit_percent, fit_validation_percent -> fit_percent_validation,

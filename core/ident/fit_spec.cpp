@@ -1,5 +1,7 @@
 #include "core/ident/fit_spec.h"
+
 #include "core/common/text.h"
+#include "core/ident/subspace.h"
 
 #include <algorithm>
 #include <cctype>
@@ -78,6 +80,12 @@ std::optional<FitModelSpec> fitModelSpecFromText(const std::string& text, bool a
     return spec;
   }
   const auto s = polyStructureFromString(head);
+  if (s == PolyStructure::Ss && text == head) {  // "ss": the order chosen by the data
+    spec.kind = FitModelKind::BlackBox;
+    spec.structure = PolyStructure::Ss;
+    spec.orders = PolyOrders::stateSpace(0);
+    return spec;
+  }
   // "oe:2,2,1" as typed, or "oe[2 2 1]" as names print.
   const bool named = s && text.size() > head.size() + 1 && text[head.size()] == '[' && text.back() == ']';
   const bool typed = s && text.size() > head.size() && text[head.size()] == ':';
@@ -94,6 +102,12 @@ std::optional<FitModelSpec> fitModelSpecFromText(const std::string& text, bool a
   spec.structure = *s;
   spec.orders = PolyOrders{0, 0, 0, 0, 0, 0};
   for (std::size_t i = 0; i < orders.size(); ++i) spec.orders[orders[i]] = v[i];
+  if (*s == PolyStructure::Ss) {
+    if (v[0] < 1 || v[0] > SubspaceOptions::kMaxOrder)
+      return fail("ss:N takes a state-space order N from 1 to " + std::to_string(SubspaceOptions::kMaxOrder) +
+                  " (\"ss\" alone lets the data choose it), not " + inQuotes(numbers));
+    spec.orders = PolyOrders::stateSpace(v[0]);
+  }
   std::string reason;
   if (!spec.orders.isValid(&reason)) return fail(text + ": " + reason);
   return spec;
@@ -103,6 +117,7 @@ std::string fitModelSpecText(const FitModelSpec& spec) {
   switch (spec.kind) {
     case FitModelKind::Physical: return spec.start ? spec.start->structureName() : "physical";
     case FitModelKind::BlackBox: {
+      if (spec.structure == PolyStructure::Ss && spec.orders.na == 0) return "ss";
       std::string out = std::string(toString(spec.structure)) + ":";
       const char* sep = "";
       for (PolyOrder o : polyOrdersOf(spec.structure)) {
@@ -122,6 +137,7 @@ std::string fitModelSpecGrammar(bool allowNonparametric) {
   std::string out;
   for (auto s : {PolyStructure::Arx, PolyStructure::Armax, PolyStructure::Oe, PolyStructure::Bj})
     out += std::string(toString(s)) + ":" + orderList(s, true) + " | ";
+  out += "ss[:N] | ";
   if (allowNonparametric) out += "spa[:M] | etfe[:W] | ";
   std::string physical;
   for (const auto& n : modelStructureNames()) physical += (physical.empty() ? "" : "|") + n;

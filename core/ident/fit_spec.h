@@ -5,6 +5,8 @@
 // Fit panel and sessions:
 //   arx:NA,NB,NK  armax:NA,NB,NC,NK  oe:NB,NF,NK  bj:NB,NC,ND,NF,NK   black-box (4.8), delay NK
 //   arx[4 4 1] ... bj[2 2 2 2 1]                                    the same, as names print
+//   ss:N | ss[N] | ss                                               state space of order N
+//                                                                   (subspace.h); ss: N by MDL
 //   rigid | two-mass | three-mass | four-mass | two-mass-theta      a physical model (chapter 3)
 //                                                                   from its nominal values
 //   spa[:M] | etfe[:W]                                              non-parametric (4.28), (4.24)

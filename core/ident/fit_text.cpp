@@ -1,5 +1,7 @@
 #include "core/ident/fit_text.h"
 
+#include "core/common/text.h"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -27,6 +29,17 @@ std::string frequencyList(const std::vector<double>& omega) {
   return text.empty() ? "none" : text + " rad/s";
 }
 
+namespace {
+// A state-space fit's start: the subspace method, the order and why, the singular values.
+std::string subspaceStart(const SubspaceEstimate& e) {
+  std::string s = "subspace (" + std::string(toString(e.method)) + ", horizon " + std::to_string(e.horizon) + "), " +
+                  e.orderReason + "; singular values";
+  for (std::size_t i = 0; i < std::min<std::size_t>(e.singularValues.size(), 16); ++i)
+    s += " " + shortNumber(e.singularValues[i]);
+  return s;
+}
+}  // namespace
+
 std::string fitResultText(const FitResult& fit, const FitLogNames& logs) {
   std::ostringstream out;
   const auto& s = fit.summary;
@@ -40,6 +53,7 @@ std::string fitResultText(const FitResult& fit, const FitLogNames& logs) {
   if (fit.method) out << "closed-loop method: " << fit.methodDescription << " (" << fit.methodReason << ")\n";
   if (fit.controller) out << "controller: " << fit.controllerSource << "\n";
   if (!fit.idimNote.empty()) out << "start: " << fit.idimNote << "\n";
+  if (fit.subspace && fit.subspace->ok) out << "start: " << subspaceStart(*fit.subspace) << "\n";
   if (fit.idim && fit.idimNote.empty())
     out << "inverse dynamics: " << fit.idim->message << ", the torque explained " << fit.idim->torqueFitPercent
         << " % (5.2), condition number " << fit.idim->conditionNumber << "\n";
@@ -178,6 +192,7 @@ std::vector<std::string> fitSummaryLines(const FitResult& r, const std::string& 
                                                            " (relative to the values): fix one of them, or log an "
                                                            "experiment that excites it."));
   if (!r.idimNote.empty()) lines.push_back("Start: " + r.idimNote + ".");
+  if (r.subspace && r.subspace->ok) lines.push_back("Start: " + subspaceStart(*r.subspace) + ".");
   for (const auto& w : r.warnings) lines.push_back("Note: " + w + ".");
   return lines;
 }

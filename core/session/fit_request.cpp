@@ -265,7 +265,7 @@ std::optional<FitRequest> fitRequestFromJson(const json& j, std::string* why) {
     auto s = j.contains("structure") && j["structure"].is_string()
                  ? polyStructureFromString(j["structure"].get<std::string>())
                  : std::nullopt;
-    if (!s) return fail(where + "structure must be arx, armax, oe or bj");
+    if (!s) return fail(where + "structure must be arx, armax, oe, bj or ss");
     o.model.structure = *s;
     if (!j.contains("orders") || !j["orders"].is_object()) return fail(where + "a black-box fit needs orders");
     const json& q = j["orders"];

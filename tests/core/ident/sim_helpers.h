@@ -1,11 +1,14 @@
 #pragma once
 // Data generators shared by the identification tests: known polynomial systems (4.8) driven by
 // white noise, in open loop or under a proportional controller u = r - K y (4.29).
+#include <memory>
 #include <random>
+#include <vector>
 
 #include <Eigen/Dense>
 
 #include "core/ident/polynomial.h"
+#include "core/signal/id_data.h"
 
 namespace flexarm::testing {
 
@@ -49,6 +52,16 @@ inline SimData simulateSystem(const Poly& a, const Poly& b, const Poly& c, const
     s.u[t] = s.r[t] - gain * s.y[t];
   }
   return s;
+}
+
+// u as the torque and y as the motor velocity of a log sampled every T seconds.
+inline std::shared_ptr<const IdData> torqueVelocityLog(const Eigen::VectorXd& u, const Eigen::VectorXd& y, double T) {
+  auto d = std::make_shared<IdData>();
+  d->sampleTime = T;
+  d->setChannel({columns::kTorqueRef, "N m", ChannelRole::Input, std::vector<double>(u.data(), u.data() + u.size())});
+  d->setChannel(
+      {columns::kMotorVelocity, "rad/s", ChannelRole::Output, std::vector<double>(y.data(), y.data() + y.size())});
+  return d;
 }
 
 }  // namespace flexarm::testing

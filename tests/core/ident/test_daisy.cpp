@@ -7,20 +7,15 @@
 #include "core/ident/nonparametric.h"
 #include "core/ident/residuals.h"
 #include "core/io/log_io.h"
+#include "tests/core/ident/daisy_data.h"
 
 namespace flexarm {
 namespace {
 
 TEST(Daisy, RobotArmGetsNonparametricBlackBoxAndResidualAnalysis) {
-  LogReadOptions opt;
-  opt.format = LogFormat::Table;
-  const auto read = readTable(FLEXARM_SAMPLE_DIR "/daisy_robot_arm.dat", opt);
-  ASSERT_TRUE(read.ok) << read.error.toString();
   Eigen::VectorXd u, y;
-  inputOutput(read.data, u, y);
+  ASSERT_TRUE(testing::daisyRobotArm(u, y));
   ASSERT_EQ(u.size(), 1024);
-  u.array() -= u.mean();
-  y.array() -= y.mean();
   const Eigen::Index ne = 700;  // estimation 0..699, validation 700..1023
   const Eigen::VectorXd ue = u.head(ne), ye = y.head(ne);
 

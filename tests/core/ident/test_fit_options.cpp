@@ -19,12 +19,7 @@ namespace {
 constexpr double kT = 2.5e-3;  // 400 Hz
 
 std::shared_ptr<const IdData> logOf(const Eigen::VectorXd& u, const Eigen::VectorXd& y, double T = kT) {
-  auto d = std::make_shared<IdData>();
-  d->sampleTime = T;
-  d->setChannel({columns::kTorqueRef, "N m", ChannelRole::Input, std::vector<double>(u.data(), u.data() + u.size())});
-  d->setChannel(
-      {columns::kMotorVelocity, "rad/s", ChannelRole::Output, std::vector<double>(y.data(), y.data() + y.size())});
-  return d;
+  return testing::torqueVelocityLog(u, y, T);
 }
 
 // truth driven by white torque from rest, with output noise of `noise` times the output's spread.

@@ -131,7 +131,7 @@ TEST(FitRequest, MalformedRequestsAreRefusedWithASentence) {
   json bad = j;
   bad["structure"] = "narx";
   EXPECT_FALSE(fitRequestFromJson(bad, &why));
-  EXPECT_NE(why.find("arx, armax, oe or bj"), std::string::npos) << why;
+  EXPECT_NE(why.find("arx, armax, oe, bj or ss"), std::string::npos) << why;
   bad = j;
   bad["decimation"] = 0;
   EXPECT_FALSE(fitRequestFromJson(bad, &why));
