@@ -1,6 +1,7 @@
 #include "widgets/bode_panel.h"
 
 #include <QCheckBox>
+#include <QComboBox>
 #include <QDoubleSpinBox>
 #include <QFileDialog>
 #include <QHBoxLayout>
@@ -9,14 +10,18 @@
 #include <QPushButton>
 #include <QSpinBox>
 #include <QSplitter>
+#include <QStackedWidget>
 #include <QVBoxLayout>
+#include <algorithm>
 #include <cmath>
 
 #include "core/ident/nonparametric.h"
+#include "core/ident/transient.h"
 #include "core/models/analysis.h"
 #include "widgets/background_refresh.h"
 #include "widgets/ident_data.h"
 #include "widgets/plots/bode_plot.h"
+#include "widgets/plots/transient_plot.h"
 
 namespace flexarm {
 namespace {
@@ -57,7 +62,8 @@ BodePanel::BodePanel(Workspace* workspace, QWidget* parent)
     : QWidget(parent), workspace_(workspace), models_(new QListWidget(this)),
       level_(new PercentSpinBox(this)), spa_(new QCheckBox(tr("SPA"), this)),
       etfe_(new QCheckBox(tr("ETFE"), this)), window_(new QSpinBox(this)),
-      export_(new QPushButton(tr("Export..."), this)), plot_(new BodePlot(this)),
+      export_(new QPushButton(tr("Export..."), this)), view_(new QComboBox(this)),
+      stack_(new QStackedWidget(this)), plot_(new BodePlot(this)), transient_(new TransientPlot(this)),
       note_(new QLabel(this)), worker_(new BackgroundRefresh(this)) {
   setObjectName("bodePanel");
   models_->setObjectName("bodeModelList");
@@ -88,7 +94,16 @@ BodePanel::BodePanel(Workspace* workspace, QWidget* parent)
   note_->setMinimumHeight(4 * note_->fontMetrics().lineSpacing());
   note_->setAlignment(Qt::AlignLeft | Qt::AlignTop);
 
+  view_->setObjectName("bodeViewCombo");
+  view_->addItem(tr("Bode"));
+  view_->addItem(tr("Step"));
+  view_->addItem(tr("Impulse"));
+  view_->setToolTip(tr("The frequency response, or the step or impulse response of each model from rest (the "
+                       "impulse a pulse of area 1), each with its band from the model's covariance"));
+  stack_->addWidget(plot_);
+  stack_->addWidget(transient_);
   auto* controls = new QHBoxLayout;
+  controls->addWidget(view_);
   controls->addWidget(new QLabel(tr("Band level"), this));
   controls->addWidget(level_);
   controls->addWidget(spa_);
@@ -99,7 +114,7 @@ BodePanel::BodePanel(Workspace* workspace, QWidget* parent)
   controls->addWidget(export_);
   auto* split = new QSplitter(Qt::Horizontal, this);
   split->addWidget(models_);
-  split->addWidget(plot_);
+  split->addWidget(stack_);
   split->setStretchFactor(1, 4);
   auto* layout = new QVBoxLayout(this);
   layout->addLayout(controls);
@@ -109,6 +124,12 @@ BodePanel::BodePanel(Workspace* workspace, QWidget* parent)
   connect(models_, &QListWidget::itemChanged, this, &BodePanel::refresh);
   connect(level_, QOverload<double>::of(&QDoubleSpinBox::valueChanged), this, &BodePanel::refresh);
   connect(window_, QOverload<int>::of(&QSpinBox::valueChanged), this, &BodePanel::refresh);
+  connect(view_, QOverload<int>::of(&QComboBox::currentIndexChanged), this, [this](int v) {
+    stack_->setCurrentIndex(v == 0 ? 0 : 1);
+    for (QWidget* w : {static_cast<QWidget*>(spa_), static_cast<QWidget*>(etfe_), static_cast<QWidget*>(window_)})
+      w->setEnabled(v == 0);
+    refresh();
+  });
   for (QCheckBox* c : {spa_, etfe_}) connect(c, &QCheckBox::toggled, this, &BodePanel::refresh);
   connect(export_, &QPushButton::clicked, this, &BodePanel::exportDialog);
   connect(workspace_, &Workspace::modelsChanged, this, [this](int) { refillList(); });
@@ -138,6 +159,10 @@ void BodePanel::setNonparametricShown(bool spa, bool etfe) {
   refresh();
 }
 
+void BodePanel::setView(int view) { view_->setCurrentIndex(std::clamp(view, 0, 2)); }
+
+int BodePanel::view() const { return view_->currentIndex(); }
+
 bool BodePanel::curveHasBand(int curve) const {
   return curve >= 0 && curve < static_cast<int>(bands_.size()) && bands_[static_cast<std::size_t>(curve)];
 }
@@ -149,6 +174,7 @@ bool BodePanel::isBusy() const { return worker_->isBusy(); }
 namespace {
 
 struct BodeChoices {
+  int view = 0;  // 0 Bode, 1 step, 2 impulse
   std::vector<bool> checked;
   double level = 0.99;
   int window = 100;
@@ -237,6 +263,43 @@ void bodeCurves(const WorkspaceSnapshot& snapshot, const std::vector<ModelEntry>
     notes.prepend(QObject::tr("Bands: %1 % confidence (Gauss approximation).").arg(100.0 * c.level, 0, 'g', 4));
 }
 
+struct TransientCurve {
+  QString name;
+  QColor color;
+  TransientResponse response;
+};
+
+// The step or impulse responses of the checked models, a physical one sampled at its fit's
+// rate on the open log (1 ms without one), a black-box one at its own.
+void transientCurves(const WorkspaceSnapshot& snapshot, const std::vector<ModelEntry>& list, const BodeChoices& c,
+                     std::vector<TransientCurve>& curves, QStringList& notes) {
+  QString why;
+  const auto data = workspaceData(snapshot, 1, false, &why);
+  const TransientKind kind = c.view == 1 ? TransientKind::Step : TransientKind::Impulse;
+  int colour = 0;
+  for (std::size_t i = 0; i < list.size(); ++i) {
+    const QColor color = kPalette[colour++ % 8];
+    if (!c.checked[i]) continue;
+    const ModelEntry& e = list[i];
+    const double T = data ? data->sampleTime * e.decimation() : 1e-3;
+    try {
+      curves.push_back({nameOf(e), color,
+                        transientResponse(e.model.get(), e.covariance, e.covarianceIndices, e.polynomial.get(), kind, T,
+                                          c.level)});
+    } catch (const std::exception& ex) {
+      notes << QObject::tr("%1: %2").arg(nameOf(e), QString::fromStdString(ex.what()));
+    }
+  }
+  if (curves.empty())
+    notes.prepend(QObject::tr("No curve: add a model (Model or Fit panel) and tick it."));
+  else
+    notes.prepend(QObject::tr("%1 responses from rest%2; bands: %3 % confidence, the estimate's covariance carried "
+                              "to the response (Gauss approximation); a model without a covariance has none.")
+                      .arg(kind == TransientKind::Step ? QObject::tr("Step") : QObject::tr("Impulse"),
+                           kind == TransientKind::Impulse ? QObject::tr(" (a pulse of area 1)") : QString())
+                      .arg(100.0 * c.level, 0, 'g', 4));
+}
+
 }  // namespace
 
 void BodePanel::refresh() {
@@ -247,6 +310,29 @@ void BodePanel::refresh() {
   c.window = window_->value();
   c.spa = spa_->isChecked();
   c.etfe = etfe_->isChecked();
+  c.view = view_->currentIndex();
+  if (c.view != 0) {
+    worker_->run([this, snapshot = snapshotOf(*workspace_), list = workspace_->models(),
+                  c](const std::atomic<bool>&) -> BackgroundRefresh::Apply {
+      auto curves = std::make_shared<std::vector<TransientCurve>>();
+      auto notes = std::make_shared<QStringList>();
+      transientCurves(snapshot, list, c, *curves, *notes);
+      return [this, curves, notes, kind = c.view == 1 ? TransientKind::Step : TransientKind::Impulse] {
+        transient_->clear();
+        transient_->setKind(kind);
+        names_.clear();
+        bands_.clear();
+        for (const auto& t : *curves) {
+          transient_->addCurve(t.name, t.color, t.response);
+          names_ << t.name;
+          bands_.push_back(t.response.hasBand());
+        }
+        note_->setText(notes->join("\n"));
+        transient_->rescale();
+      };
+    });
+    return;
+  }
   worker_->run([this, snapshot = snapshotOf(*workspace_), list = workspace_->models(),
                 c](const std::atomic<bool>&) -> BackgroundRefresh::Apply {
     auto curves = std::make_shared<std::vector<BodeCurve>>();
@@ -267,7 +353,9 @@ void BodePanel::refresh() {
   });
 }
 
-bool BodePanel::exportTo(const QString& path, QString* why) const { return plot_->exportTo(path, why); }
+bool BodePanel::exportTo(const QString& path, QString* why) const {
+  return view_->currentIndex() == 0 ? plot_->exportTo(path, why) : transient_->exportTo(path, why);
+}
 
 void BodePanel::exportDialog() {
   const QString path = QFileDialog::getSaveFileName(this, tr("Export Bode plot"), "bode.png",

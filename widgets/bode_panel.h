@@ -2,7 +2,8 @@
 // Bode panel: any models of the shared list overlaid on one Bode plot, each with its shaded
 // confidence band where the model has a covariance (99 % by default, level adjustable; the
 // Gauss approximation of Section 4.4.3), and the non-parametric ETFE (4.24) and SPA (4.28)
-// estimates of the estimation data as points. Click near a peak or notch to read it; click a
+// estimates of the estimation data as points; or, chosen by View, their step or impulse
+// responses with the same bands carried to the response. Click near a peak or notch to read it; click a
 // legend entry to hide a curve; export as PNG, PDF or SVG.
 #include <QWidget>
 #include <vector>
@@ -10,7 +11,9 @@
 #include "widgets/workspace.h"
 
 class QCheckBox;
+class QComboBox;
 class QDoubleSpinBox;
+class QStackedWidget;
 class QLabel;
 class QListWidget;
 class QPushButton;
@@ -21,6 +24,7 @@ namespace flexarm {
 class BackgroundRefresh;
 
 class BodePlot;
+class TransientPlot;
 
 class BodePanel : public QWidget {
   Q_OBJECT
@@ -28,6 +32,11 @@ class BodePanel : public QWidget {
   explicit BodePanel(Workspace* workspace, QWidget* parent = nullptr);
 
   BodePlot* plot() const { return plot_; }
+  TransientPlot* transientPlot() const { return transient_; }
+  // What is drawn: 0 the Bode plot, 1 the step responses, 2 the impulse responses, each model
+  // with its band (core/ident/transient.h).
+  void setView(int view);
+  int view() const;
   // Shows or hides model N of the shared list.
   void setModelShown(int index, bool shown);
   void setLevel(double level);
@@ -54,7 +63,10 @@ class BodePanel : public QWidget {
   QCheckBox* etfe_;
   QSpinBox* window_;
   QPushButton* export_;
+  QComboBox* view_;
+  QStackedWidget* stack_;
   BodePlot* plot_;
+  TransientPlot* transient_;
   QLabel* note_;
   QStringList names_;
   std::vector<bool> bands_;

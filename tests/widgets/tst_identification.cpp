@@ -34,6 +34,7 @@
 #include "widgets/fit_panel.h"
 #include "widgets/model_panel.h"
 #include "widgets/plots/bode_plot.h"
+#include "widgets/plots/transient_plot.h"
 #include "widgets/residuals_panel.h"
 #include "widgets/workspace.h"
 
@@ -361,6 +362,36 @@ class IdentificationTest : public QObject {
     for (int i = 0; i < n; ++i) bode->setModelShown(i, true);
   }
 
+  void bodeShowsStepAndImpulseWithBands() {
+    BodePanel* bode = window_->bodePanel();
+    showDock("bodeDock");
+    const int n = static_cast<int>(window_->workspace()->models().size());
+    for (int i = 0; i < n; ++i) bode->setModelShown(i, i >= n - 2);  // the three-mass and OE estimates
+    bode->setView(1);
+    settle();
+    QCOMPARE(bode->curveNames().size(), 2);
+    QVERIFY(bode->curveHasBand(0));
+    QVERIFY(bode->curveHasBand(1));
+    QVERIFY2(bode->noteText().contains("Step responses from rest"), qPrintable(bode->noteText()));
+    QCustomPlot* p = bode->transientPlot()->customPlot();
+    int filled = 0;
+    for (int g = 0; g < p->graphCount(); ++g) filled += p->graph(g)->channelFillGraph() != nullptr;
+    QCOMPARE(filled, 2);
+    QVERIFY(p->isVisible());
+    QVERIFY(!bode->plot()->isVisible());
+    QVERIFY(!bode->findChild<QCheckBox*>("bodeSpaCheck")->isEnabled());
+    test::saveShot(bode->grab().toImage(), "bode_panel_step");
+    bode->setView(2);
+    settle();
+    QVERIFY2(bode->noteText().contains("a pulse of area 1"), qPrintable(bode->noteText()));
+    QCOMPARE(bode->curveNames().size(), 2);
+    test::saveShot(bode->grab().toImage(), "bode_panel_impulse");
+    bode->setView(0);
+    settle();
+    QVERIFY(bode->plot()->isVisible());
+    for (int i = 0; i < n; ++i) bode->setModelShown(i, true);
+  }
+
   void compareShowsFitOfEveryModel() {
     compareOnValidation();
     ComparePanel* cmp = window_->comparePanel();
@@ -557,6 +588,25 @@ class IdentificationTest : public QObject {
     QCOMPARE(refused.count(), 1);
     QVERIFY2(fit->summaryText().startsWith("More experiments:"), qPrintable(fit->summaryText()));
     edit->clear();
+  }
+
+  // Last, so the list above keeps its order: a state-space fit with its order from the data.
+  void stateSpaceFitSaysItsOrder() {
+    FitPanel* fit = window_->fitPanel();
+    QVERIFY(fit->setModelChoice("ss"));
+    PolyOrders o;
+    o.na = 0;
+    fit->setOrders(o);
+    fit->setDecimation(10);
+    QVERIFY2(clickEstimate(fit), qPrintable(fit->summaryText()));
+    const ModelEntry& e = window_->workspace()->models().back();
+    QVERIFY(e.polynomial != nullptr);
+    QCOMPARE(e.polynomial->structure, PolyStructure::Ss);
+    QVERIFY(e.polynomial->orders.na >= 1);
+    QVERIFY2(fit->summaryText().contains("least MDL"), qPrintable(fit->summaryText()));
+    QVERIFY2(fit->summaryText().contains(QString("ss[%1]").arg(e.polynomial->orders.na)), qPrintable(fit->summaryText()));
+    test::saveShot(window_->grab().toImage(), "fit_state_space_1366x768");
+    test::saveShot(fit->grab().toImage(), "fit_panel_state_space");
   }
 
   void cleanupTestCase() { delete window_; }
