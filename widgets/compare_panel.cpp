@@ -4,6 +4,7 @@
 #include <QHBoxLayout>
 #include <QLabel>
 #include <QListWidget>
+#include <QSpinBox>
 #include <QSplitter>
 #include <QVBoxLayout>
 #include <algorithm>
@@ -26,7 +27,7 @@ const QColor kColors[] = {QColor(31, 119, 180), QColor(214, 39, 40), QColor(44, 
 
 ComparePanel::ComparePanel(Workspace* workspace, QWidget* parent)
     : QWidget(parent), workspace_(workspace), models_(new QListWidget(this)),
-      range_(new QComboBox(this)), plot_(new QCustomPlot(this)), fit_(new QLabel(this)),
+      range_(new QComboBox(this)), horizon_(new QSpinBox(this)), plot_(new QCustomPlot(this)), fit_(new QLabel(this)),
       cursor_(new PlayheadCursor(plot_, this)), deflection_(new QCustomPlot(this)),
       worker_(new BackgroundRefresh(this)) {
   setObjectName("comparePanel");
@@ -36,6 +37,13 @@ ComparePanel::ComparePanel(Workspace* workspace, QWidget* parent)
   range_->setToolTip(tr("Range the models are simulated on and the fit (5.2) computed over"));
   range_->addItem(tr("Validation range"), static_cast<int>(RangeKind::Validation));
   range_->addItem(tr("Estimation range"), static_cast<int>(RangeKind::Estimation));
+  horizon_->setObjectName("compareHorizonSpin");
+  horizon_->setRange(0, kMaxCompareHorizon);
+  horizon_->setSpecialValueText(tr("simulation"));
+  horizon_->setSuffix(tr("-step prediction"));
+  horizon_->setToolTip(tr("What each model's output is: its simulation from the input alone, or its k-step "
+                          "prediction y(t | t - k) from the measured output k samples back (a black-box "
+                          "model's noise model predicts; an output-error model predicts what it simulates)"));
   // A time plot with its legend above, no time before the range.
   auto timePlot = [this](QCustomPlot* plot, const char* name, int height, const QString& label) {
     plot->setObjectName(name);
@@ -65,6 +73,8 @@ ComparePanel::ComparePanel(Workspace* workspace, QWidget* parent)
   auto* top = new QHBoxLayout;
   top->addWidget(new QLabel(tr("Compare on"), this));
   top->addWidget(range_);
+  top->addWidget(new QLabel(tr("Output"), this));
+  top->addWidget(horizon_);
   top->addStretch(1);
   auto* split = new QSplitter(Qt::Horizontal, this);
   auto* plots = new QSplitter(Qt::Vertical, this);
@@ -82,6 +92,7 @@ ComparePanel::ComparePanel(Workspace* workspace, QWidget* parent)
 
   connect(models_, &QListWidget::itemChanged, this, &ComparePanel::refresh);
   connect(range_, QOverload<int>::of(&QComboBox::currentIndexChanged), this, &ComparePanel::refresh);
+  connect(horizon_, QOverload<int>::of(&QSpinBox::valueChanged), this, &ComparePanel::refresh);
   connect(workspace_, &Workspace::modelsChanged, this, [this](int) { refillList(); });
   // Another log (or its preprocessing) changes which models are of the open data.
   connect(workspace_, &Workspace::currentChanged, this, &ComparePanel::refillList);
@@ -100,6 +111,8 @@ void ComparePanel::setModelShown(int index, bool shown) {
   if (index >= 0 && index < models_->count())
     models_->item(index)->setCheckState(shown ? Qt::Checked : Qt::Unchecked);
 }
+
+void ComparePanel::setHorizon(int samples) { horizon_->setValue(samples); }
 
 void ComparePanel::setRangeKind(RangeKind kind) {
   range_->setCurrentIndex(range_->findData(static_cast<int>(kind)));
@@ -158,7 +171,8 @@ Curve curveOf(const Eigen::VectorXd& v, double startTime, double sampleTime, con
 // `flexarm compare`, the session part and the report make), so that the panel shows the fit
 // the Fit panel and the command line give for the same model and range; then the curves.
 CompareOutcome compareModels(const WorkspaceSnapshot& snapshot, const std::vector<ModelEntry>& list,
-                             const std::vector<bool>& checked, RangeKind kind, const std::atomic<bool>& stop) {
+                             const std::vector<bool>& checked, RangeKind kind, int horizon,
+                             const std::atomic<bool>& stop) {
   CompareOutcome out;
   if (!snapshot.data || !snapshot.data->input() || !snapshot.data->output()) {
     out.text = QObject::tr("Open a log with an input and an output channel first.");
@@ -167,6 +181,7 @@ CompareOutcome compareModels(const WorkspaceSnapshot& snapshot, const std::vecto
   CompareRequest request;
   request.data = evaluationDataOf(snapshot);
   request.range = kind == RangeKind::Validation ? DataRange::Validation : DataRange::Estimation;
+  request.horizon = horizon;
   std::vector<std::size_t> shown;  // list index of each compared model
   for (std::size_t i = 0; i < list.size(); ++i)
     if (checked[i]) {
@@ -198,8 +213,14 @@ CompareOutcome compareModels(const WorkspaceSnapshot& snapshot, const std::vecto
     out.fits.push_back(m.fit->percent.seed52);
     out.fitsNrmse.push_back(m.fit->percent.nrmse);
     const QString name = QString::fromStdString(m.name);
+    // The fit % as MATLAB's compare labels it (NRMSE) beside the seed's (5.2), of the output
+    // shown: simulated, or predicted k steps ahead.
+    const QString how = horizon > 0 ? QObject::tr(" (%1-step)").arg(horizon) : QString();
     out.curves.push_back(curveOf(m.output, m.startTime, m.sampleTime,
-                                 QObject::tr("%1: %2 % (5.2)").arg(name).arg(m.fit->percent.seed52, 0, 'f', 1),
+                                 QObject::tr("%1%2: %3 % NRMSE, %4 % (5.2)")
+                                     .arg(name, how)
+                                     .arg(m.fit->percent.nrmse, 0, 'f', 1)
+                                     .arg(m.fit->percent.seed52, 0, 'f', 1),
                                  QPen(color, 1.2)));
     if (m.deflection)
       out.deflection.push_back(curveOf(m.deflection->predicted, m.startTime, m.sampleTime,
@@ -219,10 +240,11 @@ void ComparePanel::refresh() {
   std::vector<bool> checked;
   for (std::size_t i = 0; i < workspace_->models().size(); ++i) checked.push_back(isModelChecked(models_, i));
   const auto kind = static_cast<RangeKind>(range_->currentData().toInt());
+  const int horizon = horizon_->value();
   fit_->setText(tr("Simulating..."));
-  worker_->run([this, snapshot = snapshotOf(*workspace_), list = workspace_->models(), checked,
-                kind](const std::atomic<bool>& stop) -> BackgroundRefresh::Apply {
-    auto out = std::make_shared<CompareOutcome>(compareModels(snapshot, list, checked, kind, stop));
+  worker_->run([this, snapshot = snapshotOf(*workspace_), list = workspace_->models(), checked, kind,
+                horizon](const std::atomic<bool>& stop) -> BackgroundRefresh::Apply {
+    auto out = std::make_shared<CompareOutcome>(compareModels(snapshot, list, checked, kind, horizon, stop));
     return [this, out] { showOutcome(*out); };
   });
 }

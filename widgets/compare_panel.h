@@ -14,6 +14,7 @@ class QComboBox;
 class QCustomPlot;
 class QLabel;
 class QListWidget;
+class QSpinBox;
 
 namespace flexarm {
 
@@ -29,6 +30,9 @@ class ComparePanel : public QWidget {
 
   void setModelShown(int index, bool shown);
   void setRangeKind(RangeKind kind);
+  // 0: the models' simulations (the default); k >= 1: their k-step predictions y(t | t - k),
+  // as MATLAB's compare(data, model, k) (a black-box model's noise model predicts).
+  void setHorizon(int samples);
   // Fit % of each checked model in list order (NaN where it could not be simulated).
   // Each checked model's fit % on the range shown: the seed's (5.2) and the NRMSE fit.
   std::vector<double> fits() const { return fits_; }
@@ -56,6 +60,7 @@ class ComparePanel : public QWidget {
   Workspace* workspace_;
   QListWidget* models_;
   QComboBox* range_;
+  QSpinBox* horizon_;
   QCustomPlot* plot_;
   QLabel* fit_;
   PlayheadCursor* cursor_;

@@ -17,6 +17,7 @@
 #include <qcustomplot.h>
 
 #include "core/ident/evaluation.h"
+#include "core/ident/pole_zero_regions.h"
 #include "core/models/analysis.h"
 #include "core/models/nonlinear_plant.h"
 #include "core/signal/preprocess.h"
@@ -277,6 +278,16 @@ void ModelPanel::refreshModel() {
     curve.extremaKnown = true;
     bode_->addCurve(curve);
     poleZero_->addSet(nameOf(entry), QColor(31, 119, 180), poles(sys), zeros(sys));
+    // An estimate's 99 % regions, from the covariance of its free parameters (a model with
+    // structural effects is analysed through them, so it shows none).
+    if (entry.covariance.size() > 0 && entry.effects.empty()) {
+      std::shared_ptr<PhysicalModel> linear = clonePhysical(*entry.model);
+      linear->setOptions(ModelOptions{});
+      std::vector<std::vector<std::complex<double>>> shapes;
+      for (const auto& r : poleZeroRegions(linear.get(), entry.covariance, entry.covarianceIndices, nullptr, 0.99))
+        shapes.push_back(r.boundary());
+      if (!shapes.empty()) poleZero_->addRegions(tr("99 % regions"), QColor(31, 119, 180), shapes);
+    }
     frequencies_->setText(tr("Notches %1 rad/s; peaks %2 rad/s")
                               .arg(frequenciesText(np.notches))
                               .arg(frequenciesText(np.peaks)));

@@ -34,6 +34,7 @@
 #include "widgets/fit_panel.h"
 #include "widgets/model_panel.h"
 #include "widgets/plots/bode_plot.h"
+#include "widgets/plots/pole_zero_plot.h"
 #include "widgets/plots/transient_plot.h"
 #include "widgets/residuals_panel.h"
 #include "widgets/workspace.h"
@@ -390,6 +391,11 @@ class IdentificationTest : public QObject {
     settle();
     QVERIFY(bode->plot()->isVisible());
     for (int i = 0; i < n; ++i) bode->setModelShown(i, true);
+    // The Model panel draws the physical estimate's 99 % pole and zero regions.
+    ModelPanel* mp = window_->modelPanel();
+    mp->selectModel(n - 2);
+    QVERIFY(mp->poleZero()->regionCount() >= 5);  // three-mass: five poles, four zeros
+    test::saveShot(mp->grab().toImage(), "model_panel_regions");
   }
 
   void compareShowsFitOfEveryModel() {
@@ -607,6 +613,26 @@ class IdentificationTest : public QObject {
     QVERIFY2(fit->summaryText().contains(QString("ss[%1]").arg(e.polynomial->orders.na)), qPrintable(fit->summaryText()));
     test::saveShot(window_->grab().toImage(), "fit_state_space_1366x768");
     test::saveShot(fit->grab().toImage(), "fit_panel_state_space");
+    // Compare predicts it k steps ahead as MATLAB's compare(data, model, k) does; the legend
+    // names the horizon and both fit percentages.
+    ComparePanel* cmp = window_->comparePanel();
+    const int n = static_cast<int>(window_->workspace()->models().size());
+    for (int i = 0; i < n; ++i) cmp->setModelShown(i, i == n - 1);
+    cmp->setHorizon(1);
+    compareOnValidation();
+    QCOMPARE(static_cast<int>(cmp->fits().size()), 1);
+    const double oneStep = cmp->fits().front();
+    QVERIFY2(oneStep > 95.0, qPrintable(cmp->fitText()));
+    QStringList legend;
+    for (int g = 0; g < cmp->plot()->graphCount(); ++g) legend << cmp->plot()->graph(g)->name();
+    QVERIFY2(legend.join("|").contains("(1-step)") && legend.join("|").contains("% NRMSE"), qPrintable(legend.join("|")));
+    test::saveShot(cmp->grab().toImage(), "compare_panel_one_step");
+    cmp->setHorizon(50);
+    settle();
+    QVERIFY2(cmp->fits().front() < oneStep, qPrintable(cmp->fitText()));
+    cmp->setHorizon(0);
+    for (int i = 0; i < n; ++i) cmp->setModelShown(i, true);
+    settle();
   }
 
   void cleanupTestCase() { delete window_; }

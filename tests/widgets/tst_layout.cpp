@@ -39,6 +39,7 @@
 #include "widget_test_support.h"
 #include "widgets/arm_panel.h"
 #include "widgets/bode_panel.h"
+#include "widgets/plots/bode_plot.h"
 #include "widgets/compare_panel.h"
 #include "widgets/log_panel.h"
 #include "widgets/log_slider.h"
@@ -382,7 +383,7 @@ class LayoutTest : public QObject {
     QCOMPARE(time->range().lower, window_->workspace()->current()->startTime);
     QCOMPARE(time->range().size(), 10.0);
     // The Bode plot: double click rescales after a zoom, the export writes every format.
-    QCustomPlot* bode = window_->bodePanel()->findChild<QCustomPlot*>();
+    QCustomPlot* bode = window_->bodePanel()->plot()->plot();
     QVERIFY(bode);
     PlotTools* tools = PlotTools::of(bode);
     for (const QString& ext : PlotTools::exportSuffixes()) {

@@ -32,7 +32,31 @@ PoleZeroPlot::PoleZeroPlot(QWidget* parent) : QWidget(parent), plot_(new QCustom
 }
 
 void PoleZeroPlot::clear() {
-  plot_->clearGraphs();
+  plot_->clearPlottables();
+  regions_ = 0;
+  plot_->replot();
+}
+
+void PoleZeroPlot::addRegions(const QString& label, const QColor& color,
+                              const std::vector<std::vector<std::complex<double>>>& boundaries) {
+  bool first = true;
+  for (const auto& b : boundaries) {
+    auto* c = new QCPCurve(plot_->xAxis, plot_->yAxis);
+    QVector<double> x, y;
+    for (const auto& z : b) {
+      x.push_back(z.real());
+      y.push_back(z.imag());
+    }
+    c->setData(x, y);
+    QColor fill = color;
+    fill.setAlpha(40);
+    c->setPen(QPen(color, 1.0));
+    c->setBrush(fill);
+    c->setName(label);
+    if (!first) c->removeFromLegend();
+    first = false;
+    ++regions_;
+  }
   plot_->replot();
 }
 
