@@ -58,7 +58,7 @@ double jointQuantile(std::size_t p, double k) {
 
 JointTest::JointTest(std::vector<double> theta0, std::vector<double> sigma0, double k,
                      double lambda, double kappa)
-    : theta0_(std::move(theta0)), sigma0_(std::move(sigma0)), k_(k), kappa_(kappa) {
+    : theta0_(std::move(theta0)), sigma0_(std::move(sigma0)), kappa_(kappa) {
   const std::size_t p = theta0_.size();
   sigma0_.resize(p, 0.0);
   detect_ = jointQuantile(p, k);

@@ -106,7 +106,7 @@ class JointTest {
 
  private:
   std::vector<double> theta0_, sigma0_;
-  double k_, kappa_, detect_, isolate_;
+  double kappa_, detect_, isolate_;
   std::vector<RobustTest> smooth_;
   std::vector<TestSample> out_;
   std::vector<double> alignment_;

@@ -105,13 +105,26 @@ ModelSignal failed(std::string message, SignalFailure failure = SignalFailure::F
   return out;
 }
 
-// The tail of y (formed from sample `from`) that covers range.
-ModelSignal over(const Eigen::VectorXd& y, std::size_t from, SampleRange range) {
+// How far a model's output may leave the scale of what it is compared with before it counts
+// as diverged: an unstable G grows without bound (1e84 on a 10 s log), and a fit % of such a
+// number says nothing.
+constexpr double kDivergedScale = 1e6;
+
+// The tail of y (formed from sample `from`) that covers range; diverged when it is not finite
+// or, given the measured signal over the range, when it leaves its scale by kDivergedScale.
+ModelSignal over(const Eigen::VectorXd& y, std::size_t from, SampleRange range, const Eigen::VectorXd* measured = nullptr) {
   const auto b = static_cast<Eigen::Index>(range.begin - from), n = static_cast<Eigen::Index>(range.size());
   if (y.size() < b + n) return failed("the simulation did not cover the range");
   ModelSignal out;
   out.y = y.segment(b, n);
   if (!out.y.allFinite()) return failed("the simulated output diverges (an unstable model)", SignalFailure::Diverged);
+  if (measured && measured->size() > 0 && n > 0) {
+    const double scale = measured->cwiseAbs().maxCoeff();
+    if (scale > 0.0 && out.y.cwiseAbs().maxCoeff() > kDivergedScale * scale)
+      return failed("the simulated output diverges (an unstable model: it grows to more than 1e6 times the "
+                    "measured output)",
+                    SignalFailure::Diverged);
+  }
   return out;
 }
 
@@ -151,6 +164,7 @@ ModelSignal modelOutput(const EvaluatedModel& m, const PreparedData& d, SampleRa
   const std::size_t from = firstSample(basis.start, range);
   const SampleRange span{from, range.end};
   const auto b = static_cast<Eigen::Index>(span.begin), n = static_cast<Eigen::Index>(span.size());
+  const Eigen::VectorXd measured = d.y.segment(static_cast<Eigen::Index>(range.begin), static_cast<Eigen::Index>(range.size()));
   if (m.polynomial) {
     const PolynomialModel& p = *m.polynomial;
     if (std::abs(p.sampleTime - d.sampleTime) > 1e-9 * d.sampleTime)
@@ -158,15 +172,16 @@ ModelSignal modelOutput(const EvaluatedModel& m, const PreparedData& d, SampleRa
                         std::to_string(d.sampleTime) + " s",
                     SignalFailure::RateMismatch);
     const Eigen::VectorXd u = d.u.segment(b, n);
-    return over(basis.horizon > 0 ? predict(p, u, d.y.segment(b, n), basis.horizon) : simulate(p, u), from, range);
+    return over(basis.horizon > 0 ? predict(p, u, d.y.segment(b, n), basis.horizon) : simulate(p, u), from, range,
+                &measured);
   }
   if (m.nonlinear()) {
     ModelSignal out = nonlinearOutput(m, d, span, basis.observerHz);
-    return out.ok() ? over(out.y, from, range) : out;
+    return out.ok() ? over(out.y, from, range, &measured) : out;
   }
   // A linear physical model is an output-error model (K = 0): its k-step predictor is its
   // simulation.
-  return over(simulate(*m.physical, d.u.segment(b, n), d.sampleTime), from, range);
+  return over(simulate(*m.physical, d.u.segment(b, n), d.sampleTime), from, range, &measured);
 }
 
 ModelFit modelFit(const EvaluatedModel& m, const PreparedData& d, SampleRange range, FitBasis basis) {

@@ -124,7 +124,9 @@ struct ModelSignal {
 // The model's output over range of d as basis asks: simulation (horizon 0) or k-step
 // prediction (horizon k; an output-error model's is its simulation), through the load
 // observer (observerHz > 0, a model with effects only), from the log's or the range's first
-// sample. A linear physical model is simulated by its zero-order hold (5.3) from zero
+// sample. An output that leaves the measured output's scale by a factor of 1e6 (an unstable
+// model) is reported as diverged, as one that overflows. A linear physical model is simulated
+// by its zero-order hold (5.3) from zero
 // deviation state, a model with effects by the nonlinear plant's Runge-Kutta predictor from
 // rigid-body motion at the first sample's measured speed (core/ident/nonlinear_pem.h), a
 // black-box estimate as B/(A F) u from zero state or predicted by predict (evaluation.h).

@@ -6,6 +6,8 @@
 #include <memory>
 
 #include "core/ident/blackbox.h"
+#include "core/ident/fit_data.h"
+#include "core/ident/model_output.h"
 #include "core/ident/order_scan.h"
 #include "tests/core/ident/sim_helpers.h"
 #include "tests/core/ident/subspace_logs.h"
@@ -118,6 +120,38 @@ TEST(OrderScan, StateSpaceOrderOfAFlexibleArm) {
   spec.orders = PolyOrders{0, 2, 0, 0, 2, 1};
   EXPECT_FALSE(OrderScanOptions::fromSpec(spec, &why));
   EXPECT_NE(why.find("arx:NA,NB,NK"), std::string::npos) << why;
+}
+
+}  // namespace
+}  // namespace flexarm
+
+namespace flexarm {
+namespace {
+
+// An estimate whose G is unstable simulates to a finite but absurd size on a long log (a
+// pole at 1.02 grows by 1e17 over 2000 samples): Compare and the fit call that diverged
+// instead of printing a fit % of -1e30.
+TEST(ModelOutput, AnOutputFarBeyondTheDataDiverges) {
+  const Poly one{1.0}, b{0.0, 1.0, 0.5}, f{1.0, -1.5, 0.7};
+  const testing::SimData s = testing::simulateSystem(one, b, one, one, f, 2000, 0.3, 4);
+  auto log = testing::torqueVelocityLog(s.u, s.y, 1e-3);
+  FitDataOptions fo;
+  const PreparedData d = prepareFitData(*log, fo);
+  ASSERT_TRUE(d.ok()) << d.message;
+  auto unstable = std::make_shared<PolynomialModel>(PolynomialModel::zero(PolyStructure::Oe, {0, 2, 0, 0, 1, 1}, 1e-3));
+  unstable->b = {0.0, 1.0, 0.5};
+  unstable->f = {1.0, -1.02};
+  EvaluatedModel m;
+  m.name = "unstable";
+  m.polynomial = unstable;
+  const SampleRange whole{0, static_cast<std::size_t>(d.u.size())};
+  const ModelSignal out = modelOutput(m, d, whole, FitBasis{});
+  EXPECT_FALSE(out.ok());
+  EXPECT_EQ(out.failure, SignalFailure::Diverged);
+  EXPECT_NE(out.message.find("diverges"), std::string::npos) << out.message;
+  // A stable one of the same size is compared as before.
+  unstable->f = {1.0, -0.98};
+  EXPECT_TRUE(modelOutput(m, d, whole, FitBasis{}).ok());
 }
 
 }  // namespace
