@@ -23,12 +23,7 @@ constexpr double kT = 1e-3;  // 1 kHz
 
 // A log of torque (input) and motor velocity (output) at kT.
 std::shared_ptr<const IdData> logOf(const Eigen::VectorXd& u, const Eigen::VectorXd& y) {
-  auto d = std::make_shared<IdData>();
-  d->sampleTime = kT;
-  d->setChannel({columns::kTorqueRef, "N m", ChannelRole::Input, std::vector<double>(u.data(), u.data() + u.size())});
-  d->setChannel(
-      {columns::kMotorVelocity, "rad/s", ChannelRole::Output, std::vector<double>(y.data(), y.data() + y.size())});
-  return d;
+  return testing::torqueVelocityLog(u, y, kT);
 }
 
 // Excitation 1: white torque; excitation 2: a random binary torque held for `hold` samples.
